@@ -1,0 +1,5 @@
+"""Type stubs for the compiled module ``manakov._core`` (private; use ``manakov``)."""
+
+__version__: str
+
+class ConvergenceError(RuntimeError): ...

@@ -1,0 +1,120 @@
+//! The crate's one error type.
+//!
+//! Every variant carries the offending numbers so that the message a user
+//! sees names what was wrong. The Python layer maps each variant onto an
+//! exception in `rust/python/errors.rs` (invalid arguments become
+//! `ValueError`, non-convergence becomes `manakov.ConvergenceError`).
+
+use std::fmt;
+
+/// Errors of the `manakov` core.
+#[derive(Debug, Clone, PartialEq)]
+#[non_exhaustive]
+pub enum Error {
+    /// An array or vector has the wrong length or shape.
+    Shape {
+        what: &'static str,
+        expected: String,
+        got: String,
+    },
+    /// A NaN or infinity where a finite number is required.
+    NonFinite { what: &'static str, index: usize },
+    /// Two of the `a_i` coincide, so `c_ij = (b_i - b_j)/(a_i - a_j)` (2) is undefined.
+    RepeatedA { i: usize, j: usize, value: f64 },
+    /// A matrix that must be symmetric is not.
+    NotSymmetric { what: &'static str, max_asym: f64 },
+    /// Im τ is not positive definite.
+    ImagNotPositiveDefinite { min_eig: f64 },
+    /// Two branch points of the curve coincide: the genus drops.
+    RepeatedBranchPoints { i: usize, j: usize, value: f64 },
+    /// Any other invalid argument, with the reason.
+    InvalidArgument { what: &'static str, reason: String },
+    /// An iteration did not reach its tolerance.
+    NoConvergence {
+        what: &'static str,
+        tol: f64,
+        reached: f64,
+        iterations: usize,
+    },
+}
+
+/// `Result` with the crate's [`Error`].
+pub type Result<T> = std::result::Result<T, Error>;
+
+impl fmt::Display for Error {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Error::Shape {
+                what,
+                expected,
+                got,
+            } => write!(f, "{what}: expected shape {expected}, got {got}"),
+            Error::NonFinite { what, index } => {
+                write!(f, "{what} must be finite; entry {index} is NaN or infinite")
+            }
+            Error::RepeatedA { i, j, value } => write!(
+                f,
+                "a[{i}] == a[{j}] == {value}: the a_i must be distinct, \
+                 c_ij = (b_i - b_j)/(a_i - a_j) (2) is undefined"
+            ),
+            Error::NotSymmetric { what, max_asym } => {
+                write!(f, "{what} must be symmetric; max |M - M^T| = {max_asym:e}")
+            }
+            Error::ImagNotPositiveDefinite { min_eig } => write!(
+                f,
+                "Im tau must be positive definite; its smallest eigenvalue is {min_eig:e}"
+            ),
+            Error::RepeatedBranchPoints { i, j, value } => write!(
+                f,
+                "branch points d{i} and d{j} coincide (= {value}): the curve is singular, its genus drops"
+            ),
+            Error::InvalidArgument { what, reason } => write!(f, "invalid {what}: {reason}"),
+            Error::NoConvergence {
+                what,
+                tol,
+                reached,
+                iterations,
+            } => write!(
+                f,
+                "{what} did not converge: tolerance {tol:e}, reached {reached:e} after {iterations} iterations"
+            ),
+        }
+    }
+}
+
+impl std::error::Error for Error {}
+
+/// Checks that every entry of `x` is finite.
+pub fn check_finite(what: &'static str, x: &[f64]) -> Result<()> {
+    match x.iter().position(|v| !v.is_finite()) {
+        Some(index) => Err(Error::NonFinite { what, index }),
+        None => Ok(()),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn check_finite_names_the_entry() {
+        assert_eq!(check_finite("l", &[1.0, 2.0]), Ok(()));
+        assert_eq!(
+            check_finite("l", &[1.0, f64::NAN]),
+            Err(Error::NonFinite {
+                what: "l",
+                index: 1
+            })
+        );
+    }
+
+    #[test]
+    fn messages_carry_the_numbers() {
+        let e = Error::RepeatedA {
+            i: 0,
+            j: 2,
+            value: 1.5,
+        };
+        assert!(e.to_string().contains("a[0] == a[2] == 1.5"));
+    }
+}

@@ -1,0 +1,8 @@
+//! Bindings for `crate::kotter`.
+
+use pyo3::prelude::*;
+
+/// Adds this module's functions to `manakov._core`.
+pub fn register(_m: &Bound<'_, PyModule>) -> PyResult<()> {
+    Ok(())
+}

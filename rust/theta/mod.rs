@@ -1,0 +1,1 @@
+//! Riemann theta functions with half-integer characteristics, (34)–(36).
