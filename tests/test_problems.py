@@ -7,6 +7,7 @@ import numpy as np
 import pytest
 
 import manakov
+
 from conftest import PROBLEM_NAMES
 
 SHARED = Path(__file__).resolve().parents[2] / "shared" / "reference" / "problems.json"
