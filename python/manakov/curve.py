@@ -369,9 +369,7 @@ class KotterCurve:
         if g_ref is not None:
             gr = np.ascontiguousarray(np.broadcast_to(_c(g_ref), shape).reshape(-1))
         sc = None if sqrt_c is None else np.ascontiguousarray(_c(sqrt_c).reshape(-1))
-        pts, eps, res = _core.curve_points_from_xi_eta(
-            self._d123(), xr, er, sc, gr, float(rtol)
-        )
+        pts, eps, res = _core.curve_points_from_xi_eta(self._d123(), xr, er, sc, gr, float(rtol))
         cols = [pts[:, i].reshape(shape) for i in range(5)]
         return CurvePoints(
             z1=_scalar_or(cols[0], scalar),

@@ -68,6 +68,14 @@ pub const INVERSE_RTOL: f64 = 1e-8;
 /// `d_2 d_3 = 1` only up to a few ulps.
 const REPEATED_RTOL: f64 = 8.0 * f64::EPSILON;
 
+/// `|z1 − z2|` (relative to `max(|z1|, 1)`) below which the inverse reports
+/// the double root `z1 == z2` instead of a pair: a discriminant `(z1 − z2)²`
+/// that is zero in exact arithmetic comes out ~1e-16 after rounding, i.e.
+/// `|z1 − z2|` ~1e-8, and the error of the recovered pair grows like
+/// `u/|z1 − z2|²`, reaching O(1e-4) relative at 1e-6: below that the two
+/// points are not resolved.
+const NEAR_DOUBLE_ROOT: f64 = 1e-6;
+
 /// The cyclic permutations `(j, k, l)` of `(1, 2, 3)`, in the order `j = 1, 2, 3`.
 pub const CYCLIC: [(usize, usize, usize); 3] = [(1, 2, 3), (2, 3, 1), (3, 1, 2)];
 
@@ -432,7 +440,20 @@ impl KotterCurve {
             return unreachable_error();
         };
         let b = self.refine(best, &target, &sc);
-        if b.residual <= rtol * scale {
+        if (b.z1 - b.z2).norm() <= NEAR_DOUBLE_ROOT * b.z1.norm().max(1.0) {
+            // A discriminant that vanishes in exact arithmetic is ~1e-16 after
+            // rounding, so z1 - z2 ~ 1e-8: the data sit at z1 == z2, and no
+            // pair closer than NEAR_DOUBLE_ROOT can be resolved from them.
+            Err(Error::InvalidArgument {
+                what: "xi, eta",
+                reason: format!(
+                    "they give (nearly) z1 == z2 (|z1 - z2| = {:e} at z = {}): P_jk (28) is \
+                     singular there and the two points cannot be resolved",
+                    (b.z1 - b.z2).norm(),
+                    b.z1,
+                ),
+            })
+        } else if b.residual <= rtol * scale {
             Ok(b)
         } else {
             Err(Error::InvalidArgument {

@@ -17,10 +17,23 @@ fn c(re: f64, im: f64) -> C {
 /// points drawn here) to cancellation; 1e-11 leaves a margin of ~10.
 const IDENTITY_RTOL: f64 = 1e-11;
 
-/// The round trip `(z, y) → (ξ, η) → (z, y)` is a handful of well-conditioned
-/// rational operations and one square root for separated points; 1e-12
-/// relative to the size of the data is the claim.
-const ROUNDTRIP_RTOL: f64 = 1e-12;
+/// Backward error of the inverse map: the recovered `(z1, y1, z2, y2, g, eps)`
+/// reproduce `(ξ, η)` to this fraction of `max|(ξ, η)|`. After the
+/// Gauss–Newton polish the residual is a few rounding errors of the forward
+/// map (worst seen over 20 000 random cases: 1e-14).
+const BACKWARD_RTOL: f64 = 1e-13;
+
+/// Forward error of the round trip `(z, y) → (ξ, η) → (z, y)` for points with
+/// `|z1 − z2| ≥ 1`. The inverse is conditioned like the map itself, whose
+/// Jacobian becomes singular as `z1 → z2`; for separated points the
+/// amplification of rounding errors stays below ~1e3 (worst seen: 3.4e-13).
+const FORWARD_RTOL: f64 = 1e-12;
+
+/// Forward error for any pair with `|z1 − z2| ≥ 0.1`: the smallest singular
+/// value of the Jacobian of `(z1, z2, g) → (ξ, η)` drops to ~1e-3 of the
+/// data there (an mpmath estimate for the worst case gives a bound ~6e-12 on
+/// the error of `y`; worst seen: 3.8e-11).
+const FORWARD_RTOL_CLOSE: f64 = 1e-9;
 
 fn close(a: C, b: C, scale: f64, rtol: f64) -> bool {
     (a - b).norm() <= rtol * scale.max(f64::MIN_POSITIVE)
@@ -295,18 +308,19 @@ proptest! {
         } else {
             (back.y2, back.z2, back.y1, back.z1)
         };
+        let fwd = if (z1 - z2).norm() >= 1.0 { FORWARD_RTOL } else { FORWARD_RTOL_CLOSE };
         let zs = z1.norm().max(z2.norm()).max(1.0);
-        prop_assert!(close(bz1, z1, zs, ROUNDTRIP_RTOL), "z1 {} vs {}", bz1, z1);
-        prop_assert!(close(bz2, z2, zs, ROUNDTRIP_RTOL), "z2 {} vs {}", bz2, z2);
+        prop_assert!(close(bz1, z1, zs, fwd), "z1 {} vs {}", bz1, z1);
+        prop_assert!(close(bz2, z2, zs, fwd), "z2 {} vs {}", bz2, z2);
         let ys = y1.norm().max(y2.norm()).max(1.0);
-        prop_assert!(close(b1, y1, ys, ROUNDTRIP_RTOL), "y1 {} vs {}", b1, y1);
-        prop_assert!(close(b2, y2, ys, ROUNDTRIP_RTOL), "y2 {} vs {}", b2, y2);
-        prop_assert!(close(back.g, g, g.norm(), ROUNDTRIP_RTOL));
+        prop_assert!(close(b1, y1, ys, fwd), "y1 {} vs {}", b1, y1);
+        prop_assert!(close(b2, y2, ys, fwd), "y2 {} vs {}", b2, y2);
+        prop_assert!(close(back.g, g, g.norm(), fwd));
         let scale = xi.iter().chain(eta.iter()).map(|v| v.norm()).fold(0.0, f64::max);
         let (x1, e1) = k.xi_eta(back.z1, back.y1, back.z2, back.y2, back.g, Some(back.eps), None).unwrap();
         for i in 0..3 {
-            prop_assert!(close(x1[i], xi[i], scale, ROUNDTRIP_RTOL));
-            prop_assert!(close(e1[i], eta[i], scale, ROUNDTRIP_RTOL));
+            prop_assert!(close(x1[i], xi[i], scale, BACKWARD_RTOL));
+            prop_assert!(close(e1[i], eta[i], scale, BACKWARD_RTOL));
         }
         // eps is recovered modulo the flip of P_1 … P_4 that leaves every P_jk
         // unchanged — unless a point sits on a cut of the principal roots, where
@@ -320,15 +334,19 @@ proptest! {
         }
         // Without g_ref, the pair (−g, −y1, −y2) is just as good: same (ξ, η).
         let alt = k.points_from_xi_eta(xi, eta, None, Some(-g), INVERSE_RTOL).unwrap();
-        prop_assert!(close(alt.g, -g, g.norm(), ROUNDTRIP_RTOL));
+        prop_assert!(close(alt.g, -g, g.norm(), fwd));
         let (x2, e2) = k.xi_eta(alt.z1, alt.y1, alt.z2, alt.y2, alt.g, Some(alt.eps), None).unwrap();
         for i in 0..3 {
-            prop_assert!(close(x2[i], xi[i], scale, ROUNDTRIP_RTOL));
-            prop_assert!(close(e2[i], eta[i], scale, ROUNDTRIP_RTOL));
+            prop_assert!(close(x2[i], xi[i], scale, BACKWARD_RTOL));
+            prop_assert!(close(e2[i], eta[i], scale, BACKWARD_RTOL));
         }
     }
 }
 
+/// Diagnostic, not a check: the worst forward and backward errors of the
+/// inverse over 20 000 random cases, binned by `|z1 − z2|` — the source of the
+/// numbers quoted at `FORWARD_RTOL*` and `BACKWARD_RTOL`. Run with
+/// `cargo test --release --lib curve::tests::stats -- --ignored --nocapture`.
 #[test]
 #[ignore]
 fn stats_forward_error() {
