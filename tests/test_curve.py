@@ -677,3 +677,22 @@ def test_exports():
     assert manakov.KotterCurve is KotterCurve
     assert manakov.Wurzel is manakov.curve.Wurzel
     assert manakov.CurvePoints is manakov.curve.CurvePoints
+
+
+@pytest.mark.parametrize("seed", range(10))
+def test_36_xi_eta_lie_on_koetter_quadrics_11(seed):
+    """(36) maps every point pair and g onto the three quadrics (11): the first
+    is the s**-2 coefficient of (29), the second (31a), the third (32)."""
+    rng = np.random.default_rng(5000 + seed)
+    dd, d, (z1, y1, z2, y2) = random_setup(rng)
+    k = KotterCurve(*dd)
+    g = rand_c(rng, -2, 2)
+    xi, eta = k.xi_eta(z1, y1, z2, y2, g, eps=all_eps()[seed % 16])
+    dj = d[1:4]
+    for terms in (xi**2 + eta**2, xi * eta, dj * xi**2 + eta**2 / dj):
+        assert abs(terms.sum()) <= IDENTITY_RTOL * np.abs(terms).sum()
+    # And (36) itself, against the independent numpy evaluation.
+    xn, en = np_xi_eta(d, z1, y1, z2, y2, g, all_eps()[seed % 16])
+    scale = max(np.abs(xn).max(), np.abs(en).max())
+    np.testing.assert_allclose(xi, xn, rtol=0, atol=NUMPY_RTOL * scale)
+    np.testing.assert_allclose(eta, en, rtol=0, atol=NUMPY_RTOL * scale)
