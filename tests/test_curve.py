@@ -42,9 +42,12 @@ IDENTITY_RTOL = 1e-11
 #: Gauss-Newton polish; worst seen in the Rust stats run: 1e-14).
 BACKWARD_RTOL = 1e-13
 
-#: Forward error of the round trip for |z1 - z2| >= 1, where the map
-#: (z1, z2, g) -> (xi, eta) is well conditioned (see test_inverse_conditioning).
-FORWARD_RTOL = 1e-12
+#: Forward error of the round trip in units of the first-order bound
+#: u * |(xi, eta)| / sigma_min(J), J the Jacobian of (z1, z2, g) -> (xi, eta):
+#: the inverse is as accurate as the map's conditioning allows (worst ratio
+#: seen over 100 000 random cases in the Rust stats run: 29). In absolute
+#: terms that is a median error of 2e-15 and 99 % below 3e-13.
+STABILITY_FACTOR = 100.0
 
 
 # ----------------------------------------------------------------------------
@@ -419,6 +422,34 @@ def np_xi_eta(d, z1, y1, z2, y2, g, eps=(1, 1, 1, 1, 1)):
     return xi, eta
 
 
+def np_error_bound(d, z1, y1, z2, y2, g, eps):
+    """First-order error bound of the inverse, u |data| sqrt(6) / sigma_min(J),
+    with J by central differences of the independent np_xi_eta (y continued to
+    the nearer sheet); returned for (z, y1, y2)."""
+
+    def near(y, yref):
+        return y if abs(y - yref) <= abs(y + yref) else -y
+
+    def data(a, b, gg):
+        xi, eta = np_xi_eta(d, a, near(np_y(d, a), y1), b, near(np_y(d, b), y2), gg, eps)
+        return np.concatenate([xi, eta])
+
+    f0 = data(z1, z2, g)
+    h = 1e-6 * min(abs(z1 - z2), 1.0)
+    J = np.stack(
+        [
+            (data(z1 + h, z2, g) - data(z1 - h, z2, g)) / (2 * h),
+            (data(z1, z2 + h, g) - data(z1, z2 - h, g)) / (2 * h),
+            f0 / g,
+        ],
+        axis=1,
+    )
+    smin = np.linalg.svd(J, compute_uv=False).min()
+    dz = np.finfo(float).eps * np.abs(f0).max() * np.sqrt(6) / smin
+    dy = [abs(y * np.sum(1 / (z - d)) / 2) * dz for z, y in ((z1, y1), (z2, y2))]
+    return dz, dy[0], dy[1]
+
+
 @pytest.mark.parametrize("seed", range(60))
 def test_inverse_round_trip(seed):
     rng = np.random.default_rng(4000 + seed)
@@ -433,19 +464,19 @@ def test_inverse_round_trip(seed):
     scale = max(np.abs(xi).max(), np.abs(eta).max())
     assert np.abs(np.concatenate([xb - xi, eb - eta])).max() <= 10 * BACKWARD_RTOL * scale
     assert back.residual <= BACKWARD_RTOL * scale
-    # Forward error, for well-separated points.
-    if abs(z1 - z2) >= 1.0:
-        if abs(back.z1 - z1) > abs(back.z1 - z2):
-            back_pts = (back.z2, back.y2, back.z1, back.y1)
-        else:
-            back_pts = (back.z1, back.y1, back.z2, back.y2)
-        zs = max(abs(z1), abs(z2), 1.0)
-        ys = max(abs(y1), abs(y2), 1.0)
-        assert abs(back_pts[0] - z1) <= FORWARD_RTOL * zs
-        assert abs(back_pts[2] - z2) <= FORWARD_RTOL * zs
-        assert abs(back_pts[1] - y1) <= FORWARD_RTOL * ys
-        assert abs(back_pts[3] - y2) <= FORWARD_RTOL * ys
-        assert abs(back.g - g) <= FORWARD_RTOL * abs(g)
+    # Forward error, against the conditioning of the map.
+    if abs(back.z1 - z1) > abs(back.z1 - z2):
+        bz1, by1, bz2, by2 = back.z2, back.y2, back.z1, back.y1
+    else:
+        bz1, by1, bz2, by2 = back.z1, back.y1, back.z2, back.y2
+    bound = np_error_bound(d, z1, y1, z2, y2, g, eps)
+    assert abs(bz1 - z1) <= STABILITY_FACTOR * bound[0]
+    assert abs(bz2 - z2) <= STABILITY_FACTOR * bound[0]
+    assert abs(by1 - y1) <= STABILITY_FACTOR * bound[1]
+    assert abs(by2 - y2) <= STABILITY_FACTOR * bound[2]
+    assert abs(back.g - g) <= STABILITY_FACTOR * bound[0]
+    # For these seeded cases that is the ~1e-12 claim in absolute terms.
+    assert max(abs(bz1 - z1), abs(bz2 - z2)) <= 1e-12 * max(abs(z1), abs(z2), 1)
     # eps has product +1 and eps_4 = +1.
     assert np.prod(back.eps) == 1 and back.eps[4] == 1
 

@@ -20,20 +20,18 @@ const IDENTITY_RTOL: f64 = 1e-11;
 /// Backward error of the inverse map: the recovered `(z1, y1, z2, y2, g, eps)`
 /// reproduce `(ξ, η)` to this fraction of `max|(ξ, η)|`. After the
 /// Gauss–Newton polish the residual is a few rounding errors of the forward
-/// map (worst seen over 20 000 random cases: 1e-14).
+/// map (worst seen over 100 000 random cases: 1.2e-14).
 const BACKWARD_RTOL: f64 = 1e-13;
 
-/// Forward error of the round trip `(z, y) → (ξ, η) → (z, y)` for points with
-/// `|z1 − z2| ≥ 1`. The inverse is conditioned like the map itself, whose
-/// Jacobian becomes singular as `z1 → z2`; for separated points the
-/// amplification of rounding errors stays below ~1e3 (worst seen: 3.4e-13).
-const FORWARD_RTOL: f64 = 1e-12;
-
-/// Forward error for any pair with `|z1 − z2| ≥ 0.1`: the smallest singular
-/// value of the Jacobian of `(z1, z2, g) → (ξ, η)` drops to ~1e-3 of the
-/// data there (an mpmath estimate for the worst case gives a bound ~6e-12 on
-/// the error of `y`; worst seen: 3.8e-11).
-const FORWARD_RTOL_CLOSE: f64 = 1e-9;
+/// Forward error of the round trip `(z, y) → (ξ, η) → (z, y)`, in units of
+/// the first-order bound `u ‖(ξ, η)‖ / σ_min(J)` ([`inverse_error_bound`]):
+/// the inverse is conditioned like the map itself, whose Jacobian is singular
+/// at `z1 = z2` and degrades for clustered branch points or far points. Over
+/// 100 000 random cases the worst ratio was 29 (the data themselves carry
+/// more than `u` of rounding from (28)); 100 leaves a margin of 3.5. In
+/// absolute terms the forward error had median 1.9e-15, 99 % 2.9e-13,
+/// 99.9 % 2.5e-12 (the `stats_forward_error` run).
+const STABILITY_FACTOR: f64 = 100.0;
 
 fn close(a: C, b: C, scale: f64, rtol: f64) -> bool {
     (a - b).norm() <= rtol * scale.max(f64::MIN_POSITIVE)
@@ -308,14 +306,15 @@ proptest! {
         } else {
             (back.y2, back.z2, back.y1, back.z1)
         };
-        let fwd = if (z1 - z2).norm() >= 1.0 { FORWARD_RTOL } else { FORWARD_RTOL_CLOSE };
-        let zs = z1.norm().max(z2.norm()).max(1.0);
-        prop_assert!(close(bz1, z1, zs, fwd), "z1 {} vs {}", bz1, z1);
-        prop_assert!(close(bz2, z2, zs, fwd), "z2 {} vs {}", bz2, z2);
-        let ys = y1.norm().max(y2.norm()).max(1.0);
-        prop_assert!(close(b1, y1, ys, fwd), "y1 {} vs {}", b1, y1);
-        prop_assert!(close(b2, y2, ys, fwd), "y2 {} vs {}", b2, y2);
-        prop_assert!(close(back.g, g, g.norm(), fwd));
+        let bound = inverse_error_bound(&k, z1, y1, z2, y2, g);
+        if let Some(bd) = bound {
+            let tol = bd.map(|b| STABILITY_FACTOR * b);
+            prop_assert!((bz1 - z1).norm() <= tol[0], "z1 {} vs {} (bound {:e})", bz1, z1, bd[0]);
+            prop_assert!((bz2 - z2).norm() <= tol[0], "z2 {} vs {} (bound {:e})", bz2, z2, bd[0]);
+            prop_assert!((b1 - y1).norm() <= tol[1], "y1 {} vs {} (bound {:e})", b1, y1, bd[1]);
+            prop_assert!((b2 - y2).norm() <= tol[2], "y2 {} vs {} (bound {:e})", b2, y2, bd[2]);
+            prop_assert!((back.g - g).norm() <= tol[3], "g {} vs {}", back.g, g);
+        }
         let scale = xi.iter().chain(eta.iter()).map(|v| v.norm()).fold(0.0, f64::max);
         let (x1, e1) = k.xi_eta(back.z1, back.y1, back.z2, back.y2, back.g, Some(back.eps), None).unwrap();
         for i in 0..3 {
@@ -334,7 +333,9 @@ proptest! {
         }
         // Without g_ref, the pair (−g, −y1, −y2) is just as good: same (ξ, η).
         let alt = k.points_from_xi_eta(xi, eta, None, Some(-g), INVERSE_RTOL).unwrap();
-        prop_assert!(close(alt.g, -g, g.norm(), fwd));
+        if let Some(bd) = bound {
+            prop_assert!((alt.g + g).norm() <= STABILITY_FACTOR * bd[3]);
+        }
         let (x2, e2) = k.xi_eta(alt.z1, alt.y1, alt.z2, alt.y2, alt.g, Some(alt.eps), None).unwrap();
         for i in 0..3 {
             prop_assert!(close(x2[i], xi[i], scale, BACKWARD_RTOL));
@@ -343,9 +344,56 @@ proptest! {
     }
 }
 
+/// First-order error bound of the inverse map at `(z1, y1, z2, y2, g)`:
+/// `u · ‖(ξ, η)‖ / σ_min(J)` with `J` the Jacobian of `(z1, z2, g) → (ξ, η)`
+/// (central differences through the public `xi_eta`, `y` continued to the
+/// nearer sheet), returned as bounds on `(|δz|, |δy1|, |δy2|, |δg|)`;
+/// `None` if the differences straddle a cut of the principal roots.
+fn inverse_error_bound(k: &KotterCurve, z1: C, y1: C, z2: C, y2: C, g: C) -> Option<[f64; 4]> {
+    let near = |y: C, yref: C| {
+        if (y - yref).norm() <= (y + yref).norm() {
+            y
+        } else {
+            -y
+        }
+    };
+    let data = |a: C, b: C, gg: C| -> Option<[C; 6]> {
+        let (ya, yb) = (near(k.y(a), y1), near(k.y(b), y2));
+        let (x, e) = k.xi_eta(a, ya, b, yb, gg, None, None).ok()?;
+        Some([x[0], x[1], x[2], e[0], e[1], e[2]])
+    };
+    let f0 = data(z1, z2, g)?;
+    let h = 1e-6 * (z1 - z2).norm().min(1.0);
+    let hc = C::new(h, 0.0);
+    let cols = [
+        (data(z1 + hc, z2, g)?, data(z1 - hc, z2, g)?),
+        (data(z1, z2 + hc, g)?, data(z1, z2 - hc, g)?),
+    ];
+    let mut jac = nalgebra::SMatrix::<C, 6, 3>::zeros();
+    for i in 0..6 {
+        for (c, (p, m)) in cols.iter().enumerate() {
+            jac[(i, c)] = (p[i] - m[i]) / (2.0 * h);
+        }
+        jac[(i, 2)] = f0[i] / g;
+    }
+    // A derivative that is O(1/h) larger than the data means a jump across a cut.
+    let fmax = f0.iter().map(|v| v.norm()).fold(0.0, f64::max);
+    if jac.iter().any(|v| v.norm() * h > 1e-2 * fmax) {
+        return None;
+    }
+    let smin = jac.singular_values().min();
+    let dz = f64::EPSILON * fmax * 6f64.sqrt() / smin;
+    let dy = |z: C, y: C| {
+        let d = k.branch_points();
+        let dlog: C = d.iter().map(|dj| 1.0 / (z - dj)).sum();
+        (y * dlog / 2.0).norm() * dz
+    };
+    Some([dz, dy(z1, y1), dy(z2, y2), dz])
+}
+
 /// Diagnostic, not a check: the worst forward and backward errors of the
-/// inverse over 20 000 random cases, binned by `|z1 − z2|` — the source of the
-/// numbers quoted at `FORWARD_RTOL*` and `BACKWARD_RTOL`. Run with
+/// inverse over 100 000 random cases, binned by `|z1 − z2|` — the source of the
+/// numbers quoted at `STABILITY_FACTOR` and `BACKWARD_RTOL`. Run with
 /// `cargo test --release --lib curve::tests::stats -- --ignored --nocapture`.
 #[test]
 #[ignore]
@@ -361,7 +409,9 @@ fn stats_forward_error() {
         cplx(-2.0, 2.0),
     );
     let mut worst = vec![0.0f64; 6];
-    for _ in 0..20000 {
+    let mut worst_ratio = 0.0f64;
+    let mut all: Vec<f64> = Vec::new();
+    for _ in 0..100_000 {
         let (d1, d2, d3, z1, z2, g) =
             proptest::strategy::ValueTree::current(&strat.new_tree(&mut runner).unwrap());
         let Ok(k) = KotterCurve::new(d1, d2, d3) else {
@@ -389,14 +439,34 @@ fn stats_forward_error() {
         let b = k
             .points_from_xi_eta(xi, eta, None, Some(g), INVERSE_RTOL)
             .unwrap();
-        let (bz1, by1) = if (b.z1 - z1).norm() < (b.z2 - z1).norm() {
-            (b.z1, b.y1)
+        let (bz1, by1, bz2, by2) = if (b.z1 - z1).norm() <= (b.z1 - z2).norm() {
+            (b.z1, b.y1, b.z2, b.y2)
         } else {
-            (b.z2, b.y2)
+            (b.z2, b.y2, b.z1, b.y1)
         };
-        let ez = (bz1 - z1).norm() / z1.norm().max(1.0);
-        let ey = (by1 - y1).norm() / y1.norm().max(1.0);
-        worst[bin] = worst[bin].max(ez.max(ey));
+        // The same measures as `inverse_round_trip`.
+        let zs = z1.norm().max(z2.norm()).max(1.0);
+        let ys = y1.norm().max(y2.norm()).max(1.0);
+        let e = [
+            (bz1 - z1).norm() / zs,
+            (bz2 - z2).norm() / zs,
+            (by1 - y1).norm() / ys,
+            (by2 - y2).norm() / ys,
+            (b.g - g).norm() / g.norm(),
+        ];
+        let m = e.iter().fold(0.0f64, |a, &b| a.max(b));
+        worst[bin] = worst[bin].max(m);
+        all.push(m);
+        if let Some(bd) = inverse_error_bound(&k, z1, y1, z2, y2, g) {
+            let ratio = [
+                (bz1 - z1).norm() / bd[0],
+                (bz2 - z2).norm() / bd[0],
+                (by1 - y1).norm() / bd[1],
+                (by2 - y2).norm() / bd[2],
+                (b.g - g).norm() / bd[3],
+            ];
+            worst_ratio = ratio.iter().fold(worst_ratio, |a, &b| a.max(b));
+        }
         let scale = xi
             .iter()
             .chain(eta.iter())
@@ -405,4 +475,15 @@ fn stats_forward_error() {
         worst[5] = worst[5].max(b.residual / scale);
     }
     println!("worst forward error by |z1-z2| bin [.1,.3,.6,1,2,inf], backward: {worst:?}");
+    println!("worst forward error / first-order bound: {worst_ratio:e}");
+    all.sort_by(f64::total_cmp);
+    let q = |p: f64| all[((all.len() - 1) as f64 * p) as usize];
+    println!(
+        "forward error over {} cases: median {:e}, 90% {:e}, 99% {:e}, 99.9% {:e}",
+        all.len(),
+        q(0.5),
+        q(0.9),
+        q(0.99),
+        q(0.999)
+    );
 }
