@@ -727,3 +727,37 @@ def test_36_xi_eta_lie_on_koetter_quadrics_11(seed):
     scale = max(np.abs(xn).max(), np.abs(en).max())
     np.testing.assert_allclose(xi, xn, rtol=0, atol=NUMPY_RTOL * scale)
     np.testing.assert_allclose(eta, en, rtol=0, atol=NUMPY_RTOL * scale)
+
+
+@pytest.mark.parametrize(
+    ("dd", "z1", "z2"),
+    [
+        # Real branch points, real points between them: z - d_j < 0 for some j, i.e.
+        # on the cuts of the principal roots (sqrt of a negative real is +i sqrt).
+        ((1.0, 2.5, 4.0), 1.7, 3.2),
+        ((1.0, 2.5, 4.0), -0.6, 12.0),
+        ((-0.5, 0.8, 3.0), -0.2, 0.4),
+        # Real d_j, complex points.
+        ((0.3, 1.9, -2.2), 0.5 + 0.5j, -1.0 - 0.25j),
+    ],
+)
+@pytest.mark.parametrize("sheets", [(1, 1), (1, -1)])
+def test_real_branch_points_and_points_on_cuts(dd, z1, z2, sheets):
+    k = KotterCurve(*dd)
+    d = k.branch_points
+    assert np.all(d.imag == 0)
+    y1, y2 = k.y(z1, sheet=sheets[0]), k.y(z2, sheet=sheets[1])
+    w = k.wurzel(z1, y1, z2, y2)
+    P, Pjk = np_wurzel(d, complex(z1), y1, complex(z2), y2)
+    np.testing.assert_allclose(w.P, P, rtol=NUMPY_RTOL)
+    np.testing.assert_allclose(w.Pjk, Pjk, rtol=0, atol=NUMPY_RTOL * np.abs(Pjk).max())
+    for name, (v, expected, scale) in identities(d, w.P, w.Pjk).items():
+        assert abs(v - expected) <= IDENTITY_RTOL * scale, name
+    g = 0.9
+    xi, eta = k.xi_eta(z1, y1, z2, y2, g)
+    back = k.points_from_wurzel(xi, eta, g_ref=g)
+    assert back.residual <= BACKWARD_RTOL * max(np.abs(xi).max(), np.abs(eta).max())
+    assert {round(back.z1.real, 9), round(back.z2.real, 9)} == {
+        round(complex(z1).real, 9),
+        round(complex(z2).real, 9),
+    }
