@@ -599,6 +599,10 @@ def test_bad_points():
         k.wurzel(z1, y1, z2, y2, eps=[1, 1, 1])
     with pytest.raises(ValueError, match="sheet"):
         k.y(z1, sheet=2)
+    with pytest.raises(ValueError, match="finite"):
+        k.R([0.5, np.nan])
+    with pytest.raises(ValueError, match="finite"):
+        k.y(np.inf)
 
 
 def test_bad_inverse_input():
