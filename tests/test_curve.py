@@ -765,3 +765,38 @@ def test_real_branch_points_and_points_on_cuts(dd, z1, z2, sheets):
         round(complex(z1).real, 9),
         round(complex(z2).real, 9),
     }
+
+
+@pytest.mark.parametrize("seed", range(10))
+def test_wurzel_symmetries(seed):
+    """Choices the result must not depend on: the order of the two points; and
+    the hyperelliptic involution on both points, (y1, y2) -> (-y1, -y2), which
+    leaves every P_j and flips every P_jk (so it is the same as g -> -g in (36))."""
+    rng = np.random.default_rng(6000 + seed)
+    dd, d, (z1, y1, z2, y2) = random_setup(rng, bp_dist=0.0)
+    k = KotterCurve(*dd)
+    eps = all_eps()[seed % 16]
+    w = k.wurzel(z1, y1, z2, y2, eps=eps)
+    swapped = k.wurzel(z2, y2, z1, y1, eps=eps)
+    scale = np.abs(w.Pjk).max()
+    np.testing.assert_allclose(swapped.P, w.P, rtol=1e-14)
+    np.testing.assert_allclose(swapped.Pjk, w.Pjk, rtol=0, atol=IDENTITY_RTOL * scale)
+    inv = k.wurzel(z1, -y1, z2, -y2, eps=eps)
+    np.testing.assert_allclose(inv.P, w.P, rtol=1e-14)
+    np.testing.assert_allclose(inv.Pjk, -w.Pjk, rtol=0, atol=IDENTITY_RTOL * scale)
+
+
+@pytest.mark.parametrize("scale", [1e-170, 1e-20, 1e20, 1e300])
+def test_inverse_is_homogeneous_in_g(scale):
+    """(36) is linear in g: scaling (xi, eta) by s scales g by s and leaves the
+    points, even where g**2 would under- or overflow."""
+    k = KotterCurve(2.0, 3.0, -0.5 + 1j)
+    z1, z2 = 0.3 + 0.2j, -1.0 + 0.5j
+    y1, y2 = k.y(z1), k.y(z2, sheet=-1)
+    xi, eta = k.xi_eta(z1, y1, z2, y2, 0.8 + 0.3j)
+    ref = k.points_from_wurzel(xi, eta)
+    b = k.points_from_wurzel(np.asarray(xi) * scale, np.asarray(eta) * scale)
+    for a, r in ((b.z1, ref.z1), (b.z2, ref.z2), (b.y1, ref.y1), (b.y2, ref.y2)):
+        assert abs(a - r) <= 1e-13 * max(abs(r), 1)
+    assert abs(b.g / scale - ref.g) <= 1e-13 * abs(ref.g)
+    np.testing.assert_array_equal(b.eps, ref.eps)
