@@ -11,6 +11,18 @@ fn c(re: f64, im: f64) -> C {
     C::new(re, im)
 }
 
+/// Single evaluations of a few (≤ 10) rounded operations on O(1) numbers
+/// (`√w`, `R(x)`, `y(x)²`): a few tens of ulps.
+const ROUNDING_TOL: f64 = 1e-13;
+
+/// Points closer than this to a cut `d_j + (−∞, 0]` may come back on the other
+/// side of it (the recovered `z` carries ~1e-15 of rounding), with `eps`
+/// compensating; 1e-9 is far above that rounding.
+const ON_CUT_DIST: f64 = 1e-9;
+
+/// A misprinted identity misses by an O(1) factor; 0.1 is far above rounding.
+const MISPRINT_MARGIN: f64 = 0.1;
+
 /// Identities are compared relative to the sum of the moduli of their terms.
 /// Each term is a product of ~20 rounded factors (relative error ~1e-15) and
 /// `P_jk` loses at most a factor `|a|/|a − b|` (≲ 1e2 for the separated
@@ -64,7 +76,7 @@ fn sqrt_principal_branch() {
     let w = c(-3.0, -4.0);
     let r = sqrt_principal(w);
     assert_eq!(r, c(1.0, -2.0));
-    assert_relative_eq!((r * r - w).norm(), 0.0, epsilon = 1e-15);
+    assert_relative_eq!((r * r - w).norm(), 0.0, epsilon = ROUNDING_TOL);
 }
 
 #[test]
@@ -79,8 +91,12 @@ fn construction_and_validation() {
     }
     let x = c(0.3, -0.7);
     let direct = x * (x - d[1]) * (x - d[2]) * (x - d[3]) * (x - d[4]);
-    assert_relative_eq!((k.r(x) - direct).norm(), 0.0, epsilon = 1e-14);
-    assert_relative_eq!((k.y(x) * k.y(x) - k.r(x)).norm(), 0.0, epsilon = 1e-13);
+    assert_relative_eq!((k.r(x) - direct).norm(), 0.0, epsilon = ROUNDING_TOL);
+    assert_relative_eq!(
+        (k.y(x) * k.y(x) - k.r(x)).norm(),
+        0.0,
+        epsilon = ROUNDING_TOL
+    );
 
     // d_j = 0 coincides with d_0.
     assert!(matches!(
@@ -170,7 +186,7 @@ fn printed_29_fails() {
     let (lhs, _) = lhs_29(&k, &w, s);
     let d = k.branch_points();
     let printed = s / ((s - d[1]) * (s - d[2]) * (s - d[3]) * (s - d[4]));
-    assert!((lhs - printed).norm() > 0.1 * printed.norm());
+    assert!((lhs - printed).norm() > MISPRINT_MARGIN * printed.norm());
     assert!(close(lhs, k.kappa() * printed, lhs.norm(), IDENTITY_RTOL));
 }
 
@@ -326,7 +342,7 @@ proptest! {
         // unchanged — unless a point sits on a cut of the principal roots, where
         // the rounding of the recovered z decides the side and eps compensates.
         let d = k.branch_points();
-        let on_cut = |z: C| d.iter().any(|dj| (z - dj).im.abs() < 1e-9 && (z - dj).re < 0.0);
+        let on_cut = |z: C| d.iter().any(|dj| (z - dj).im.abs() < ON_CUT_DIST && (z - dj).re < 0.0);
         if !on_cut(z1) && !on_cut(z2) {
             let sgn = i8::from(eps[4] > 0) * 2 - 1;
             let norm_eps = [eps[0], eps[1] * sgn, eps[2] * sgn, eps[3] * sgn, 1];
