@@ -6,11 +6,15 @@ Equation numbers in docstrings are the paper's.
 """
 
 from ._core import ConvergenceError, __version__
+from .curve import CurvePoints, KotterCurve, Wurzel
 from .problems import Problem, benchmark_setup, problem, problem_names
 
 __all__ = [
     "ConvergenceError",
+    "CurvePoints",
+    "KotterCurve",
     "Problem",
+    "Wurzel",
     "__version__",
     "benchmark_setup",
     "problem",
