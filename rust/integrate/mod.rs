@@ -40,15 +40,65 @@ pub trait VectorField: Sync {
     fn dim(&self) -> usize;
     /// Writes `f(y)` into `dy`; both have length [`VectorField::dim`].
     fn eval(&self, y: &[f64], dy: &mut [f64]);
+
+    /// Evaluates `f` at `S` states at once, stored component-major:
+    /// `y[k][i]` is component `k` of state `i`. The default gathers each state
+    /// and calls [`VectorField::eval`]; a field may override it to run the
+    /// states as SIMD lanes.
+    #[inline(always)]
+    fn eval_lanes<const S: usize, const M: usize>(
+        &self,
+        y: &[[f64; S]; M],
+        out: &mut [[f64; S]; M],
+    ) {
+        for i in 0..S {
+            let mut yi = [0.0; M];
+            for k in 0..M {
+                yi[k] = y[k][i];
+            }
+            let mut o = [0.0; M];
+            self.eval(&yi, &mut o);
+            for k in 0..M {
+                out[k][i] = o[k];
+            }
+        }
+    }
 }
 
 impl VectorField for FrahmTop {
     fn dim(&self) -> usize {
         FrahmTop::dim(self)
     }
-    #[inline]
+    #[inline(always)]
     fn eval(&self, y: &[f64], dy: &mut [f64]) {
         self.vector_field(y, dy)
+    }
+
+    #[inline(always)]
+    fn eval_lanes<const S: usize, const M: usize>(
+        &self,
+        y: &[[f64; S]; M],
+        out: &mut [[f64; S]; M],
+    ) {
+        if let (Some(c), Ok(y6), Ok(o6)) = (
+            self.c4(),
+            <&[[f64; S]; 6]>::try_from(&y[..]),
+            <&mut [[f64; S]; 6]>::try_from(&mut out[..]),
+        ) {
+            crate::so4::vector_field4_lanes(c, y6, o6);
+            return;
+        }
+        for i in 0..S {
+            let mut yi = [0.0; M];
+            for k in 0..M {
+                yi[k] = y[k][i];
+            }
+            let mut o = [0.0; M];
+            self.vector_field(&yi, &mut o);
+            for k in 0..M {
+                out[k][i] = o[k];
+            }
+        }
     }
 }
 
@@ -100,6 +150,17 @@ impl Method {
             Method::Gauss4 => Some(2),
             Method::Gauss6 => Some(3),
             Method::Gauss16 => Some(8),
+            Method::Dopri5 => None,
+        }
+    }
+
+    /// The stage predictor `E` (row-major `s × s`) of a Gauss method.
+    pub fn gauss_predictor(self) -> Option<Vec<f64>> {
+        use gauss_tables::*;
+        match self {
+            Method::Gauss4 => Some(E2.concat()),
+            Method::Gauss6 => Some(E3.concat()),
+            Method::Gauss16 => Some(E8.concat()),
             Method::Dopri5 => None,
         }
     }
@@ -219,32 +280,245 @@ pub fn check_sample_times(t0: f64, times: &[f64]) -> Result<()> {
     Ok(())
 }
 
-/// Gauss–Legendre stepper with its scratch space, allocated once.
-struct Gauss {
+/// Stopping rule of the stage iteration: stop once the increments stop
+/// decreasing (Antoñana, Makazaga & Murua 2017). Roundoff makes converged
+/// increments wobble, so an increment that fails to beat the smallest so far
+/// ends the iteration only once that smallest one is at roundoff level
+/// (`ROUNDOFF_RTOL`); above it, two failures in a row are needed.
+struct StopRule {
+    best: f64,
+    stalls: u32,
+    iterations: usize,
+}
+
+/// Increments below this fraction of the state's size are roundoff: 10^4 ulps.
+const ROUNDOFF_RTOL: f64 = 1e4 * f64::EPSILON;
+
+impl StopRule {
+    fn new() -> Self {
+        StopRule {
+            best: f64::INFINITY,
+            stalls: 0,
+            iterations: 0,
+        }
+    }
+
+    /// Records one iteration's largest increment; `Ok(true)` means stop.
+    fn update(&mut self, dmax: f64, ymax: f64) -> Result<bool> {
+        self.iterations += 1;
+        if !dmax.is_finite() {
+            return Err(Error::NoConvergence {
+                what: "Gauss stage iteration (state became non-finite; reduce dt)",
+                tol: 0.0,
+                reached: dmax,
+                iterations: self.iterations,
+            });
+        }
+        if dmax == 0.0 {
+            return Ok(true);
+        }
+        if dmax < self.best {
+            self.best = dmax;
+            self.stalls = 0;
+            return Ok(false).and_then(|s| self.cap(s, ymax));
+        }
+        self.stalls += 1;
+        let stop = self.stalls >= 2 || self.best <= ROUNDOFF_RTOL * ymax;
+        self.cap(stop, ymax)
+    }
+
+    fn cap(&self, stop: bool, ymax: f64) -> Result<bool> {
+        if !(stop || self.iterations >= MAX_FIXED_POINT_ITER) {
+            return Ok(false);
+        }
+        if self.best > STALL_RTOL * ymax.max(f64::MIN_POSITIVE) {
+            return Err(Error::NoConvergence {
+                what: "Gauss stage iteration (step too large; reduce dt)",
+                tol: STALL_RTOL * ymax,
+                reached: self.best,
+                iterations: self.iterations,
+            });
+        }
+        Ok(true)
+    }
+}
+
+/// One step of a Gauss method on `y`, advanced in place.
+trait Stepper {
+    fn step<F: VectorField>(&mut self, f: &F, y: &mut [f64], h: f64) -> Result<()>;
+    fn evals(&self) -> u64;
+}
+
+/// Gauss–Legendre stepper on fixed-size arrays (`S` stages, state dimension
+/// `M`), stored component-major (`[component][stage]`) so that the stage sums
+/// and the vector field run across the `S` stages as SIMD lanes
+/// ([`VectorField::eval_lanes`]). Used for so(4), `M = 6`.
+struct GaussFixed<const S: usize, const M: usize> {
+    b: [f64; S],
+    /// `mu_t[j][i] = μ_ij`: column `j` contiguous over the stages `i`.
+    mu_t: [[f64; S]; S],
+    e_t: [[f64; S]; S],
+    /// `L[k][i] = h b_i f_k(Y_i)`; after a step, the source of the next guess.
+    l: [[f64; S]; M],
+    /// Kahan compensation of the update.
+    comp: [f64; M],
+    last_h: f64,
+    evals: u64,
+}
+
+fn transpose<const S: usize>(a: &[[f64; S]; S]) -> [[f64; S]; S] {
+    let mut t = [[0.0; S]; S];
+    for i in 0..S {
+        for j in 0..S {
+            t[j][i] = a[i][j];
+        }
+    }
+    t
+}
+
+impl<const S: usize, const M: usize> GaussFixed<S, M> {
+    fn new(b: &[f64; S], mu: &[[f64; S]; S], e: &[[f64; S]; S]) -> Self {
+        GaussFixed {
+            b: *b,
+            mu_t: transpose(mu),
+            e_t: transpose(e),
+            l: [[0.0; S]; M],
+            comp: [0.0; M],
+            last_h: 0.0,
+            evals: 0,
+        }
+    }
+}
+
+impl<const S: usize, const M: usize> Stepper for GaussFixed<S, M> {
+    fn evals(&self) -> u64 {
+        self.evals
+    }
+
+    #[inline]
+    fn step<F: VectorField>(&mut self, f: &F, y: &mut [f64], h: f64) -> Result<()> {
+        let len = y.len();
+        let y: &mut [f64; M] = y.try_into().map_err(|_| Error::Shape {
+            what: "state",
+            expected: format!("({M},)"),
+            got: format!("({len},)"),
+        })?;
+        let mut hb = [0.0; S];
+        for i in 0..S {
+            hb[i] = h * self.b[i];
+        }
+        if self.last_h == 0.0 {
+            // First step: every stage starts from f(y).
+            let mut fbuf = [0.0; M];
+            f.eval(y, &mut fbuf);
+            self.evals += 1;
+            for k in 0..M {
+                for i in 0..S {
+                    self.l[k][i] = hb[i] * fbuf[k];
+                }
+            }
+        } else if h == self.last_h {
+            // Predictor: extrapolate the previous step's collocation polynomial,
+            // f at the new nodes = Σ_j ℓ_j(1 + c_i) f(Y_j), with f(Y_j) = L_j / (h b_j).
+            for k in 0..M {
+                let mut fj = [0.0; S];
+                for j in 0..S {
+                    fj[j] = self.l[k][j] / hb[j];
+                }
+                let mut acc = [0.0; S];
+                for j in 0..S {
+                    for i in 0..S {
+                        acc[i] += self.e_t[j][i] * fj[j];
+                    }
+                }
+                for i in 0..S {
+                    self.l[k][i] = hb[i] * acc[i];
+                }
+            }
+        } else {
+            // L ∝ h: rescale the previous stages.
+            let r = h / self.last_h;
+            for lk in self.l.iter_mut() {
+                for x in lk.iter_mut() {
+                    *x *= r;
+                }
+            }
+        }
+        self.last_h = h;
+        let ymax = y.iter().fold(0.0f64, |acc, v| acc.max(v.abs()));
+        let mut rule = StopRule::new();
+        let mut ys = [[0.0; S]; M];
+        let mut fs = [[0.0; S]; M];
+        loop {
+            // Y_i = y + Σ_j μ_ij L_j, all stages at once.
+            for k in 0..M {
+                let mut acc = [y[k]; S];
+                for j in 0..S {
+                    let ljk = self.l[k][j];
+                    for i in 0..S {
+                        acc[i] += self.mu_t[j][i] * ljk;
+                    }
+                }
+                ys[k] = acc;
+            }
+            f.eval_lanes(&ys, &mut fs);
+            let mut dmax = [0.0f64; S];
+            for k in 0..M {
+                for i in 0..S {
+                    let new = hb[i] * fs[k][i];
+                    dmax[i] = dmax[i].max((new - self.l[k][i]).abs());
+                    self.l[k][i] = new;
+                }
+            }
+            self.evals += S as u64;
+            let dmax = dmax.iter().fold(0.0f64, |a, &b| a.max(b));
+            if rule.update(dmax, ymax)? {
+                break;
+            }
+        }
+        // Compensated update y += Σ_i L_i (Kahan): comp carries the lost low bits.
+        for k in 0..M {
+            let mut sum = self.comp[k];
+            for i in 0..S {
+                sum += self.l[k][i];
+            }
+            let new = y[k] + sum;
+            self.comp[k] = (y[k] - new) + sum;
+            y[k] = new;
+        }
+        Ok(())
+    }
+}
+
+/// Gauss–Legendre stepper for any state dimension, scratch allocated once.
+struct GaussDyn {
     s: usize,
     m: usize,
     b: &'static [f64],
     mu: Vec<f64>,
-    /// `L_i = h b_i f(Y_i)`, `s × m`; kept between steps as the next initial guess.
+    e: Vec<f64>,
     l: Vec<f64>,
+    fj: Vec<f64>,
     ystage: Vec<f64>,
     fbuf: Vec<f64>,
-    /// Kahan compensation of the update.
     comp: Vec<f64>,
     last_h: f64,
     evals: u64,
 }
 
-impl Gauss {
+impl GaussDyn {
     fn new(method: Method, m: usize) -> Option<Self> {
         let (_, b, mu) = method.gauss_tableau()?;
+        let e = method.gauss_predictor()?;
         let s = b.len();
-        Some(Gauss {
+        Some(GaussDyn {
             s,
             m,
             b,
             mu,
+            e,
             l: vec![0.0; s * m],
+            fj: vec![0.0; s * m],
             ystage: vec![0.0; s * m],
             fbuf: vec![0.0; m],
             comp: vec![0.0; m],
@@ -252,11 +526,16 @@ impl Gauss {
             evals: 0,
         })
     }
+}
+
+impl Stepper for GaussDyn {
+    fn evals(&self) -> u64 {
+        self.evals
+    }
 
     fn step<F: VectorField>(&mut self, f: &F, y: &mut [f64], h: f64) -> Result<()> {
         let (s, m) = (self.s, self.m);
         if self.last_h == 0.0 {
-            // First step: every stage starts from f(y).
             f.eval(y, &mut self.fbuf);
             self.evals += 1;
             for i in 0..s {
@@ -265,18 +544,27 @@ impl Gauss {
                     self.l[i * m + k] = hb * self.fbuf[k];
                 }
             }
-        } else if h != self.last_h {
-            // L ∝ h: rescale the previous step's stages as the guess.
+        } else if h == self.last_h {
+            // Predictor, as in GaussFixed.
+            for j in 0..s {
+                for k in 0..m {
+                    self.fj[j * m + k] = self.l[j * m + k] / self.b[j];
+                }
+            }
+            for i in 0..s {
+                for k in 0..m {
+                    let acc: f64 = (0..s).map(|j| self.e[i * s + j] * self.fj[j * m + k]).sum();
+                    self.l[i * m + k] = self.b[i] * acc;
+                }
+            }
+        } else {
             let r = h / self.last_h;
             self.l.iter_mut().for_each(|x| *x *= r);
         }
         self.last_h = h;
         let ymax = y.iter().fold(0.0f64, |acc, v| acc.max(v.abs()));
-        let mut best = f64::INFINITY;
-        let mut stalls = 0;
-        let mut iterations = 0;
+        let mut rule = StopRule::new();
         loop {
-            iterations += 1;
             for i in 0..s {
                 let yi = &mut self.ystage[i * m..(i + 1) * m];
                 yi.copy_from_slice(y);
@@ -300,39 +588,10 @@ impl Gauss {
                 }
             }
             self.evals += s as u64;
-            if !dmax.is_finite() {
-                return Err(Error::NoConvergence {
-                    what: "Gauss stage iteration (state became non-finite; reduce dt)",
-                    tol: 0.0,
-                    reached: dmax,
-                    iterations,
-                });
-            }
-            if dmax == 0.0 {
-                break;
-            }
-            // Stop once the increments stop decreasing: two iterations that do
-            // not beat the smallest increment so far (roundoff makes converged
-            // increments wobble, so "smaller than the previous" is not enough).
-            if dmax < best {
-                best = dmax;
-                stalls = 0;
-            } else {
-                stalls += 1;
-            }
-            if stalls >= 2 || iterations >= MAX_FIXED_POINT_ITER {
-                if best > STALL_RTOL * ymax.max(f64::MIN_POSITIVE) {
-                    return Err(Error::NoConvergence {
-                        what: "Gauss stage iteration (step too large; reduce dt)",
-                        tol: STALL_RTOL * ymax,
-                        reached: best,
-                        iterations,
-                    });
-                }
+            if rule.update(dmax, ymax)? {
                 break;
             }
         }
-        // Compensated update y += Σ_i L_i (Kahan): comp carries the lost low bits.
         for k in 0..m {
             let mut sum = self.comp[k];
             for i in 0..s {
@@ -585,7 +844,7 @@ fn integrate_into<F: VectorField>(
     let m = f.dim();
     let mut y = y0.to_vec();
     let mut t = t0;
-    if let Some(mut g) = Gauss::new(opts.method, m) {
+    if opts.method.stages().is_some() {
         let total = times
             .iter()
             .fold((t0, 0.0), |(prev, n), &tk| {
@@ -600,21 +859,46 @@ fn integrate_into<F: VectorField>(
                 ),
             });
         }
-        for &tk in times {
-            let span = tk - t;
-            if span > 0.0 {
-                let n = substeps(span, opts.dt);
-                let h = span / n;
-                // n ≤ MAX_STEPS < 2^53, so the count is exact.
-                for _ in 0..n as u64 {
-                    g.step(f, &mut y, h)?;
-                }
-                *steps += n as u64;
-                t = tk;
+        use gauss_tables::*;
+        *evals += match (opts.method, m) {
+            (Method::Gauss4, 6) => run_gauss(
+                GaussFixed::<2, 6>::new(&B2, &MU2, &E2),
+                f,
+                &mut y,
+                t0,
+                times,
+                opts.dt,
+                ys,
+                steps,
+            )?,
+            (Method::Gauss6, 6) => run_gauss(
+                GaussFixed::<3, 6>::new(&B3, &MU3, &E3),
+                f,
+                &mut y,
+                t0,
+                times,
+                opts.dt,
+                ys,
+                steps,
+            )?,
+            (Method::Gauss16, 6) => run_gauss(
+                GaussFixed::<8, 6>::new(&B8, &MU8, &E8),
+                f,
+                &mut y,
+                t0,
+                times,
+                opts.dt,
+                ys,
+                steps,
+            )?,
+            (method, _) => {
+                let g = GaussDyn::new(method, m).ok_or_else(|| Error::InvalidArgument {
+                    what: "method",
+                    reason: "not a Gauss method".into(),
+                })?;
+                run_gauss(g, f, &mut y, t0, times, opts.dt, ys, steps)?
             }
-            ys.extend_from_slice(&y);
-        }
-        *evals += g.evals;
+        };
     } else {
         let mut d = Dopri5::new(m, opts);
         for &tk in times {
@@ -624,6 +908,36 @@ fn integrate_into<F: VectorField>(
         *evals += d.evals;
     }
     Ok(())
+}
+
+/// Steps a Gauss method through the sample times; returns the evaluation count.
+#[allow(clippy::too_many_arguments)]
+fn run_gauss<S: Stepper, F: VectorField>(
+    mut g: S,
+    f: &F,
+    y: &mut [f64],
+    t0: f64,
+    times: &[f64],
+    dt: f64,
+    ys: &mut Vec<f64>,
+    steps: &mut u64,
+) -> Result<u64> {
+    let mut t = t0;
+    for &tk in times {
+        let span = tk - t;
+        if span > 0.0 {
+            let n = substeps(span, dt);
+            let h = span / n;
+            // n ≤ MAX_STEPS < 2^53, so the count is exact.
+            for _ in 0..n as u64 {
+                g.step(f, y, h)?;
+            }
+            *steps += n as u64;
+            t = tk;
+        }
+        ys.extend_from_slice(y);
+    }
+    Ok(g.evals())
 }
 
 /// Integrates a batch of initial states `y0s` (row-major `(batch, dim)`) with

@@ -196,6 +196,12 @@ impl FrahmTop {
         self.cv.len()
     }
 
+    /// For `n = 4`, the six `c_ij` (`i < j`) in state order.
+    #[inline(always)]
+    pub fn c4(&self) -> Option<&[f64; 6]> {
+        self.c4.as_ref()
+    }
+
     /// `c_ij` for `i < j` in state order.
     pub fn c_upper(&self) -> &[f64] {
         &self.cv
@@ -206,7 +212,7 @@ impl FrahmTop {
     /// `l` and `out` have length [`FrahmTop::dim`] (checked by the caller; a
     /// mismatch panics in debug builds only through slice indexing, so callers
     /// validate shapes first).
-    #[inline]
+    #[inline(always)]
     pub fn vector_field(&self, l: &[f64], out: &mut [f64]) {
         if let (Some(c), Ok(l4), Ok(o4)) = (
             &self.c4,
@@ -249,7 +255,7 @@ impl FrahmTop {
 
 /// The so(4) vector field (1) on the fixed-size state, `c` the six `c_ij`
 /// (`i < j`) in state order: `l̇_ij = Σ_{k ∉ {i,j}} l_ik l_kj (c_kj - c_ik)`.
-#[inline]
+#[inline(always)]
 pub fn vector_field4(c: &[f64; 6], l: &[f64; 6]) -> [f64; 6] {
     let [l12, l13, l14, l23, l24, l34] = *l;
     let [c12, c13, c14, c23, c24, c34] = *c;
@@ -269,6 +275,33 @@ pub fn vector_field4(c: &[f64; 6], l: &[f64; 6]) -> [f64; 6] {
         // (3,4): k = 1, 2
         (-l13) * l14 * (c14 - c13) + (-l23) * l24 * (c24 - c23),
     ]
+}
+
+/// [`vector_field4`] at `S` states at once, component-major (`l[k][i]` is
+/// component `k` of state `i`), written lane-wise so that it vectorises.
+#[inline(always)]
+pub fn vector_field4_lanes<const S: usize>(
+    c: &[f64; 6],
+    l: &[[f64; S]; 6],
+    out: &mut [[f64; S]; 6],
+) {
+    let [c12, c13, c14, c23, c24, c34] = *c;
+    let (d1, d2) = (c23 - c13, c24 - c14);
+    let (d3, d4) = (c23 - c12, c34 - c14);
+    let (d5, d6) = (c24 - c12, c34 - c13);
+    let (d7, d8) = (c13 - c12, c34 - c24);
+    let (d9, d10) = (c14 - c12, c34 - c23);
+    let (d11, d12) = (c14 - c13, c24 - c23);
+    let [l12, l13, l14, l23, l24, l34] = l;
+    for i in 0..S {
+        // The same terms as vector_field4, with the c differences hoisted.
+        out[0][i] = -(l13[i] * l23[i] * d1 + l14[i] * l24[i] * d2);
+        out[1][i] = l12[i] * l23[i] * d3 - l14[i] * l34[i] * d4;
+        out[2][i] = l12[i] * l24[i] * d5 + l13[i] * l34[i] * d6;
+        out[3][i] = -(l12[i] * l13[i] * d7 + l24[i] * l34[i] * d8);
+        out[4][i] = l23[i] * l34[i] * d10 - l12[i] * l14[i] * d9;
+        out[5][i] = -(l13[i] * l14[i] * d11 + l23[i] * l24[i] * d12);
+    }
 }
 
 /// The Poisson tensor of the so(n) bracket (3):

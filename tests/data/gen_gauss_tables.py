@@ -11,6 +11,8 @@ matrix is stored as mu_ij = a_ij / b_j. Symplecticity, b_i a_ij + b_j a_ji =
 b_i b_j, reads mu_ij + mu_ji = 1, and it is kept EXACT in floating point: of
 each pair the entry >= 1/2 is rounded to nearest and its partner is set to
 1 - (that double), a subtraction that is exact (|1 - x| <= |x| for x >= 1/2).
+The predictor E_ij = ell_j(1 + c_i) (Lagrange basis on the nodes, evaluated at
+the next step's nodes) gives the starting guess of the stage iteration.
 Every other number is the double nearest to the mpmath value at 60 digits.
 
 Run from the repository root:  python tests/data/gen_gauss_tables.py
@@ -97,6 +99,19 @@ def main() -> None:
         out.append(f"pub const MU{s}: [[f64; {s}]; {s}] = [")
         for row in mu:
             out.append(f"    [{', '.join(fmt(x) for x in row)}],")
+        out.append("];")
+        out.append(f"/// Stage predictor of the {s}-stage method: `E_ij = ell_j(1 + c_i)`, the")
+        out.append("/// Lagrange basis on the nodes extrapolated to the next step's nodes.")
+        out.append(f"pub const E{s}: [[f64; {s}]; {s}] = [")
+        for i in range(s):
+            row = []
+            for j in range(s):
+                v = mp.mpf(1)
+                for k in range(s):
+                    if k != j:
+                        v *= (1 + c[i] - c[k]) / (c[j] - c[k])
+                row.append(fmt(float(v)))
+            out.append(f"    [{', '.join(row)}],")
         out.append("];")
         out.append("")
     path = pathlib.Path(__file__).resolve().parents[2] / "rust" / "integrate" / "gauss_tables.rs"
