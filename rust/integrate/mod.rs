@@ -26,6 +26,9 @@
 //! size `Δt / n ≤ dt`, so a sample lands exactly on its time and memory is
 //! `O(samples)`: a step allocates nothing (see `tests/alloc.rs`).
 
+// Index loops mirror the subscripts of the formulas (i, j stages; k components).
+#![allow(clippy::needless_range_loop)]
+
 #[rustfmt::skip]
 pub mod gauss_tables;
 

@@ -18,6 +18,9 @@
 //! `H2 = Σ_{j<k} (a_l + a_m) l_jk²`, `H3 = Σ_{j<k} a_l a_m l_jk²`
 //! (see `docs/errata-so4.md`). [`integrals4`] returns the corrected forms.
 
+// Index loops mirror the subscripts of the formulas (i, j stages; k components).
+#![allow(clippy::needless_range_loop)]
+
 use crate::error::{check_finite, Error, Result};
 
 /// Length of the so(4) state vector.
