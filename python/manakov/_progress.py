@@ -34,7 +34,8 @@ class ProgressBar:
         left = elapsed * (1 - self.fraction) / self.fraction if self.fraction > 0 else float("nan")
         bar = "#" * filled + "-" * (self.width - filled)
         pct = 100 * self.fraction
-        self.stream.write(f"\r{self.label} [{bar}] {pct:5.1f}%  {elapsed:6.1f}s  (~{left:.1f}s left)")
+        line = f"\r{self.label} [{bar}] {pct:5.1f}%  {elapsed:6.1f}s  (~{left:.1f}s left)"
+        self.stream.write(line)
         self.stream.flush()
 
     def close(self) -> None:
