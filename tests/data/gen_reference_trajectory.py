@@ -1,3 +1,4 @@
+# ruff: noqa: E741
 """Reference states of the shared 'generic' top at t = 10 and t = 100, at 38 digits.
 
 Independent of the package: the vector field (1) with c from (2) is written
@@ -17,7 +18,8 @@ import pathlib
 
 import mpmath as mp
 
-PROBLEMS = pathlib.Path(__file__).resolve().parents[2] / "python" / "manakov" / "data" / "problems.json"
+ROOT = pathlib.Path(__file__).resolve().parents[2]
+PROBLEMS = ROOT / "python" / "manakov" / "data" / "problems.json"
 OUT = pathlib.Path(__file__).resolve().parent / "reference_generic.json"
 PAIRS = [(0, 1), (0, 2), (0, 3), (1, 2), (1, 3), (2, 3)]
 TIMES = (10, 100)
@@ -45,7 +47,8 @@ def solve(dps: int) -> dict[int, list]:
                 if k in (i, j):
                     continue
                 # (1): l_ik w_kj - w_ik l_kj with w = c l
-                s += entry(l, i, k) * c[(k, j)] * entry(l, k, j) - c[(i, k)] * entry(l, i, k) * entry(l, k, j)
+                lik, lkj = entry(l, i, k), entry(l, k, j)
+                s += lik * c[(k, j)] * lkj - c[(i, k)] * lik * lkj
             out.append(s)
         return out
 
