@@ -256,16 +256,16 @@ fn integrate_many_py<'py>(
     Ok((y, steps))
 }
 
-/// The Gauss tableau (c, b, mu) of a Gauss method, mu_ij = a_ij / b_j.
-#[pyfunction(name = "gauss_tableau")]
-fn gauss_tableau_py<'py>(
-    py: Python<'py>,
-    method: &str,
-) -> PyResult<(
+/// `(c, b, mu)` as numpy arrays.
+type Tableau<'py> = (
     Bound<'py, PyArray1<f64>>,
     Bound<'py, PyArray1<f64>>,
     Bound<'py, PyArray2<f64>>,
-)> {
+);
+
+/// The Gauss tableau (c, b, mu) of a Gauss method, mu_ij = a_ij / b_j.
+#[pyfunction(name = "gauss_tableau")]
+fn gauss_tableau_py<'py>(py: Python<'py>, method: &str) -> PyResult<Tableau<'py>> {
     let m = Method::from_name(method)?;
     let (c, b, mu) = m.gauss_tableau().ok_or_else(|| Error::InvalidArgument {
         what: "method",

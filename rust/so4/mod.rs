@@ -519,6 +519,29 @@ mod tests {
         }
 
         #[test]
+        fn lane_form_matches_single_states(
+            l in prop::collection::vec(-2.0f64..2.0, 48),
+            b in prop::array::uniform4(-2.0f64..2.0),
+        ) {
+            let top = FrahmTop::manakov(&GENERIC_A, &b).unwrap();
+            let mut y = [[0.0; 8]; 6];
+            for k in 0..6 {
+                for i in 0..8 {
+                    y[k][i] = l[8 * k + i];
+                }
+            }
+            let mut out = [[0.0; 8]; 6];
+            vector_field4_lanes(top.c4().unwrap(), &y, &mut out);
+            for i in 0..8 {
+                let li: [f64; 6] = std::array::from_fn(|k| y[k][i]);
+                let want = vf_matrix(4, &manakov_c(&GENERIC_A, &b).unwrap(), &li);
+                for k in 0..6 {
+                    prop_assert!((out[k][i] - want[k]).abs() <= 1e-13 * (1.0 + want[k].abs()));
+                }
+            }
+        }
+
+        #[test]
         fn vector_field_is_hamiltonian_flow_of_h(
             l in prop::collection::vec(-2.0f64..2.0, 10),
             b in prop::collection::vec(-2.0f64..2.0, 5),
