@@ -124,6 +124,11 @@ def main() -> None:
     print()
     print(f"scipy DOP853 steps: {rows[0][3]} (nfev // 12); the step count is estimated from "
           f"nfev as DOP853 uses 12 evaluations per step")
+    d = rows[1]
+    print(f"default gauss16: max drift {max(d[4].values()):.1e} (claim <= 1e-13: "
+          f"{'yes' if max(d[4].values()) <= 1e-13 else 'NO'}), error at t=100 {d[5]:.1e} vs scipy "
+          f"{rows[0][5]:.1e} ({'no worse' if d[5] <= rows[0][5] else 'WORSE'}), speed-up "
+          f"{t_scipy / d[1]:.0f}x (claim >= 300x: {'yes' if t_scipy / d[1] >= 300 else 'NO'})")
     print(f"integrate_many, 8 initial states: serial {batch[False]:.4f} s, "
           f"parallel (rayon) {batch[True]:.4f} s, ratio {batch[False] / batch[True]:.2f}")
 
