@@ -3,6 +3,22 @@
 import numpy as np
 from numpy.typing import NDArray
 
+__all__ = [
+    "ConvergenceError",
+    "__version__",
+    "check_c",
+    "gauss_tableau",
+    "hamiltonian",
+    "integrate",
+    "integrate_many",
+    "manakov_c",
+    "manakov_integral_labels",
+    "manakov_integrals",
+    "poisson_tensor",
+    "so4_integrals",
+    "vector_field",
+]
+
 __version__: str
 
 class ConvergenceError(RuntimeError): ...
