@@ -88,6 +88,7 @@ def main() -> None:
     configs = [
         ("manakov gauss16 (default)", {}),
         ("manakov gauss6 (default dt)", {"method": "gauss6"}),
+        ("manakov dop853 (tol 1e-12)", {"method": "dop853", "rtol": 1e-12, "atol": 1e-12}),
         ("manakov dopri5 (tol 1e-12)", {"method": "dopri5", "rtol": 1e-12, "atol": 1e-12}),
     ]
     for label, kw in configs:

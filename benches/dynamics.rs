@@ -91,18 +91,21 @@ fn steps(c: &mut Criterion) {
             bch.iter(|| integrate(&top, black_box(&L0), 0.0, &t_end, &opts).unwrap())
         });
     }
-    // dopri5 at rtol = atol = 1e-12: time per accepted step.
-    let opts = Options {
-        method: Method::Dopri5,
-        dt: 0.0,
-        rtol: 1e-12,
-        atol: 1e-12,
-    };
-    let probe = integrate(&top, &L0, 0.0, &[10.0], &opts).unwrap();
-    let t_end = 10.0 * STEPS as f64 / probe.steps as f64;
-    g.bench_function("dopri5_tol1e-12", |bch| {
-        bch.iter(|| integrate(&top, black_box(&L0), 0.0, &[t_end], &opts).unwrap())
-    });
+    // Explicit methods at rtol = atol = 1e-12: time per accepted step.
+    for method in [Method::Dopri5, Method::Dop853] {
+        let opts = Options {
+            method,
+            dt: 0.0,
+            rtol: 1e-12,
+            atol: 1e-12,
+        };
+        let probe = integrate(&top, &L0, 0.0, &[10.0], &opts).unwrap();
+        let t_end = 10.0 * STEPS as f64 / probe.steps as f64;
+        g.bench_function(
+            BenchmarkId::new("explicit_tol1e-12", method.name()),
+            |bch| bch.iter(|| integrate(&top, black_box(&L0), 0.0, &[t_end], &opts).unwrap()),
+        );
+    }
     g.finish();
 }
 

@@ -153,6 +153,23 @@ def test_dopri5_agrees_with_reference_at_its_tolerance():
     assert max(tr.max_drift().values()) > 1e-10
 
 
+def test_dop853_matches_scipy_dop853():
+    """Same tableau and control as scipy's DOP853: similar step counts and errors at 1e-10."""
+    ref = _reference()[10.0]
+    p = manakov.problem("generic")
+    top = manakov.ManakovTop(p.a, p.b)
+    tr = top.integrate(p.l0, 10.0, t_eval=[10.0], method="dop853", rtol=1e-10, atol=1e-10)
+    sol = solve_ivp(lambda t, y: top.vector_field(y), (0, 10.0), p.l0, method="DOP853",
+                    rtol=1e-10, atol=1e-10)
+    scipy_steps = sol.nfev // 12
+    # Step counts within 15 % (the controllers differ in small details, e.g. the first step).
+    assert abs(tr.steps - scipy_steps) <= 0.15 * scipy_steps, (tr.steps, scipy_steps)
+    err = np.max(np.abs(tr.l[-1] - ref))
+    err_scipy = np.max(np.abs(sol.y[:, -1] - ref))
+    assert err < 1e-8 and err_scipy < 1e-8
+    assert 0.1 < err / err_scipy < 10
+
+
 def test_sampling_lands_on_the_requested_times():
     p = manakov.problem("generic")
     top = manakov.ManakovTop(p.a, p.b)
@@ -222,6 +239,7 @@ def test_too_large_dt_raises_convergence_error():
         {"t_end": 1e300, "dt": 1e-300},
         {"t_end": 1.0, "method": "dopri5", "rtol": 0.0, "atol": 0.0},
         {"t_end": 1.0, "method": "dopri5", "rtol": -1.0},
+        {"t_end": 1.0, "method": "dop853", "atol": float("nan")},
     ],
 )
 def test_bad_integration_arguments_raise_value_error(kwargs):

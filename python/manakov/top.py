@@ -42,8 +42,9 @@ __all__ = [
 ]
 
 #: Integration methods: Gauss–Legendre collocation with 2, 3 and 8 stages
-#: (orders 4, 6, 16) and the explicit adaptive Dormand–Prince 5(4) pair.
-METHODS = ("gauss4", "gauss6", "gauss16", "dopri5")
+#: (orders 4, 6, 16) and the explicit adaptive Dormand–Prince pairs 5(4) and 8(5,3).
+METHODS = ("gauss4", "gauss6", "gauss16", "dopri5", "dop853")
+_EXPLICIT = ("dopri5", "dop853")
 
 #: Default step of each Gauss method in units of the top's time scale
 #: ``1/Ω``, ``Ω = max |c_kj - c_ik| · ‖l0‖`` (a bound on the Lipschitz constant
@@ -164,7 +165,7 @@ class Trajectory:
         The top's integrals along the samples (see ``FrahmTop.integrals``).
     method : str
     dt : float
-        The largest step (Gauss methods) or the initial step (``dopri5``; 0 = automatic).
+        The largest step (Gauss methods) or the initial step (explicit; 0 = automatic).
     steps, evals : int
         Steps taken and vector-field evaluations.
     """
@@ -278,10 +279,10 @@ class FrahmTop:
         return math.inf if omega == 0 else 1.0 / omega
 
     def default_dt(self, l0: Any, method: str = "gauss16") -> float:
-        """The default step of ``method`` for this top from ``l0`` (0 for ``dopri5``: automatic)."""
+        """The default step of ``method`` for this top from ``l0`` (0 for explicit: automatic)."""
         if method not in METHODS:
             raise ValueError(f"unknown method {method!r}; known: {', '.join(METHODS)}")
-        if method == "dopri5":
+        if method in _EXPLICIT:
             return 0.0
         ts = self.time_scale(l0)
         return DT_SCALE[method] * ts if math.isfinite(ts) else 1.0
@@ -352,15 +353,15 @@ class FrahmTop:
         t_end : float, >= 0
         dt : float, optional
             Largest step of a Gauss method (default: ``default_dt``); initial
-            step of ``dopri5`` (default automatic).
+            step of ``dopri5``/``dop853`` (default automatic).
         t_eval : array_like, optional
             Sorted sample times in [0, t_end].
         sample_every : float, optional
             Sample at 0, sample_every, 2 sample_every, ..., and t_end.
             Default (neither given): 1001 evenly spaced samples.
-        method : {"gauss16", "gauss6", "gauss4", "dopri5"}
+        method : {"gauss16", "gauss6", "gauss4", "dopri5", "dop853"}
         rtol, atol : float
-            Tolerances of ``dopri5`` (ignored by Gauss methods).
+            Tolerances of ``dopri5`` and ``dop853`` (ignored by Gauss methods).
         progress : callable, optional
             Called with the fraction done after each chunk.
         chunks : int
