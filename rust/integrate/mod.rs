@@ -616,6 +616,8 @@ impl Stepper for GaussDyn {
 }
 
 // Dormand–Prince 5(4) tableau (Dormand & Prince 1980, Table 2; HNW I, Table II.5.2).
+/// Nodes; the field is autonomous, so only the tests use them.
+#[cfg_attr(not(test), allow(dead_code))]
 const DP_C: [f64; 7] = [0.0, 1.0 / 5.0, 3.0 / 10.0, 4.0 / 5.0, 8.0 / 9.0, 1.0, 1.0];
 const DP_A: [[f64; 6]; 7] = [
     [0.0; 6],
@@ -744,12 +746,10 @@ impl Dopri5 {
                     }
                     self.ytmp[i] = y[i] + h * acc;
                 }
-                let (head, tail) = self.k.split_at_mut(st * m);
-                let _ = head;
+                let (_, tail) = self.k.split_at_mut(st * m);
                 f.eval(&self.ytmp, &mut tail[..m]);
             }
             self.evals += 6;
-            let _ = DP_C;
             // ytmp holds the 5th-order solution (stage 7 point); error = h Σ (b - b̂) k.
             let mut err = 0.0f64;
             for i in 0..m {
@@ -1080,6 +1080,22 @@ mod tests {
                 "{m:?}: observed order {}",
                 ratio.log2()
             );
+        }
+    }
+
+    #[test]
+    fn dopri5_tableau_satisfies_order_conditions() {
+        for i in 0..7 {
+            let s: f64 = DP_A[i].iter().sum();
+            assert!((s - DP_C[i]).abs() < 1e-14, "row {i}");
+        }
+        for k in 0..5 {
+            let s: f64 = (0..7).map(|i| DP_B[i] * DP_C[i].powi(k)).sum();
+            assert_relative_eq!(s, 1.0 / (k as f64 + 1.0), max_relative = 1e-14);
+        }
+        for k in 0..4 {
+            let s: f64 = (0..7).map(|i| DP_BHAT[i] * DP_C[i].powi(k)).sum();
+            assert_relative_eq!(s, 1.0 / (k as f64 + 1.0), max_relative = 1e-14);
         }
     }
 
