@@ -387,3 +387,33 @@ def test_to_from_matrix_round_trip():
         assert m[0, 0, i, j] == l[0, 0, list(itertools.combinations(range(5), 2)).index((i, j))]
     with pytest.raises(ValueError):
         manakov.from_matrix(np.ones((4, 4)))
+
+
+@st.composite
+def so_n_tops(draw):
+    n = draw(st.integers(3, 7))
+    gaps = draw(st.lists(st.floats(0.05, 2.0), min_size=n, max_size=n))
+    a = np.cumsum(gaps)
+    b = np.array(draw(st.lists(finite, min_size=n, max_size=n)))
+    l = np.array(draw(st.lists(finite, min_size=n * (n - 1) // 2, max_size=n * (n - 1) // 2)))
+    return n, a, b, l
+
+
+@settings(max_examples=100, deadline=None)
+@given(so_n_tops())
+def test_property_so_n_lax_pair_and_field(data):
+    """(1)-(2) on so(n) is the Lax equation d/dt (l + λA) = [l + λA, ω + λB]: the λ-terms
+    [l, B] + [A, ω] vanish identically when c is (2); and (1) matches numpy."""
+    n, a, b, l = data
+    top = manakov.ManakovTop(a, b)
+    L = np_matrix(l, n)
+    W = top.c * L
+    A, B = np.diag(a), np.diag(b)
+    lam_term = L @ B - B @ L + A @ W - W @ A
+    cmax = np.abs(top.c).max() + 1
+    scale = cmax * (np.abs(a).max() + np.abs(b).max() + 1) * (np.abs(l).max() + 1)
+    # Each entry is a difference of O(n) products of rounded c, a, b, l: 1e-13 of their size.
+    assert np.max(np.abs(lam_term)) <= 1e-13 * scale
+    f = top.vector_field(l)
+    want = np_vector_field(np_c(a, b), l, n)
+    assert np.max(np.abs(f - want)) <= RTOL_FIELD * n * cmax * (np.sum(l**2) + 1)
