@@ -417,3 +417,17 @@ def test_property_so_n_lax_pair_and_field(data):
     f = top.vector_field(l)
     want = np_vector_field(np_c(a, b), l, n)
     assert np.max(np.abs(f - want)) <= RTOL_FIELD * n * cmax * (np.sum(l**2) + 1)
+
+
+@pytest.mark.parametrize("n", [16, 17])
+def test_large_n_paths_match_numpy(n):
+    """n <= 16 uses a stack copy of the skew matrix, n > 16 index arithmetic: both are (1)."""
+    rng = np.random.default_rng(n)
+    a = np.arange(n, dtype=float) + rng.uniform(0, 0.5, n)
+    b = rng.normal(size=n)
+    top = manakov.ManakovTop(a, b)
+    l = rng.normal(size=(3, n * (n - 1) // 2))
+    c = np_c(a, b)
+    want = np_vector_field(c, l, n)
+    scale = n * np.abs(c).max() * np.max(np.abs(l)) ** 2
+    assert np.max(np.abs(top.vector_field(l) - want)) <= RTOL_FIELD * scale

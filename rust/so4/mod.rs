@@ -130,9 +130,14 @@ pub struct FrahmTop {
     n: usize,
     /// `c_ij` for `i < j` in state order (the diagonal of `c` never enters (1) or (4)).
     cv: Vec<f64>,
-    /// For `n = 4`: the differences `c_kj - c_ik` of the fast path, see [`vector_field4`].
+    /// For `n = 4`: the six `c_ij` of the fast path, see [`vector_field4`].
     c4: Option<[f64; 6]>,
+    /// The full symmetric `c` with zero diagonal, row-major (general path).
+    cfull: Vec<f64>,
 }
+
+/// Bodies up to this dimension evaluate (1) on a stack copy of the skew matrix.
+const SMALL_N: usize = 16;
 
 impl FrahmTop {
     /// A top from a symmetric `n × n` row-major `c`; `n ≥ 3`.
@@ -180,7 +185,14 @@ impl FrahmTop {
         } else {
             None
         };
-        Ok(FrahmTop { n, cv, c4 })
+        let mut cfull = vec![0.0; n * n];
+        for i in 0..n {
+            for j in i + 1..n {
+                cfull[i * n + j] = c[i * n + j];
+                cfull[j * n + i] = c[i * n + j];
+            }
+        }
+        Ok(FrahmTop { n, cv, c4, cfull })
     }
 
     /// Manakov's top: `c` from (2), see [`manakov_c`].
@@ -226,6 +238,34 @@ impl FrahmTop {
             return;
         }
         let n = self.n;
+        if n <= SMALL_N {
+            // Full skew matrix on the stack: no allocation, no index arithmetic
+            // in the O(n³) loop.
+            let mut lm = [0.0; SMALL_N * SMALL_N];
+            let mut p = 0;
+            for i in 0..n {
+                for j in i + 1..n {
+                    lm[i * n + j] = l[p];
+                    lm[j * n + i] = -l[p];
+                    p += 1;
+                }
+            }
+            let c = &self.cfull;
+            let mut p = 0;
+            for i in 0..n {
+                for j in i + 1..n {
+                    // (1) with ω_kj = c_kj l_kj:  l̇_ij = Σ_k l_ik l_kj (c_kj - c_ik);
+                    // the k = i, j terms vanish (l_ii = 0, c_jj - c_ij multiplies l_jj = 0).
+                    let mut s = 0.0;
+                    for k in 0..n {
+                        s += lm[i * n + k] * lm[k * n + j] * (c[k * n + j] - c[i * n + k]);
+                    }
+                    out[p] = s;
+                    p += 1;
+                }
+            }
+            return;
+        }
         // (1) with ω_kj = c_kj l_kj:  l̇_ij = Σ_k l_ik l_kj (c_kj - c_ik).
         let cc = |i: usize, k: usize| -> f64 {
             match i.cmp(&k) {
