@@ -1,7 +1,8 @@
 """Shared fixtures: the reference problems, as the package carries them."""
 
-import manakov
 import pytest
+
+import manakov
 
 PROBLEM_NAMES = ("generic", "physical", "wide", "near_degenerate")
 
