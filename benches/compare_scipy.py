@@ -20,9 +20,10 @@ import statistics
 import time
 from pathlib import Path
 
-import manakov
 import numpy as np
 from scipy.integrate import solve_ivp
+
+import manakov
 
 ROOT = Path(__file__).resolve().parents[1]
 NAMES = ("H0", "H1", "H2", "H3", "H")

@@ -4,9 +4,10 @@ non-contiguous inputs, inputs never modified, exact exception types, no panics."
 # ruff: noqa: E741
 from __future__ import annotations
 
-import manakov
 import numpy as np
 import pytest
+
+import manakov
 
 
 @pytest.fixture

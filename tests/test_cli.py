@@ -6,9 +6,10 @@ import io
 import subprocess
 import sys
 
-import manakov
 import numpy as np
 import pytest
+
+import manakov
 from manakov import cli
 from manakov._progress import ProgressBar
 

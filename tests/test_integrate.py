@@ -6,12 +6,13 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
-import manakov
 import mpmath as mp
 import numpy as np
 import pytest
-from manakov import _core
 from scipy.integrate import solve_ivp
+
+import manakov
+from manakov import _core
 
 DATA = Path(__file__).resolve().parent / "data"
 STAGES = {"gauss4": 2, "gauss6": 3, "gauss16": 8}
