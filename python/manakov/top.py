@@ -23,7 +23,7 @@ Equations (numbers are those of Perelomov's paper)
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from typing import Any, Callable
 
 import numpy as np
@@ -47,8 +47,8 @@ METHODS = ("gauss4", "gauss6", "gauss16", "dopri5", "dop853")
 _EXPLICIT = ("dopri5", "dop853")
 
 #: Default step of each Gauss method in units of the top's time scale
-#: ``1/Ω``, ``Ω = max |c_kj - c_ik| · ‖l0‖`` (a bound on the Lipschitz constant
-#: of (1) on the orbit). Chosen on the shared 'generic' top so that the error at
+#: ``1/Ω``, ``Ω = (max c_ij - min c_ij) · ‖l0‖`` (a bound on the Lipschitz
+#: constant of (1) on the orbit). Chosen on the shared 'generic' top so that the error at
 #: t = 100 is ~1e-13 (gauss16: dt = 0.34, three steps per unit time) and the
 #: stage iteration converges in ~15 sweeps; see ``docs/dynamics.md``.
 DT_SCALE = {"gauss4": 0.01, "gauss6": 0.044, "gauss16": 1.5}
@@ -177,7 +177,6 @@ class Trajectory:
     dt: float
     steps: int
     evals: int
-    meta: dict[str, Any] = field(default_factory=dict)
 
     def relative_drift(self) -> dict[str, np.ndarray]:
         """``|I(t) - I(t0)| / |I(t0)|`` for each integral (absolute if ``I(t0) = 0``)."""
@@ -270,7 +269,10 @@ class FrahmTop:
     # -- integration ---------------------------------------------------------
 
     def time_scale(self, l0: Any) -> float:
-        """``1/Ω`` with ``Ω = max_{i,j,k distinct} |c_kj - c_ik| · ‖l0‖₂``; ``inf`` if Ω = 0."""
+        """``1/Ω``, ``Ω = (max_{i≠j} c_ij - min_{i≠j} c_ij) · ‖l0‖₂``; ``inf`` if Ω = 0.
+
+        ``Ω`` bounds ``|c_kj - c_ik| · ‖l‖``, the Lipschitz constant of (1) on the orbit.
+        """
         l0a = _float_array(l0, "l0")
         n, c = self.n, self._c
         off = c[~np.eye(n, dtype=bool)]
