@@ -159,3 +159,19 @@ def test_no_panic_reaches_python_from_the_core():
     for call in bad_calls:
         with pytest.raises(ValueError):
             call()
+
+
+def test_overflow_is_an_error_not_a_silent_nan(top):
+    huge = np.full(6, 1e200)
+    with pytest.raises(ValueError, match="overflow"):
+        top.vector_field(huge)
+    with pytest.raises(ValueError, match="overflow"):
+        top.hamiltonian(huge)
+    with pytest.raises(ValueError, match="overflow"):
+        top.integrals(huge)
+    # The default step scales as 1/|l0|: 1e200 steps would be needed.
+    with pytest.raises(ValueError, match="steps would be needed"):
+        top.integrate(huge, 1.0)
+    for method in ("gauss16", "gauss4", "dop853", "dopri5"):
+        with pytest.raises(manakov.ConvergenceError):
+            top.integrate(huge, 1.0, dt=0.1, method=method)

@@ -90,8 +90,16 @@ def _states(l: Any, m: int, what: str = "l") -> tuple[np.ndarray, tuple[int, ...
     return np.ascontiguousarray(arr.reshape(-1, m)), lead
 
 
+def _finite_result(values: np.ndarray) -> np.ndarray:
+    """Raise instead of returning an overflowed (inf/NaN) result from finite input."""
+    if not np.all(np.isfinite(values)):
+        raise ValueError("the result overflows (inf or NaN) for this l: rescale l")
+    return values
+
+
 def _out(values: np.ndarray, lead: tuple[int, ...]) -> Any:
     """Reshape per-state results back to the leading shape; 0-d → scalar."""
+    values = _finite_result(values)
     res = values.reshape(lead + values.shape[1:])
     return res[()] if res.ndim == 0 else res
 
@@ -244,7 +252,7 @@ class FrahmTop:
         ndarray, same shape as ``l``
         """
         flat, lead = _states(l, self.dim)
-        return _core.vector_field(self._c, flat).reshape(lead + (self.dim,))
+        return _finite_result(_core.vector_field(self._c, flat)).reshape(lead + (self.dim,))
 
     def hamiltonian(self, l: Any) -> Any:
         """The energy (4), ``H = ½ Σ_{j<k} c_jk l_jk²``; shape ``l.shape[:-1]``."""
@@ -260,9 +268,12 @@ class FrahmTop:
         flat, lead = _states(l, self.dim)
         out: dict[str, Any] = {}
         if self.n == 4:
-            out["H0"] = _out(flat[:, 0] * flat[:, 5] + flat[:, 3] * flat[:, 2]
-                             - flat[:, 1] * flat[:, 4], lead)
-        out["H1"] = _out(np.einsum("ij,ij->i", flat, flat), lead)
+            with np.errstate(over="ignore", invalid="ignore"):
+                h0 = flat[:, 0] * flat[:, 5] + flat[:, 3] * flat[:, 2] - flat[:, 1] * flat[:, 4]
+            out["H0"] = _out(h0, lead)
+        with np.errstate(over="ignore", invalid="ignore"):
+            h1 = np.einsum("ij,ij->i", flat, flat)
+        out["H1"] = _out(h1, lead)
         out["H"] = _out(_core.hamiltonian(self._c, flat), lead)
         return out
 
@@ -277,7 +288,11 @@ class FrahmTop:
         n, c = self.n, self._c
         off = c[~np.eye(n, dtype=bool)]
         spread = float(np.max(off) - np.min(off)) if off.size else 0.0
-        omega = spread * float(np.linalg.norm(l0a))
+        big = float(np.max(np.abs(l0a), initial=0.0))
+        # ‖l0‖ scaled by its largest entry, so that squaring cannot overflow.
+        norm = big * float(np.linalg.norm(l0a / big)) if big > 0 else 0.0
+        with np.errstate(over="ignore"):
+            omega = float(np.float64(spread) * np.float64(norm))
         return math.inf if omega == 0 else 1.0 / omega
 
     def default_dt(self, l0: Any, method: str = "gauss16") -> float:
@@ -287,7 +302,12 @@ class FrahmTop:
         if method in _EXPLICIT:
             return 0.0
         ts = self.time_scale(l0)
-        return DT_SCALE[method] * ts if math.isfinite(ts) else 1.0
+        if not math.isfinite(ts):
+            return 1.0
+        dt = DT_SCALE[method] * ts
+        if not dt > 0:
+            raise ValueError("l0 is too large: its time scale 1/Ω underflows; rescale l0")
+        return dt
 
     def _sample_times(
         self, t_end: Any, t_eval: Any, sample_every: Any

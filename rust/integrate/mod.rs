@@ -496,6 +496,15 @@ impl<const S: usize, const M: usize> Stepper for GaussFixed<S, M> {
             self.comp[k] = (y[k] - new) + sum;
             y[k] = new;
         }
+        // f64::max ignores NaN, so the stop rule cannot see one: check the result.
+        if !y.iter().all(|v| v.is_finite()) {
+            return Err(Error::NoConvergence {
+                what: "Gauss step (state overflowed or became NaN; reduce dt or rescale l)",
+                tol: 0.0,
+                reached: f64::NAN,
+                iterations: rule.iterations,
+            });
+        }
         Ok(())
     }
 }
@@ -610,6 +619,15 @@ impl Stepper for GaussDyn {
             let new = y[k] + sum;
             self.comp[k] = (y[k] - new) + sum;
             y[k] = new;
+        }
+        // f64::max ignores NaN, so the stop rule cannot see one: check the result.
+        if !y.iter().all(|v| v.is_finite()) {
+            return Err(Error::NoConvergence {
+                what: "Gauss step (state overflowed or became NaN; reduce dt or rescale l)",
+                tol: 0.0,
+                reached: f64::NAN,
+                iterations: rule.iterations,
+            });
         }
         Ok(())
     }
