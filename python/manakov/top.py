@@ -462,12 +462,13 @@ class FrahmTop:
         """
         flat, lead = _states(l0s, self.dim, "l0s")
         times = self._sample_times(t_end, t_eval, sample_every)
+        if method not in METHODS:
+            raise ValueError(f"unknown method {method!r}; known: {', '.join(METHODS)}")
         if dt is None:
+            # One step for the whole batch: the smallest default over its members.
             dtf = min((self.default_dt(x, method) for x in flat), default=1.0)
-            if method not in METHODS:
-                raise ValueError(f"unknown method {method!r}")
         else:
-            dtf = self._options(flat[0] if len(flat) else np.zeros(self.dim), method, dt)
+            dtf = self._options(np.zeros(self.dim), method, dt)
         ys, _ = _core.integrate_many(
             self._c, flat, 0.0, times, method, dtf, _scalar(rtol, "rtol"),
             _scalar(atol, "atol"), bool(parallel),
