@@ -10,10 +10,11 @@ from __future__ import annotations
 
 import itertools
 
-import manakov
 import mpmath
 import numpy as np
 import pytest
+
+import manakov
 from manakov import KotterCurve
 
 CYCLIC = ((1, 2, 3), (2, 3, 1), (3, 1, 2))

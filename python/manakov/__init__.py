@@ -8,6 +8,15 @@ Equation numbers in docstrings are the paper's.
 from ._core import ConvergenceError, __version__
 from .curve import CurvePoints, KotterCurve, Wurzel
 from .problems import Problem, benchmark_setup, problem, problem_names
+from .top import (
+    METHODS,
+    FrahmTop,
+    ManakovTop,
+    Trajectory,
+    from_matrix,
+    poisson_tensor,
+    to_matrix,
+)
 
 __all__ = [
     "ConvergenceError",
@@ -15,8 +24,16 @@ __all__ = [
     "KotterCurve",
     "Problem",
     "Wurzel",
+    "FrahmTop",
+    "METHODS",
+    "ManakovTop",
+    "Problem",
+    "Trajectory",
     "__version__",
     "benchmark_setup",
+    "from_matrix",
+    "poisson_tensor",
     "problem",
     "problem_names",
+    "to_matrix",
 ]

@@ -2,9 +2,27 @@
 
 import numpy as np
 import numpy.typing as npt
+from numpy.typing import NDArray
 
 __all__ = [
     "ConvergenceError",
+    "check_c",
+    "curve_branch_points",
+    "curve_constants",
+    "curve_eval",
+    "curve_points_from_xi_eta",
+    "curve_wurzel",
+    "curve_xi_eta",
+    "gauss_tableau",
+    "hamiltonian",
+    "integrate",
+    "integrate_many",
+    "manakov_c",
+    "manakov_integral_labels",
+    "manakov_integrals",
+    "poisson_tensor",
+    "so4_integrals",
+    "vector_field",
     "__version__",
 ]
 
@@ -47,3 +65,37 @@ def curve_points_from_xi_eta(
     g_ref: npt.NDArray[np.complex128] | None = None,
     rtol: float = 1e-08,
 ) -> tuple[npt.NDArray[np.complex128], npt.NDArray[np.int8], npt.NDArray[np.float64]]: ...
+
+# --- so4 / integrate (rust/python/so4.rs) ---
+def manakov_c(a: NDArray[np.float64], b: NDArray[np.float64]) -> NDArray[np.float64]: ...
+def check_c(c: NDArray[np.float64]) -> None: ...
+def vector_field(c: NDArray[np.float64], l: NDArray[np.float64]) -> NDArray[np.float64]: ...
+def hamiltonian(c: NDArray[np.float64], l: NDArray[np.float64]) -> NDArray[np.float64]: ...
+def so4_integrals(a: NDArray[np.float64], l: NDArray[np.float64]) -> NDArray[np.float64]: ...
+def manakov_integral_labels(n: int) -> list[tuple[int, int]]: ...
+def manakov_integrals(a: NDArray[np.float64], l: NDArray[np.float64]) -> NDArray[np.float64]: ...
+def poisson_tensor(l: NDArray[np.float64]) -> NDArray[np.float64]: ...
+def integrate(
+    c: NDArray[np.float64],
+    l0: NDArray[np.float64],
+    t0: float,
+    times: NDArray[np.float64],
+    method: str,
+    dt: float,
+    rtol: float,
+    atol: float,
+) -> tuple[NDArray[np.float64], int, int]: ...
+def integrate_many(
+    c: NDArray[np.float64],
+    l0s: NDArray[np.float64],
+    t0: float,
+    times: NDArray[np.float64],
+    method: str,
+    dt: float,
+    rtol: float,
+    atol: float,
+    parallel: bool,
+) -> tuple[NDArray[np.float64], int]: ...
+def gauss_tableau(
+    method: str,
+) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]: ...

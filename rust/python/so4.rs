@@ -1,8 +1,295 @@
-//! Bindings for `crate::so4`.
+//! Bindings for `crate::so4` and `crate::integrate`.
 
+use numpy::ndarray::{Array2, Array3};
+use numpy::{IntoPyArray, PyArray1, PyArray2, PyArray3, PyReadonlyArray1, PyReadonlyArray2};
 use pyo3::prelude::*;
 
+use crate::error::Error;
+use crate::integrate::{self, Method, Options};
+use crate::so4::{self, FrahmTop};
+
+/// Copies a read-only 1-d array (any strides) into a Vec.
+fn vec1(x: &PyReadonlyArray1<'_, f64>) -> Vec<f64> {
+    x.as_array().iter().copied().collect()
+}
+
+/// Copies a read-only 2-d array (any strides) into a row-major Vec with its shape.
+fn vec2(x: &PyReadonlyArray2<'_, f64>) -> (Vec<f64>, usize, usize) {
+    let v = x.as_array();
+    let (r, c) = v.dim();
+    (v.iter().copied().collect(), r, c)
+}
+
+fn top_from_c(c: &PyReadonlyArray2<'_, f64>) -> Result<FrahmTop, Error> {
+    let (cv, r, k) = vec2(c);
+    if r != k {
+        return Err(Error::Shape {
+            what: "c",
+            expected: "(n, n)".into(),
+            got: format!("({r}, {k})"),
+        });
+    }
+    FrahmTop::new(r, &cv)
+}
+
+fn check_states(what: &'static str, cols: usize, m: usize) -> Result<(), Error> {
+    if cols != m {
+        return Err(Error::Shape {
+            what,
+            expected: format!("(..., {m})"),
+            got: format!("(..., {cols})"),
+        });
+    }
+    Ok(())
+}
+
+fn shape_err(e: impl std::fmt::Display) -> Error {
+    Error::InvalidArgument {
+        what: "output shape",
+        reason: e.to_string(),
+    }
+}
+
+/// Manakov's c_ij (2) from a, b.
+#[pyfunction(name = "manakov_c")]
+fn manakov_c_py<'py>(
+    py: Python<'py>,
+    a: PyReadonlyArray1<'py, f64>,
+    b: PyReadonlyArray1<'py, f64>,
+) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    let (a, b) = (vec1(&a), vec1(&b));
+    let n = a.len();
+    let c = py.detach(|| so4::manakov_c(&a, &b))?;
+    Ok(Array2::from_shape_vec((n, n), c)
+        .map_err(shape_err)?
+        .into_pyarray(py))
+}
+
+/// Validates a Frahm coefficient matrix c (raises ValueError).
+#[pyfunction(name = "check_c")]
+fn check_c_py(c: PyReadonlyArray2<'_, f64>) -> PyResult<()> {
+    top_from_c(&c)?;
+    Ok(())
+}
+
+/// The vector field (1) at each row of l (N, n(n-1)/2).
+#[pyfunction(name = "vector_field")]
+fn vector_field_py<'py>(
+    py: Python<'py>,
+    c: PyReadonlyArray2<'py, f64>,
+    l: PyReadonlyArray2<'py, f64>,
+) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    let top = top_from_c(&c)?;
+    let (lv, rows, cols) = vec2(&l);
+    check_states("l", cols, top.dim())?;
+    let out = py.detach(|| {
+        let mut out = vec![0.0; lv.len()];
+        for (x, o) in lv.chunks(cols.max(1)).zip(out.chunks_mut(cols.max(1))) {
+            top.vector_field(x, o);
+        }
+        out
+    });
+    Ok(Array2::from_shape_vec((rows, cols), out)
+        .map_err(shape_err)?
+        .into_pyarray(py))
+}
+
+/// The Hamiltonian (4) at each row of l.
+#[pyfunction(name = "hamiltonian")]
+fn hamiltonian_py<'py>(
+    py: Python<'py>,
+    c: PyReadonlyArray2<'py, f64>,
+    l: PyReadonlyArray2<'py, f64>,
+) -> PyResult<Bound<'py, PyArray1<f64>>> {
+    let top = top_from_c(&c)?;
+    let (lv, _, cols) = vec2(&l);
+    check_states("l", cols, top.dim())?;
+    let out: Vec<f64> = py.detach(|| lv.chunks(cols.max(1)).map(|x| top.hamiltonian(x)).collect());
+    Ok(out.into_pyarray(py))
+}
+
+/// The so(4) integrals [H0, H1, H2, H3] (6)-(7), corrected, at each row of l (N, 6).
+#[pyfunction(name = "so4_integrals")]
+fn so4_integrals_py<'py>(
+    py: Python<'py>,
+    a: PyReadonlyArray1<'py, f64>,
+    l: PyReadonlyArray2<'py, f64>,
+) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    let a = vec1(&a);
+    let a4: [f64; 4] = a.as_slice().try_into().map_err(|_| Error::Shape {
+        what: "a",
+        expected: "(4,)".into(),
+        got: format!("({},)", a.len()),
+    })?;
+    let (lv, rows, cols) = vec2(&l);
+    check_states("l", cols, so4::DIM4)?;
+    let out: Vec<f64> = py.detach(|| {
+        lv.chunks(6)
+            .flat_map(|x| {
+                let x: [f64; 6] = [x[0], x[1], x[2], x[3], x[4], x[5]];
+                so4::integrals4(&a4, &x)
+            })
+            .collect()
+    });
+    Ok(Array2::from_shape_vec((rows, 4), out)
+        .map_err(shape_err)?
+        .into_pyarray(py))
+}
+
+/// Labels (k, j) of Manakov's integrals on so(n).
+#[pyfunction(name = "manakov_integral_labels")]
+fn manakov_integral_labels_py(n: usize) -> Vec<(usize, usize)> {
+    so4::manakov_integral_labels(n)
+}
+
+/// Manakov's integrals (coefficients of tr (l + λA)^k) at each row of l.
+#[pyfunction(name = "manakov_integrals")]
+fn manakov_integrals_py<'py>(
+    py: Python<'py>,
+    a: PyReadonlyArray1<'py, f64>,
+    l: PyReadonlyArray2<'py, f64>,
+) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    let a = vec1(&a);
+    let n = a.len();
+    let (lv, rows, cols) = vec2(&l);
+    check_states("l", cols, so4::state_dim(n))?;
+    let k = so4::manakov_integral_labels(n).len();
+    let out: Vec<f64> = py.detach(|| {
+        lv.chunks(cols.max(1))
+            .flat_map(|x| so4::manakov_integrals(&a, x))
+            .collect()
+    });
+    Ok(Array2::from_shape_vec((rows, k), out)
+        .map_err(shape_err)?
+        .into_pyarray(py))
+}
+
+/// The Poisson tensor (3) at each row of l, shape (N, m, m).
+#[pyfunction(name = "poisson_tensor")]
+fn poisson_tensor_py<'py>(
+    py: Python<'py>,
+    l: PyReadonlyArray2<'py, f64>,
+) -> PyResult<Bound<'py, PyArray3<f64>>> {
+    let (lv, rows, cols) = vec2(&l);
+    let n = so4::n_from_state_dim(cols)
+        .filter(|&n| n >= 2)
+        .ok_or_else(|| Error::Shape {
+            what: "l",
+            expected: "(..., n(n-1)/2)".into(),
+            got: format!("(..., {cols})"),
+        })?;
+    let out = py.detach(|| {
+        let mut out = vec![0.0; rows * cols * cols];
+        for (x, o) in lv.chunks(cols).zip(out.chunks_mut(cols * cols)) {
+            so4::poisson_tensor(n, x, o);
+        }
+        out
+    });
+    Ok(Array3::from_shape_vec((rows, cols, cols), out)
+        .map_err(shape_err)?
+        .into_pyarray(py))
+}
+
+fn options(method: &str, dt: f64, rtol: f64, atol: f64) -> Result<Options, Error> {
+    let o = Options {
+        method: Method::from_name(method)?,
+        dt,
+        rtol,
+        atol,
+    };
+    o.validate()?;
+    Ok(o)
+}
+
+/// Integrates (1) from l0 at t0, sampling at `times`; returns (l (S, m), steps, evals).
+#[pyfunction(name = "integrate")]
+#[pyo3(signature = (c, l0, t0, times, method, dt, rtol, atol))]
+#[allow(clippy::too_many_arguments)]
+fn integrate_py<'py>(
+    py: Python<'py>,
+    c: PyReadonlyArray2<'py, f64>,
+    l0: PyReadonlyArray1<'py, f64>,
+    t0: f64,
+    times: PyReadonlyArray1<'py, f64>,
+    method: &str,
+    dt: f64,
+    rtol: f64,
+    atol: f64,
+) -> PyResult<(Bound<'py, PyArray2<f64>>, u64, u64)> {
+    let top = top_from_c(&c)?;
+    let (l0, times) = (vec1(&l0), vec1(&times));
+    let opts = options(method, dt, rtol, atol)?;
+    let tr = py.detach(|| integrate::integrate(&top, &l0, t0, &times, &opts))?;
+    let m = top.dim();
+    let y = Array2::from_shape_vec((tr.t.len(), m), tr.y)
+        .map_err(shape_err)?
+        .into_pyarray(py);
+    Ok((y, tr.steps, tr.evals))
+}
+
+/// Integrates a batch (B, m) of initial states; returns (l (B, S, m), steps).
+#[pyfunction(name = "integrate_many")]
+#[pyo3(signature = (c, l0s, t0, times, method, dt, rtol, atol, parallel))]
+#[allow(clippy::too_many_arguments)]
+fn integrate_many_py<'py>(
+    py: Python<'py>,
+    c: PyReadonlyArray2<'py, f64>,
+    l0s: PyReadonlyArray2<'py, f64>,
+    t0: f64,
+    times: PyReadonlyArray1<'py, f64>,
+    method: &str,
+    dt: f64,
+    rtol: f64,
+    atol: f64,
+    parallel: bool,
+) -> PyResult<(Bound<'py, PyArray3<f64>>, u64)> {
+    let top = top_from_c(&c)?;
+    let (l0s, rows, cols) = vec2(&l0s);
+    check_states("l0s", cols, top.dim())?;
+    let times = vec1(&times);
+    let opts = options(method, dt, rtol, atol)?;
+    let (ys, steps) =
+        py.detach(|| integrate::integrate_many(&top, &l0s, t0, &times, &opts, parallel))?;
+    let y = Array3::from_shape_vec((rows, times.len(), cols), ys)
+        .map_err(shape_err)?
+        .into_pyarray(py);
+    Ok((y, steps))
+}
+
+/// `(c, b, mu)` as numpy arrays.
+type Tableau<'py> = (
+    Bound<'py, PyArray1<f64>>,
+    Bound<'py, PyArray1<f64>>,
+    Bound<'py, PyArray2<f64>>,
+);
+
+/// The Gauss tableau (c, b, mu) of a Gauss method, mu_ij = a_ij / b_j.
+#[pyfunction(name = "gauss_tableau")]
+fn gauss_tableau_py<'py>(py: Python<'py>, method: &str) -> PyResult<Tableau<'py>> {
+    let m = Method::from_name(method)?;
+    let (c, b, mu) = m.gauss_tableau().ok_or_else(|| Error::InvalidArgument {
+        what: "method",
+        reason: format!("{method:?} is not a Gauss method"),
+    })?;
+    let s = b.len();
+    let mu = Array2::from_shape_vec((s, s), mu)
+        .map_err(shape_err)?
+        .into_pyarray(py);
+    Ok((c.to_vec().into_pyarray(py), b.to_vec().into_pyarray(py), mu))
+}
+
 /// Adds this module's functions to `manakov._core`.
-pub fn register(_m: &Bound<'_, PyModule>) -> PyResult<()> {
+pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_function(wrap_pyfunction!(manakov_c_py, m)?)?;
+    m.add_function(wrap_pyfunction!(check_c_py, m)?)?;
+    m.add_function(wrap_pyfunction!(vector_field_py, m)?)?;
+    m.add_function(wrap_pyfunction!(hamiltonian_py, m)?)?;
+    m.add_function(wrap_pyfunction!(so4_integrals_py, m)?)?;
+    m.add_function(wrap_pyfunction!(manakov_integral_labels_py, m)?)?;
+    m.add_function(wrap_pyfunction!(manakov_integrals_py, m)?)?;
+    m.add_function(wrap_pyfunction!(poisson_tensor_py, m)?)?;
+    m.add_function(wrap_pyfunction!(integrate_py, m)?)?;
+    m.add_function(wrap_pyfunction!(integrate_many_py, m)?)?;
+    m.add_function(wrap_pyfunction!(gauss_tableau_py, m)?)?;
     Ok(())
 }

@@ -1,0 +1,585 @@
+# The state is called l, as in the paper (and ω, c, a, b): E741 does not apply.
+# ruff: noqa: E741
+"""The Euler–Frahm top on so(4) and so(n), Manakov's integrable case, and its integration.
+
+State convention
+----------------
+An angular momentum ``l`` in so(n) is a skew matrix, ``l_ji = -l_ij``. Arrays
+hold its strict upper triangle row by row, so the last axis has length
+``n(n-1)/2``; for n = 4 it is ordered ``(l12, l13, l14, l23, l24, l34)``. Every
+function broadcasts over leading axes; a single state in gives scalars out.
+
+Equations (numbers are those of Perelomov's paper)
+---------------------------------------------------
+(1) ``l̇_ij = Σ_k (l_ik ω_kj - ω_ik l_kj)``, ``ω_ij = c_ij l_ij``;
+(2) ``c_ij = (b_i - b_j)/(a_i - a_j)``;
+(3) ``{l_ij, l_km} = l_im δ_jk - l_ik δ_jm + l_jk δ_im - l_jm δ_ik``;
+(4) ``H = ½ Σ_{j<k} c_jk l_jk²``; (5) ``l̇_jk = {H, l_jk}`` (sign as printed holds);
+(6) ``H0 = l12 l34 + l23 l14 + l31 l24``; (7), corrected (see ``docs/errata-so4.md``):
+``H1 = Σ l_jk²``, ``H2 = Σ (a_l + a_m) l_jk²``, ``H3 = Σ a_l a_m l_jk²`` with
+``{l, m} = {1,2,3,4} \\ {j, k}``.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any, Callable
+
+import numpy as np
+
+from . import _core
+
+__all__ = [
+    "FrahmTop",
+    "ManakovTop",
+    "Trajectory",
+    "METHODS",
+    "poisson_tensor",
+    "to_matrix",
+    "from_matrix",
+    "state_dim",
+]
+
+#: Integration methods: Gauss–Legendre collocation with 2, 3 and 8 stages
+#: (orders 4, 6, 16) and the explicit adaptive Dormand–Prince pairs 5(4) and 8(5,3).
+METHODS = ("gauss4", "gauss6", "gauss16", "dopri5", "dop853")
+_EXPLICIT = ("dopri5", "dop853")
+
+#: Default step of each Gauss method in units of the top's time scale
+#: ``1/Ω``, ``Ω = (max c_ij - min c_ij) · ‖l0‖`` (a bound on the Lipschitz
+#: constant of (1) on the orbit). Chosen on the shared 'generic' top so that the error at
+#: t = 100 is ~1e-13 (gauss16: dt = 0.34, three steps per unit time) and the
+#: stage iteration converges in ~15 sweeps; see ``docs/dynamics.md``.
+DT_SCALE = {"gauss4": 0.01, "gauss6": 0.044, "gauss16": 1.5}
+
+#: Default number of samples when neither ``t_eval`` nor ``sample_every`` is given.
+DEFAULT_SAMPLES = 1001
+
+
+def state_dim(n: int) -> int:
+    """Length ``n(n-1)/2`` of the so(n) state vector."""
+    return n * (n - 1) // 2
+
+
+def _n_from_dim(m: int) -> int:
+    n = int(round((1 + math.sqrt(1 + 8 * m)) / 2))
+    if state_dim(n) != m or n < 2:
+        raise ValueError(f"last axis of length {m} is not n(n-1)/2 for any n")
+    return n
+
+
+def _float_array(x: Any, what: str) -> np.ndarray:
+    arr = np.asarray(x)
+    if np.iscomplexobj(arr):
+        raise ValueError(f"{what} must be real, got a complex array")
+    if arr.dtype == object:
+        raise ValueError(f"{what} must be a numeric array")
+    arr = arr.astype(np.float64, copy=False)
+    if not np.all(np.isfinite(arr)):
+        raise ValueError(f"{what} must be finite; it contains NaN or infinity")
+    return arr
+
+
+def _states(l: Any, m: int, what: str = "l") -> tuple[np.ndarray, tuple[int, ...]]:
+    """``l`` as a C-contiguous (N, m) float array and its leading shape."""
+    arr = _float_array(l, what)
+    if arr.ndim == 0 or arr.shape[-1] != m:
+        raise ValueError(f"{what} must have shape (..., {m}), got {arr.shape}")
+    lead = arr.shape[:-1]
+    return np.ascontiguousarray(arr.reshape(-1, m)), lead
+
+
+def _finite_result(values: np.ndarray) -> np.ndarray:
+    """Raise instead of returning an overflowed (inf/NaN) result from finite input."""
+    if not np.all(np.isfinite(values)):
+        raise ValueError("the result overflows (inf or NaN) for this l: rescale l")
+    return values
+
+
+def _out(values: np.ndarray, lead: tuple[int, ...]) -> Any:
+    """Reshape per-state results back to the leading shape; 0-d → scalar."""
+    values = _finite_result(values)
+    res = values.reshape(lead + values.shape[1:])
+    return res[()] if res.ndim == 0 else res
+
+
+def to_matrix(l: Any) -> np.ndarray:
+    """The skew matrices of states ``l`` of shape ``(..., n(n-1)/2)``: shape ``(..., n, n)``."""
+    arr = np.asarray(l, dtype=float)
+    if arr.ndim == 0:
+        raise ValueError("l must have at least one axis")
+    n = _n_from_dim(arr.shape[-1])
+    iu = np.triu_indices(n, 1)
+    out = np.zeros(arr.shape[:-1] + (n, n))
+    out[..., iu[0], iu[1]] = arr
+    out[..., iu[1], iu[0]] = -arr
+    return out
+
+
+def from_matrix(m: Any, *, check: bool = True) -> np.ndarray:
+    """The state vectors (strict upper triangles) of skew matrices ``m`` of shape ``(..., n, n)``.
+
+    With ``check``, raise ``ValueError`` unless ``m`` is skew to 8 ulps of its largest entry.
+    """
+    arr = np.asarray(m, dtype=float)
+    if arr.ndim < 2 or arr.shape[-1] != arr.shape[-2]:
+        raise ValueError(f"m must have shape (..., n, n), got {arr.shape}")
+    if check:
+        scale = np.max(np.abs(arr), initial=0.0)
+        asym = np.max(np.abs(arr + np.swapaxes(arr, -1, -2)), initial=0.0)
+        if asym > 8 * np.finfo(float).eps * scale:
+            raise ValueError(f"m must be skew-symmetric; max |m + m^T| = {asym:e}")
+    n = arr.shape[-1]
+    iu = np.triu_indices(n, 1)
+    return arr[..., iu[0], iu[1]].copy()
+
+
+def poisson_tensor(l: Any) -> np.ndarray:
+    """The Lie–Poisson tensor (3) of so(n) at ``l``: ``P[..., p, q] = {l_p, l_q}``.
+
+    ``{l_ij, l_km} = l_im δ_jk - l_ik δ_jm + l_jk δ_im - l_jm δ_ik`` (3), for
+    state indices ``p = (ij)``, ``q = (km)`` (``i < j``, ``k < m``). For any
+    function ``F``, ``{F, l_q} = Σ_p ∂F/∂l_p P[p, q]``.
+
+    Parameters
+    ----------
+    l : array_like, shape (..., n(n-1)/2)
+
+    Returns
+    -------
+    ndarray, shape (..., n(n-1)/2, n(n-1)/2)
+    """
+    arr = _float_array(l, "l")
+    if arr.ndim == 0:
+        raise ValueError("l must have shape (..., n(n-1)/2)")
+    m = arr.shape[-1]
+    _n_from_dim(m)
+    flat, lead = _states(arr, m)
+    return _core.poisson_tensor(flat).reshape(lead + (m, m))
+
+
+@dataclass(frozen=True)
+class Trajectory:
+    """A sampled solution of (1).
+
+    Attributes
+    ----------
+    t : ndarray, shape (S,)
+        Sample times.
+    l : ndarray, shape (S, n(n-1)/2)
+        States at the sample times.
+    integrals : dict of str to ndarray (S,)
+        The top's integrals along the samples (see ``FrahmTop.integrals``).
+    method : str
+    dt : float
+        The largest step (Gauss methods) or the initial step (explicit; 0 = automatic).
+    steps, evals : int
+        Steps taken and vector-field evaluations.
+    """
+
+    t: np.ndarray
+    l: np.ndarray
+    integrals: dict[str, np.ndarray]
+    method: str
+    dt: float
+    steps: int
+    evals: int
+
+    def relative_drift(self) -> dict[str, np.ndarray]:
+        """``|I(t) - I(t0)| / |I(t0)|`` for each integral (absolute if ``I(t0) = 0``)."""
+        out = {}
+        for name, v in self.integrals.items():
+            ref = abs(v[0]) if v[0] != 0 else 1.0
+            out[name] = np.abs(v - v[0]) / ref
+        return out
+
+    def max_drift(self) -> dict[str, float]:
+        """The largest relative drift of each integral over the samples."""
+        return {k: float(np.max(v, initial=0.0)) for k, v in self.relative_drift().items()}
+
+
+class FrahmTop:
+    """The Euler–Frahm top (1) on so(n) with symmetric coefficients ``c_ij = 1/I_ij``.
+
+    Parameters
+    ----------
+    c : array_like, shape (n, n)
+        Symmetric (to 8 ulps), finite; ``n >= 3``. The diagonal is not used.
+
+    Raises
+    ------
+    ValueError
+        If ``c`` is not square, not finite, not symmetric, or ``n < 3``.
+    """
+
+    def __init__(self, c: Any) -> None:
+        carr = _float_array(c, "c")
+        if carr.ndim != 2 or carr.shape[0] != carr.shape[1] or carr.shape[0] < 3:
+            raise ValueError(f"c must have shape (n, n) with n >= 3, got {carr.shape}")
+        carr = np.array(carr, dtype=float, order="C")
+        _core.check_c(carr)
+        carr.setflags(write=False)
+        self._c = carr
+
+    @property
+    def c(self) -> np.ndarray:
+        """The coefficients ``c_ij`` (read-only)."""
+        return self._c
+
+    @property
+    def n(self) -> int:
+        """The dimension ``n`` of the body."""
+        return int(self._c.shape[0])
+
+    @property
+    def dim(self) -> int:
+        """Length ``n(n-1)/2`` of the state."""
+        return state_dim(self.n)
+
+    def __repr__(self) -> str:
+        return f"{type(self).__name__}(n={self.n})"
+
+    def vector_field(self, l: Any) -> np.ndarray:
+        """The right-hand side of (1): ``l̇ = [l, ω]``, ``ω_ij = c_ij l_ij``.
+
+        Parameters
+        ----------
+        l : array_like, shape (..., n(n-1)/2)
+
+        Returns
+        -------
+        ndarray, same shape as ``l``
+        """
+        flat, lead = _states(l, self.dim)
+        return _finite_result(_core.vector_field(self._c, flat)).reshape(lead + (self.dim,))
+
+    def hamiltonian(self, l: Any) -> Any:
+        """The energy (4), ``H = ½ Σ_{j<k} c_jk l_jk²``; shape ``l.shape[:-1]``."""
+        flat, lead = _states(l, self.dim)
+        return _out(_core.hamiltonian(self._c, flat), lead)
+
+    def integrals(self, l: Any) -> dict[str, Any]:
+        """Conserved quantities of (1) for any symmetric ``c``.
+
+        ``H1 = Σ_{j<k} l_jk²`` (the Casimir ``-½ tr l²``), ``H`` (4), and for
+        n = 4 also the Casimir ``H0 = l12 l34 + l23 l14 + l31 l24`` (6).
+        """
+        flat, lead = _states(l, self.dim)
+        out: dict[str, Any] = {}
+        if self.n == 4:
+            with np.errstate(over="ignore", invalid="ignore"):
+                h0 = flat[:, 0] * flat[:, 5] + flat[:, 3] * flat[:, 2] - flat[:, 1] * flat[:, 4]
+            out["H0"] = _out(h0, lead)
+        with np.errstate(over="ignore", invalid="ignore"):
+            h1 = np.einsum("ij,ij->i", flat, flat)
+        out["H1"] = _out(h1, lead)
+        out["H"] = _out(_core.hamiltonian(self._c, flat), lead)
+        return out
+
+    # -- integration ---------------------------------------------------------
+
+    def time_scale(self, l0: Any) -> float:
+        """``1/Ω``, ``Ω = (max_{i≠j} c_ij - min_{i≠j} c_ij) · ‖l0‖₂``; ``inf`` if Ω = 0.
+
+        ``Ω`` bounds ``|c_kj - c_ik| · ‖l‖``, the Lipschitz constant of (1) on the orbit.
+        """
+        l0a = _float_array(l0, "l0")
+        n, c = self.n, self._c
+        off = c[~np.eye(n, dtype=bool)]
+        spread = float(np.max(off) - np.min(off)) if off.size else 0.0
+        big = float(np.max(np.abs(l0a), initial=0.0))
+        # ‖l0‖ scaled by its largest entry, so that squaring cannot overflow.
+        norm = big * float(np.linalg.norm(l0a / big)) if big > 0 else 0.0
+        with np.errstate(over="ignore"):
+            omega = float(np.float64(spread) * np.float64(norm))
+        return math.inf if omega == 0 else 1.0 / omega
+
+    def default_dt(self, l0: Any, method: str = "gauss16") -> float:
+        """The default step of ``method`` for this top from ``l0`` (0 for explicit: automatic)."""
+        if method not in METHODS:
+            raise ValueError(f"unknown method {method!r}; known: {', '.join(METHODS)}")
+        if method in _EXPLICIT:
+            return 0.0
+        ts = self.time_scale(l0)
+        if not math.isfinite(ts):
+            return 1.0
+        dt = DT_SCALE[method] * ts
+        if not dt > 0:
+            raise ValueError("l0 is too large: its time scale 1/Ω underflows; rescale l0")
+        return dt
+
+    def _sample_times(self, t_end: Any, t_eval: Any, sample_every: Any) -> np.ndarray:
+        t_end_f = _scalar(t_end, "t_end")
+        if t_end_f < 0:
+            raise ValueError(f"t_end must be >= 0, got {t_end_f}")
+        if t_eval is not None and sample_every is not None:
+            raise ValueError("give at most one of t_eval and sample_every")
+        if t_eval is not None:
+            te = _float_array(t_eval, "t_eval")
+            if te.ndim != 1:
+                raise ValueError(f"t_eval must be 1-d, got shape {te.shape}")
+            if te.size and (np.any(np.diff(te) < 0) or te[0] < 0 or te[-1] > t_end_f):
+                raise ValueError("t_eval must be sorted and lie in [0, t_end]")
+            return np.ascontiguousarray(te)
+        if sample_every is not None:
+            every = _scalar(sample_every, "sample_every")
+            if every <= 0:
+                raise ValueError(f"sample_every must be > 0, got {every}")
+            k = math.floor(t_end_f / every * (1 + 1e-12))
+            if k > 10**9:
+                raise ValueError(f"sample_every = {every} gives more than 10^9 samples")
+            times = np.arange(k + 1, dtype=float) * every
+            times = times[times <= t_end_f]
+            if times[-1] < t_end_f:
+                times = np.append(times, t_end_f)
+            return times
+        return np.linspace(0.0, t_end_f, DEFAULT_SAMPLES)
+
+    def _options(self, l0: Any, method: str, dt: Any) -> float:
+        if method not in METHODS:
+            raise ValueError(f"unknown method {method!r}; known: {', '.join(METHODS)}")
+        if dt is None:
+            return self.default_dt(l0, method)
+        dtf = _scalar(dt, "dt")
+        if dtf <= 0:
+            raise ValueError(f"dt must be > 0, got {dtf}")
+        return dtf
+
+    def integrate(
+        self,
+        l0: Any,
+        t_end: float,
+        *,
+        dt: float | None = None,
+        t_eval: Any = None,
+        sample_every: float | None = None,
+        method: str = "gauss16",
+        rtol: float = 1e-12,
+        atol: float = 1e-12,
+        progress: Callable[[float], None] | None = None,
+        chunks: int = 1,
+    ) -> Trajectory:
+        """Integrate (1) from ``l0`` at t = 0 to ``t_end``, keeping samples only.
+
+        Gauss methods take equal steps of at most ``dt`` between consecutive
+        sample times (so every sample lands on its time) and solve each step to
+        machine precision: the quadratic integrals H0–H3 and H are conserved to
+        roundoff, which grows like the square root of the number of steps.
+
+        Parameters
+        ----------
+        l0 : array_like, shape (n(n-1)/2,)
+        t_end : float, >= 0
+        dt : float, optional
+            Largest step of a Gauss method (default: ``default_dt``); initial
+            step of ``dopri5``/``dop853`` (default automatic).
+        t_eval : array_like, optional
+            Sorted sample times in [0, t_end].
+        sample_every : float, optional
+            Sample at 0, sample_every, 2 sample_every, ..., and t_end.
+            Default (neither given): 1001 evenly spaced samples.
+        method : {"gauss16", "gauss6", "gauss4", "dopri5", "dop853"}
+        rtol, atol : float
+            Tolerances of ``dopri5`` and ``dop853`` (ignored by Gauss methods).
+        progress : callable, optional
+            Called with the fraction done after each chunk.
+        chunks : int
+            Split the run into this many calls to the core (for ``progress``).
+
+        Returns
+        -------
+        Trajectory
+
+        Raises
+        ------
+        ValueError
+            Bad shapes, non-finite values, ``t_end`` < 0 or NaN, ``dt`` <= 0.
+        manakov.ConvergenceError
+            A Gauss step whose stage equations do not converge (``dt`` too large).
+        """
+        l0a, _ = _states(l0, self.dim, "l0")
+        if l0a.shape[0] != 1 or np.ndim(l0) != 1:
+            raise ValueError(f"l0 must have shape ({self.dim},), got {np.shape(l0)}")
+        times = self._sample_times(t_end, t_eval, sample_every)
+        dtf = self._options(l0a[0], method, dt)
+        rt, at = _scalar(rtol, "rtol"), _scalar(atol, "atol")
+        if times.size == 0:
+            ls = np.empty((0, self.dim))
+            steps = evals = 0
+        else:
+            pieces = np.array_split(times, max(1, min(int(chunks), times.size)))
+            y, t0 = l0a[0], 0.0
+            out, steps, evals = [], 0, 0
+            for piece in pieces:
+                ys, s, e = _core.integrate(self._c, y, t0, piece, method, dtf, rt, at)
+                out.append(ys)
+                steps, evals = steps + s, evals + e
+                y, t0 = ys[-1], float(piece[-1])
+                if progress is not None:
+                    progress(t0 / float(times[-1]) if times[-1] > 0 else 1.0)
+            ls = np.concatenate(out)
+        return Trajectory(
+            t=times,
+            l=ls,
+            integrals=self.integrals(ls),
+            method=method,
+            dt=dtf,
+            steps=int(steps),
+            evals=int(evals),
+        )
+
+    def integrate_many(
+        self,
+        l0s: Any,
+        t_end: float,
+        *,
+        dt: float | None = None,
+        t_eval: Any = None,
+        sample_every: float | None = None,
+        method: str = "gauss16",
+        rtol: float = 1e-12,
+        atol: float = 1e-12,
+        parallel: bool = True,
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """Integrate a batch of initial states in one call, GIL released.
+
+        Parameters
+        ----------
+        l0s : array_like, shape (..., n(n-1)/2)
+        t_end, dt, t_eval, sample_every, method, rtol, atol
+            As in :meth:`integrate`; ``dt`` defaults to the smallest default
+            step over the batch.
+        parallel : bool
+            Split the batch over threads (rayon).
+
+        Returns
+        -------
+        t : ndarray, shape (S,)
+        l : ndarray, shape (..., S, n(n-1)/2)
+        """
+        flat, lead = _states(l0s, self.dim, "l0s")
+        times = self._sample_times(t_end, t_eval, sample_every)
+        if method not in METHODS:
+            raise ValueError(f"unknown method {method!r}; known: {', '.join(METHODS)}")
+        if dt is None:
+            # One step for the whole batch: the smallest default over its members.
+            dtf = min((self.default_dt(x, method) for x in flat), default=1.0)
+        else:
+            dtf = self._options(np.zeros(self.dim), method, dt)
+        ys, _ = _core.integrate_many(
+            self._c,
+            flat,
+            0.0,
+            times,
+            method,
+            dtf,
+            _scalar(rtol, "rtol"),
+            _scalar(atol, "atol"),
+            bool(parallel),
+        )
+        return times, ys.reshape(lead + (times.size, self.dim))
+
+
+class ManakovTop(FrahmTop):
+    """Manakov's integrable top: (1) with ``c_ij = (b_i - b_j)/(a_i - a_j)`` (2).
+
+    Parameters
+    ----------
+    a, b : array_like, shape (n,)
+        ``n >= 3``, finite, ``a_i`` distinct.
+
+    Raises
+    ------
+    ValueError
+        Lengths differ, ``n < 3``, non-finite values, or ``a_i == a_j``
+        (the message names the pair).
+
+    Notes
+    -----
+    ``c_ij`` is the correctly rounded quotient of the exact differences of the
+    given doubles when ``a_i``, ``a_j`` are close (Sterbenz's lemma); the
+    loss of digits in the near-degenerate case is the conditioning of (2),
+    ``|a_i| / |a_i - a_j|``, applied to the rounding of the inputs.
+    """
+
+    def __init__(self, a: Any, b: Any) -> None:
+        aa = _float_array(a, "a")
+        bb = _float_array(b, "b")
+        if aa.ndim != 1 or bb.ndim != 1:
+            raise ValueError(f"a and b must be 1-d, got shapes {aa.shape}, {bb.shape}")
+        if aa.shape != bb.shape:
+            raise ValueError(f"a and b must have the same length, got {aa.size} and {bb.size}")
+        aa = np.array(aa, dtype=float)
+        bb = np.array(bb, dtype=float)
+        c = _core.manakov_c(aa, bb)
+        super().__init__(c)
+        aa.setflags(write=False)
+        bb.setflags(write=False)
+        self._a, self._b = aa, bb
+
+    @property
+    def a(self) -> np.ndarray:
+        """The ``a_i`` of (2) (read-only)."""
+        return self._a
+
+    @property
+    def b(self) -> np.ndarray:
+        """The ``b_i`` of (2) (read-only)."""
+        return self._b
+
+    def integrals(self, l: Any) -> dict[str, Any]:
+        """The integrals of motion, by name.
+
+        For n = 4: ``H0`` (6), ``H1``, ``H2``, ``H3`` (7, corrected: the printed
+        ``H3 = Σ a_j a_k l_jk²`` is not conserved; the conserved forms use the
+        complementary pair ``{l, m} = {1,2,3,4} \\ {j, k}``,
+        ``H2 = Σ (a_l + a_m) l_jk²``, ``H3 = Σ a_l a_m l_jk²``), and ``H`` (4).
+        For n ≠ 4: ``H1``, ``H`` and Manakov's integrals ``"I{k}_{j}"``, the
+        coefficient of ``λ^j`` in ``tr (l + λ diag(a))^k``.
+        """
+        flat, lead = _states(l, self.dim)
+        if self.n == 4:
+            h = _core.so4_integrals(self._a, flat)
+            out = {f"H{i}": _out(h[:, i], lead) for i in range(4)}
+            out["H"] = _out(_core.hamiltonian(self._c, flat), lead)
+            return out
+        out = super().integrals(l)
+        vals = _core.manakov_integrals(self._a, flat)
+        for i, (k, j) in enumerate(self.manakov_integral_labels()):
+            out[f"I{k}_{j}"] = _out(vals[:, i], lead)
+        return out
+
+    def manakov_integral_labels(self) -> list[tuple[int, int]]:
+        """Labels ``(k, j)`` of :meth:`manakov_integrals`.
+
+        ``k = 2..n``, ``j <= k - 2``, ``k - j`` even (the others vanish or are constant).
+        """
+        return [tuple(x) for x in _core.manakov_integral_labels(self.n)]  # type: ignore[misc]
+
+    def manakov_integrals(self, l: Any) -> np.ndarray:
+        """Manakov's integrals: the coefficients of ``λ^j`` in ``tr (l + λ A)^k``, ``A = diag(a)``.
+
+        Conserved by (1)–(2) for every n because (1) is the Lax equation
+        ``d/dt (l + λA) = [l + λA, ω + λB]``, ``B = diag(b)`` [Ma 1977].
+
+        Returns
+        -------
+        ndarray, shape (..., K), ordered as :meth:`manakov_integral_labels`
+        """
+        flat, lead = _states(l, self.dim)
+        vals = _core.manakov_integrals(self._a, flat)
+        return vals.reshape(lead + (vals.shape[1],))
+
+    def __repr__(self) -> str:
+        return f"ManakovTop(a={self._a.tolist()}, b={self._b.tolist()})"
+
+
+def _scalar(x: Any, what: str) -> float:
+    arr = np.asarray(x)
+    if arr.ndim != 0 or np.iscomplexobj(arr) or arr.dtype == object:
+        raise ValueError(f"{what} must be a real scalar, got {x!r}")
+    v = float(arr)
+    if not math.isfinite(v):
+        raise ValueError(f"{what} must be finite, got {v}")
+    return v

@@ -1,0 +1,179 @@
+"""API contract of the dynamics functions: dtypes, shapes, broadcasting, read-only and
+non-contiguous inputs, inputs never modified, exact exception types, no panics."""
+
+# ruff: noqa: E741
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import manakov
+
+
+@pytest.fixture
+def top():
+    p = manakov.problem("generic")
+    return manakov.ManakovTop(p.a, p.b)
+
+
+def test_scalar_in_scalar_out(top):
+    l = manakov.problem("generic").l0
+    h = top.hamiltonian(l)
+    assert np.ndim(h) == 0 and isinstance(h, float)
+    ints = top.integrals(l)
+    assert all(np.ndim(v) == 0 for v in ints.values())
+    assert top.vector_field(l).shape == (6,)
+    assert manakov.poisson_tensor(l).shape == (6, 6)
+
+
+def test_broadcasting_over_leading_axes(top):
+    rng = np.random.default_rng(0)
+    ls = rng.normal(size=(2, 3, 6))
+    f = top.vector_field(ls)
+    assert f.shape == (2, 3, 6)
+    for idx in np.ndindex(2, 3):
+        np.testing.assert_array_equal(f[idx], top.vector_field(ls[idx]))
+        assert top.hamiltonian(ls)[idx] == top.hamiltonian(ls[idx])
+    assert manakov.poisson_tensor(ls).shape == (2, 3, 6, 6)
+    assert all(v.shape == (2, 3) for v in top.integrals(ls).values())
+    assert top.vector_field(np.zeros((0, 6))).shape == (0, 6)
+
+
+@pytest.mark.parametrize("dtype", [np.float32, np.int64, np.float64])
+def test_other_real_dtypes_are_converted(top, dtype):
+    l = np.array([1, -2, 0, 3, 1, 2], dtype=dtype)
+    np.testing.assert_array_equal(top.vector_field(l), top.vector_field(l.astype(float)))
+    assert top.vector_field(l).dtype == np.float64
+
+
+def test_read_only_and_non_contiguous_inputs(top):
+    rng = np.random.default_rng(1)
+    base = rng.normal(size=(4, 12))
+    view = base[:, ::2]  # non-contiguous (stride 2)
+    assert not view.flags.c_contiguous
+    ro = view.copy()
+    ro.setflags(write=False)
+    np.testing.assert_array_equal(top.vector_field(view), top.vector_field(ro))
+    np.testing.assert_array_equal(top.vector_field(view.T.copy().T), top.vector_field(ro))
+    before = base.copy()
+    top.integrate(view[0], 1.0)
+    top.integrate_many(view, 1.0)
+    manakov.poisson_tensor(view)
+    np.testing.assert_array_equal(base, before)
+    # Fortran-ordered input
+    np.testing.assert_array_equal(top.vector_field(np.asfortranarray(ro)), top.vector_field(ro))
+
+
+def test_constructor_inputs_are_not_modified_and_attributes_read_only():
+    a = np.array([0.3, 1.1, 2.0, 3.7])
+    b = np.array([0.5, -0.2, 1.4, 0.9])
+    top = manakov.ManakovTop(a, b)
+    a[0] = 99.0
+    assert top.a[0] == 0.3
+    for arr in (top.a, top.b, top.c):
+        with pytest.raises(ValueError):
+            arr[0] = 1.0
+    assert top.n == 4 and top.c.shape == (4, 4)
+
+
+def test_trajectory_shapes(top):
+    tr = top.integrate(manakov.problem("generic").l0, 2.0, sample_every=0.5)
+    assert tr.t.shape == (5,) and tr.l.shape == (5, 6)
+    assert all(v.shape == (5,) for v in tr.integrals.values())
+    assert tr.steps > 0 and tr.evals > tr.steps
+
+
+@pytest.mark.parametrize(
+    "a,b,match",
+    [
+        ([1.0, 2.0, 1.0, 3.0], [0, 1, 2, 3], r"a\[0\] == a\[2\]"),
+        ([1.0, 2.0, 3.0], [0, 1], "same length"),
+        ([1.0, 2.0], [0.0, 1.0], "n >= 3"),
+        ([1.0, np.nan, 3.0], [0, 1, 2], "finite"),
+        ([1.0, 2.0, 3.0], [0, np.inf, 2], "finite"),
+        ([[1.0, 2.0, 3.0]], [[0, 1, 2]], "1-d"),
+        ([1.0, 2.0, 3.0 + 1j], [0, 1, 2], "real"),
+        ([0.0, 1e-300, 1.0], [1e300, -1e300, 0.0], "overflow"),
+    ],
+)
+def test_manakov_top_rejects_bad_parameters(a, b, match):
+    with pytest.raises(ValueError, match=match):
+        manakov.ManakovTop(a, b)
+
+
+@pytest.mark.parametrize(
+    "c,match",
+    [
+        (np.array([[0, 1, 2], [1.5, 0, 3], [2, 3, 0]]), "symmetric"),
+        (np.ones((3, 4)), "shape"),
+        (np.ones((2, 2)), "n >= 3"),
+        (np.full((3, 3), np.nan), "finite"),
+    ],
+)
+def test_frahm_top_rejects_bad_c(c, match):
+    with pytest.raises(ValueError, match=match):
+        manakov.FrahmTop(c)
+
+
+def test_frahm_top_accepts_roundoff_asymmetry():
+    c = np.array([[0, 1, 2], [1 + 2e-16, 0, 3], [2, 3, 0]])
+    manakov.FrahmTop(c)
+
+
+@pytest.mark.parametrize(
+    "l", [np.ones(5), np.ones((2, 7)), np.array([np.nan] * 6), 3.0, np.array([1j] * 6)]
+)
+def test_state_functions_reject_bad_states(top, l):
+    for fn in (top.vector_field, top.hamiltonian, top.integrals):
+        with pytest.raises(ValueError):
+            fn(l)
+
+
+def test_poisson_tensor_rejects_bad_lengths():
+    with pytest.raises(ValueError):
+        manakov.poisson_tensor(np.ones(5))
+    with pytest.raises(ValueError):
+        manakov.poisson_tensor(2.0)
+
+
+def test_no_panic_reaches_python_from_the_core():
+    """Direct calls into the compiled module with inconsistent arguments raise ValueError."""
+    from manakov import _core
+
+    c = manakov.problem("generic")
+    cm = _core.manakov_c(c.a, c.b)
+    bad_calls = [
+        lambda: _core.vector_field(cm, np.ones((2, 5))),
+        lambda: _core.vector_field(np.ones((3, 4)), np.ones((2, 6))),
+        lambda: _core.so4_integrals(np.ones(3), np.ones((1, 6))),
+        lambda: _core.manakov_integrals(np.arange(4.0), np.ones((1, 5))),
+        lambda: _core.poisson_tensor(np.ones((1, 4))),
+        lambda: _core.integrate(cm, np.ones(5), 0.0, np.array([1.0]), "gauss6", 0.1, 0, 0),
+        lambda: _core.integrate(cm, np.ones(6), 0.0, np.array([1.0]), "nope", 0.1, 0, 0),
+        lambda: _core.integrate(cm, np.ones(6), 0.0, np.array([np.nan]), "gauss6", 0.1, 0, 0),
+        lambda: _core.integrate(cm, np.ones(6), np.inf, np.array([1.0]), "gauss6", 0.1, 0, 0),
+        lambda: _core.integrate_many(
+            cm, np.ones((2, 5)), 0.0, np.array([1.0]), "gauss6", 0.1, 0, 0, True
+        ),
+        lambda: _core.gauss_tableau("dopri5"),
+        lambda: _core.manakov_c(np.ones(3), np.ones(3)),
+    ]
+    for call in bad_calls:
+        with pytest.raises(ValueError):
+            call()
+
+
+def test_overflow_is_an_error_not_a_silent_nan(top):
+    huge = np.full(6, 1e200)
+    with pytest.raises(ValueError, match="overflow"):
+        top.vector_field(huge)
+    with pytest.raises(ValueError, match="overflow"):
+        top.hamiltonian(huge)
+    with pytest.raises(ValueError, match="overflow"):
+        top.integrals(huge)
+    # The default step scales as 1/|l0|: 1e200 steps would be needed.
+    with pytest.raises(ValueError, match="steps would be needed"):
+        top.integrate(huge, 1.0)
+    for method in ("gauss16", "gauss4", "dop853", "dopri5"):
+        with pytest.raises(manakov.ConvergenceError):
+            top.integrate(huge, 1.0, dt=0.1, method=method)
