@@ -1,19 +1,23 @@
 //! A proven tail bound for the theta series (docs/theta.md, section "Tail bound").
 //!
-//! For a lattice `Λ ⊂ R^g` whose shortest nonzero vector has length `ρ`, any
-//! translate `v + Λ`, an integer `p ≥ 0` and `R ≥ ρ`,
+//! For a lattice `Λ ⊂ R^g` in which distinct points are at least `ρ` apart
+//! (`ρ` ≤ the shortest nonzero vector), any translate `v + Λ`, an integer
+//! `p ≥ 0` and `R ≥ ρ/2`,
 //!
 //! ```text
 //! Σ_{x ∈ v+Λ, |x| ≥ R} |x|^p e^{-|x|²}
-//!     ≤ g (2/ρ)^g ∫_{R-ρ}^∞ (t + ρ/2)^{g-1} (t + ρ)^p e^{-t²} dt .
+//!     ≤ e^{κ} g (2/ρ)^g ∫_{R-ρ/2}^∞ r^{g-1} (r + ρ/2)^p e^{-r²} dr,   κ = g ρ² / (4 (g+2)).
 //! ```
 //!
-//! Proof (after Deconinck, Heil, Bobenko, van Hoeij, Schmies, *Computing
-//! Riemann theta functions*, Math. Comp. 73 (2004) 1417–1442, Thm. 2): the balls
-//! `B(x, ρ/2)` are disjoint and lie in `|y| ≥ R - ρ/2`; on each,
-//! `|x| ≥ |y| - ρ/2 ≥ 0` and `|x| ≤ |y| + ρ/2`, so each term is at most the
-//! ball average of `(|y|+ρ/2)^p e^{-(|y|-ρ/2)²}`; integrate in polar
-//! coordinates (`|S^{g-1}| = g·vol(B^g)`) and substitute `t = |y| - ρ/2`.
+//! Proof (the ball-packing argument of Deconinck, Heil, Bobenko, van Hoeij,
+//! Schmies, *Computing Riemann theta functions*, Math. Comp. 73 (2004)
+//! 1417–1442, Thm. 2, made explicit with Jensen's inequality): the balls
+//! `B(x, ρ/2)` are disjoint and lie in `|y| ≥ R - ρ/2`. On each, by convexity of
+//! `exp`, the average of `e^{-|y|²}` is at least `exp(-avg|y|²) = e^{-|x|²-κ}`
+//! (the mean of `|y-x|²` over a ball of radius `ρ/2` is `g ρ²/(4(g+2))`), and
+//! `|x| ≤ |y| + ρ/2`; so each term is at most `e^κ` times the ball average of
+//! `(|y|+ρ/2)^p e^{-|y|²}`. Sum over the disjoint balls and integrate in polar
+//! coordinates (`|S^{g-1}| = g·vol(B^g)`).
 
 /// Upper bounds for `I_k(s) = ∫_s^∞ t^k e^{-t²} dt`, `k = 0..=kmax`, `s ≥ 0`.
 ///
@@ -41,31 +45,27 @@ fn gaussian_moment_tails(s: f64, kmax: usize) -> Vec<f64> {
 }
 
 /// The bound of the module documentation: an upper bound for
-/// `Σ_{x ∈ v+Λ, |x| ≥ r} |x|^p e^{-|x|²}` for every translate `v`, valid for `r ≥ rho`.
-/// Returns `+∞` for `r < rho` (the proof does not apply).
+/// `Σ_{x ∈ v+Λ, |x| ≥ r} |x|^p e^{-|x|²}` for every translate `v` of a lattice
+/// whose points are at least `rho` apart; valid for `r ≥ rho/2`, `+∞` otherwise.
 pub fn tail_bound(g: usize, rho: f64, r: f64, p: u32) -> f64 {
-    if r < rho || rho <= 0.0 || g == 0 {
+    if r < 0.5 * rho || rho <= 0.0 || g == 0 {
         return f64::INFINITY;
     }
-    // Coefficients of (t + ρ/2)^{g-1} (t + ρ)^p, lowest degree first.
-    let mut poly = vec![1.0];
-    let mul_linear = |poly: &Vec<f64>, c: f64| {
+    // Coefficients of r^{g-1} (r + ρ/2)^p, lowest degree first.
+    let mut poly = vec![0.0; g];
+    poly[g - 1] = 1.0;
+    for _ in 0..p {
         let mut next = vec![0.0; poly.len() + 1];
         for (k, &v) in poly.iter().enumerate() {
-            next[k] += c * v;
+            next[k] += 0.5 * rho * v;
             next[k + 1] += v;
         }
-        next
-    };
-    for _ in 1..g {
-        poly = mul_linear(&poly, 0.5 * rho);
+        poly = next;
     }
-    for _ in 0..p {
-        poly = mul_linear(&poly, rho);
-    }
-    let moments = gaussian_moment_tails(r - rho, poly.len() - 1);
+    let moments = gaussian_moment_tails(r - 0.5 * rho, poly.len() - 1);
     let integral: f64 = poly.iter().zip(&moments).map(|(c, m)| c * m).sum();
-    g as f64 * (2.0 / rho).powi(g as i32) * integral
+    let kappa = g as f64 * rho * rho / (4.0 * (g as f64 + 2.0));
+    kappa.exp() * g as f64 * (2.0 / rho).powi(g as i32) * integral
 }
 
 #[cfg(test)]
@@ -89,8 +89,8 @@ mod tests {
     #[test]
     fn bound_dominates_direct_genus_one_tails() {
         for &(spacing, shift) in &[(1.0, 0.0), (0.7, 0.3), (2.5, 0.49), (1.7724, 0.25)] {
-            for &r in &[2.5, 3.0, 4.0, 5.5] {
-                if r < spacing {
+            for &r in &[0.9, 1.5, 2.5, 3.0, 4.0, 5.5] {
+                if r < 0.5 * spacing {
                     continue;
                 }
                 for p in 0..=2u32 {
@@ -106,6 +106,8 @@ mod tests {
                 }
             }
         }
-        assert_eq!(tail_bound(2, 1.0, 0.5, 0), f64::INFINITY);
+        assert_eq!(tail_bound(2, 1.0, 0.4, 0), f64::INFINITY);
+        // a smaller spacing is also a valid (weaker) lattice constant
+        assert!(tail_bound(1, 0.5, 3.0, 0) > 0.0);
     }
 }

@@ -79,10 +79,11 @@ pub struct ThetaPlan {
     rq: f64,
     radius: f64,
     rho: f64,
-    /// `i^{aᵀSa}` for each characteristic.
-    char_phase: Vec<Complex64>,
-    /// For each characteristic: the 2^g pairs (class `j mod 4` index, power of i).
-    combine: Vec<(usize, u8)>,
+    rho_used: f64,
+    /// `class_of[a * 2^g + h]`: index of the class `j ≡ a + 2h (mod 4)`.
+    class_of: Vec<usize>,
+    /// `unit_pow[idx] = a·b + aᵀSa mod 4`: the power of i multiplying the transform.
+    unit_pow: Vec<u8>,
     /// `exp(iπ τ'_kl / 2)` and inverses for the recurrences (row-major).
     qmat: Vec<Complex64>,
     qinv: Vec<Complex64>,
@@ -124,6 +125,9 @@ pub struct Workspace {
     s0: Vec<Complex64>,
     s1: Vec<Complex64>,
     s2: Vec<Complex64>,
+    buf: Vec<Complex64>,
+    vrow: Vec<Complex64>,
+    grow: Vec<Complex64>,
 }
 
 fn pi() -> f64 {
@@ -205,37 +209,25 @@ impl ThetaPlan {
         }
         let x: Vec<f64> = taur.iter().map(|c| c.re).collect();
         let n_out = 1usize << (2 * g);
-        let mask = (1usize << g) - 1;
-        let char_phase = (0..n_out)
-            .map(|idx| {
-                let a = (idx >> g) & mask;
-                let bit = |k: usize| ((a >> (g - 1 - k)) & 1) as i64;
-                let mut asa = 0i64;
-                for i in 0..g {
-                    for k in 0..g {
-                        asa += bit(i) * s[i * g + k] * bit(k);
-                    }
-                }
-                i_pow(asa.rem_euclid(4) as u8)
-            })
-            .collect();
-        let mut combine = Vec::with_capacity(n_out << g);
-        for idx in 0..n_out {
-            let a = (idx >> g) & mask;
-            let b = idx & mask;
-            for hi in 0..(1usize << g) {
-                // r_k = a_k + 2 h_k, class index Σ r_k 4^{g-1-k}
-                let mut r = 0usize;
-                let mut pow = 0usize;
+        let nh = 1usize << g;
+        let abit = |a: usize, k: usize| (a >> (g - 1 - k)) & 1;
+        let mut unit_pow = vec![0u8; n_out];
+        for a in 0..nh {
+            let mut asa = 0i64;
+            for i in 0..g {
                 for k in 0..g {
-                    let ak = (a >> (g - 1 - k)) & 1;
-                    let bk = (b >> (g - 1 - k)) & 1;
-                    let hk = (hi >> (g - 1 - k)) & 1;
-                    let rk = ak + 2 * hk;
-                    r = 4 * r + rk;
-                    pow += rk * bk;
+                    asa += (abit(a, i) * abit(a, k)) as i64 * s[i * g + k];
                 }
-                combine.push((r, (pow % 4) as u8));
+            }
+            for b in 0..nh {
+                let ab = (a & b).count_ones() as i64;
+                unit_pow[(a << g) | b] = (ab + asa).rem_euclid(4) as u8;
+            }
+        }
+        let mut class_of = vec![0usize; nh * nh];
+        for a in 0..nh {
+            for h in 0..nh {
+                class_of[a * nh + h] = (0..g).fold(0, |r, k| 4 * r + abit(a, k) + 2 * abit(h, k));
             }
         }
         let rho = pi().sqrt() * shortest_vector(&ldl_d, &ldl_l, g).sqrt();
@@ -243,25 +235,18 @@ impl ThetaPlan {
         let sk = (0..g)
             .map(|k| (yinv[k * g + k] / pi()).sqrt())
             .fold(0.0, f64::max);
-        let bound = |r: f64| output_error_bound(g, rho, r, sk, order);
-        let mut lo = rho.max(1.0);
-        let mut hi = lo;
-        while bound(hi) > tol {
-            lo = hi;
-            hi *= 1.25;
-            if hi > 1e3 {
-                break;
+        // Any ρ' ≤ ρ is a valid packing constant; a smaller one trades the factor
+        // (2/ρ')^g for a later start of the integral. Keep the best radius.
+        let mut radius = f64::INFINITY;
+        let mut rho_used = rho;
+        for frac in [1.0, 0.85, 0.7, 0.55, 0.4, 0.25] {
+            let rp = rho * frac;
+            let r = radius_for(|r| output_error_bound(g, rp, r, sk, order), 0.5 * rp, tol);
+            if r < radius {
+                radius = r;
+                rho_used = rp;
             }
         }
-        for _ in 0..40 {
-            let mid = 0.5 * (lo + hi);
-            if bound(mid) > tol {
-                lo = mid;
-            } else {
-                hi = mid;
-            }
-        }
-        let radius = hi;
         let rq = radius * radius / pi();
         let qmat: Vec<Complex64> = taur
             .iter()
@@ -284,8 +269,9 @@ impl ThetaPlan {
             rq,
             radius,
             rho,
-            char_phase,
-            combine,
+            rho_used,
+            class_of,
+            unit_pow,
             qmat,
             qinv,
             fast_g2,
@@ -326,7 +312,7 @@ impl ThetaPlan {
         PlanInfo {
             radius: self.radius,
             rho: self.rho,
-            error_bound: output_error_bound(g, self.rho, self.radius, sk, self.order),
+            error_bound: output_error_bound(g, self.rho_used, self.radius, sk, self.order),
             expected_terms: vg * self.rq.powf(g as f64 / 2.0) / det.sqrt() * f64::from(1u32 << g),
         }
     }
@@ -338,6 +324,9 @@ impl ThetaPlan {
             s0: vec![Complex64::new(0.0, 0.0); n],
             s1: vec![Complex64::new(0.0, 0.0); n * self.g],
             s2: vec![Complex64::new(0.0, 0.0); n * self.g * self.g],
+            buf: vec![Complex64::new(0.0, 0.0); 1 << self.g],
+            vrow: vec![Complex64::new(0.0, 0.0); 1 << self.g],
+            grow: vec![Complex64::new(0.0, 0.0); self.g << self.g],
         }
     }
 
@@ -433,7 +422,7 @@ impl ThetaPlan {
                     ),
                 });
             }
-            q[i] = w.round();
+            q[i] = sum::round_i64(w) as f64;
         }
         for i in 0..g {
             let shift: Complex64 = (0..g).map(|k| self.tau[i * g + k] * q[k]).sum();
@@ -444,7 +433,7 @@ impl ThetaPlan {
                     reason: format!("Re z has an entry {:e}: theta is not determined", z[i].re),
                 });
             }
-            p[i] = v.re.round();
+            p[i] = sum::round_i64(v.re) as f64;
             zr[i] = Complex64::new(v.re - p[i], v.im);
         }
         let zr = &zr[..g];
@@ -479,54 +468,71 @@ impl ThetaPlan {
             (false, 1) => self.sum_generic::<1>(zr, wr, ws),
             (false, _) => self.sum_generic::<2>(zr, wr, ws),
         }
+        // θ[a;b] = i^{a·b} Σ_h (-1)^{h·b} S[a + 2h]: a Walsh–Hadamard transform over h
+        // per a, then one unit factor per characteristic collecting i^{a·b},
+        // i^{aᵀSa} (Re τ reduction) and (-1)^{a·p + b·q} (z reduction).
         let prefactor = Complex64::from_polar(1.0, phi);
+        let (mut pbits, mut qbits) = (0usize, 0usize);
+        for k in 0..g {
+            pbits |= ((p[k] as i64 & 1) as usize) << (g - 1 - k);
+            qbits |= ((q[k] as i64 & 1) as usize) << (g - 1 - k);
+        }
+        let nh = 1usize << g;
         let ipi = Complex64::new(0.0, pi());
-        // gradient of the reduction prefactor: -2πi q
         let mut gq = [Complex64::new(0.0, 0.0); MAX_GENUS];
         for k in 0..g {
+            // gradient of the reduction prefactor exp(-2πi qᵀz)
             gq[k] = Complex64::new(0.0, -2.0 * pi() * q[k]);
         }
-        let mask = (1usize << g) - 1;
-        let nc = 1usize << g;
-        for idx in 0..n {
-            let a = (idx >> g) & mask;
-            let b = idx & mask;
-            let mut sign_par = 0i64;
-            for k in 0..g {
-                let ak = ((a >> (g - 1 - k)) & 1) as i64;
-                let bk = ((b >> (g - 1 - k)) & 1) as i64;
-                sign_par += ak * (p[k] as i64 & 1) + bk * (q[k] as i64 & 1);
+        let Workspace {
+            s0,
+            s1,
+            s2,
+            buf,
+            vrow,
+            grow,
+        } = ws;
+        for a in 0..nh {
+            let rows = &self.class_of[a * nh..(a + 1) * nh];
+            let mut units = [0u8; 1 << MAX_GENUS];
+            for (b, u) in units[..nh].iter_mut().enumerate() {
+                let sign = ((a & pbits).count_ones() + (b & qbits).count_ones()) as u8 & 1;
+                *u = self.unit_pow[(a << g) | b].wrapping_add(2 * sign);
             }
-            let mut fac = prefactor * self.char_phase[idx];
-            if sign_par & 1 == 1 {
-                fac = -fac;
+            let fac = |b: usize| times_i_pow(prefactor, units[b]);
+            for (h, &r) in rows.iter().enumerate() {
+                vrow[h] = s0[r];
             }
-            let terms = &self.combine[idx * nc..(idx + 1) * nc];
-            let mut v = Complex64::new(0.0, 0.0);
-            for &(r, pw) in terms {
-                v += i_pow(pw) * ws.s0[r];
+            walsh_hadamard(&mut vrow[..nh]);
+            for b in 0..nh {
+                values[(a << g) | b] = fac(b) * vrow[b];
             }
-            values[idx] = fac * v;
             if order >= 1 {
-                let mut gr = [Complex64::new(0.0, 0.0); MAX_GENUS];
                 for k in 0..g {
-                    let mut s = Complex64::new(0.0, 0.0);
-                    for &(r, pw) in terms {
-                        s += i_pow(pw) * ws.s1[r * g + k];
+                    for (h, &r) in rows.iter().enumerate() {
+                        buf[h] = s1[r * g + k];
                     }
-                    gr[k] = ipi * s;
-                    gradient[idx * g + k] = fac * (gr[k] + gq[k] * v);
+                    walsh_hadamard(&mut buf[..nh]);
+                    for b in 0..nh {
+                        let gr = ipi * buf[b];
+                        grow[b * g + k] = gr;
+                        gradient[((a << g) | b) * g + k] = fac(b) * (gr + gq[k] * vrow[b]);
+                    }
                 }
-                if order >= 2 {
-                    for k in 0..g {
-                        for l in 0..g {
-                            let mut s = Complex64::new(0.0, 0.0);
-                            for &(r, pw) in terms {
-                                s += i_pow(pw) * ws.s2[(r * g + k) * g + l];
-                            }
-                            let h =
-                                ipi * ipi * s + gq[k] * gr[l] + gr[k] * gq[l] + gq[k] * gq[l] * v;
-                            hessian[(idx * g + k) * g + l] = fac * h;
+            }
+            if order >= 2 {
+                for k in 0..g {
+                    for l in 0..g {
+                        for (h, &r) in rows.iter().enumerate() {
+                            buf[h] = s2[(r * g + k) * g + l];
+                        }
+                        walsh_hadamard(&mut buf[..nh]);
+                        for b in 0..nh {
+                            let hkl = -pi() * pi() * buf[b]
+                                + gq[k] * grow[b * g + l]
+                                + grow[b * g + k] * gq[l]
+                                + gq[k] * gq[l] * vrow[b];
+                            hessian[(((a << g) | b) * g + k) * g + l] = fac(b) * hkl;
                         }
                     }
                 }
@@ -594,12 +600,31 @@ pub fn theta_jet(z: &[Complex64], tau: &[Complex64], tol: f64) -> Result<ThetaJe
     ThetaPlan::new(tau, z.len(), tol, 2)?.jet(z, 2)
 }
 
-fn i_pow(p: u8) -> Complex64 {
-    match p % 4 {
-        0 => Complex64::new(1.0, 0.0),
-        1 => Complex64::new(0.0, 1.0),
-        2 => Complex64::new(-1.0, 0.0),
-        _ => Complex64::new(0.0, -1.0),
+/// `v · i^p` by swapping and negating parts.
+#[inline(always)]
+fn times_i_pow(v: Complex64, p: u8) -> Complex64 {
+    match p & 3 {
+        0 => v,
+        1 => Complex64::new(-v.im, v.re),
+        2 => -v,
+        _ => Complex64::new(v.im, -v.re),
+    }
+}
+
+/// In-place Walsh–Hadamard transform `v_b ← Σ_h (-1)^{popcount(h & b)} v_h`.
+#[inline(always)]
+fn walsh_hadamard(v: &mut [Complex64]) {
+    let n = v.len();
+    let mut half = 1;
+    while half < n {
+        for start in (0..n).step_by(2 * half) {
+            for i in start..start + half {
+                let (x, y) = (v[i], v[i + half]);
+                v[i] = x + y;
+                v[i + half] = x - y;
+            }
+        }
+        half *= 2;
     }
 }
 
@@ -620,6 +645,26 @@ fn output_error_bound(g: usize, rho: f64, r: f64, s: f64, order: usize) -> f64 {
 }
 
 /// `Γ(n/2)` for small integers `n ≥ 1`.
+/// Smallest `R ≥ r0` (to 1e-12 relative) with `bound(R) ≤ tol`; `bound` is
+/// decreasing in `R` and `+∞` below `r0`.
+fn radius_for(bound: impl Fn(f64) -> f64, r0: f64, tol: f64) -> f64 {
+    let mut lo = r0;
+    let mut hi = r0.max(1.0);
+    while bound(hi) > tol && hi < 1e3 {
+        lo = hi;
+        hi *= 1.25;
+    }
+    for _ in 0..45 {
+        let mid = 0.5 * (lo + hi);
+        if bound(mid) > tol {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    hi
+}
+
 fn gamma_half_int(n: usize) -> f64 {
     if n == 1 {
         pi().sqrt()

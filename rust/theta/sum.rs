@@ -59,9 +59,9 @@ impl ThetaPlan {
         let (q11, q12, q22) = (self.qmat[0], self.qmat[1], self.qmat[3]);
         let (q12i, q22i) = (self.qinv[1], self.qinv[3]);
         let h1 = (rq / d1).sqrt();
-        let j1min = (2.0 * (-h1 - wr[0])).ceil() as i64;
-        let j1max = (2.0 * (h1 - wr[0])).floor() as i64;
-        let j1c = ((-2.0 * wr[0]).round() as i64).clamp(j1min.min(j1max), j1max.max(j1min));
+        let j1min = ceil_i64(2.0 * (-h1 - wr[0]));
+        let j1max = floor_i64(2.0 * (h1 - wr[0]));
+        let j1c = round_i64(-2.0 * wr[0]).clamp(j1min.min(j1max), j1max.max(j1min));
         // centre and half-width (in j2 units) of row j1
         let row = |j1: i64| -> (f64, f64) {
             let u1 = 0.5 * j1 as f64 + wr[0];
@@ -76,7 +76,7 @@ impl ThetaPlan {
                 },
             )
         };
-        let kc = row(j1c).0.round() as i64;
+        let kc = round_i64(row(j1c).0);
         let e0 = self.log_term(&[j1c, kc], zr, wr).exp();
         let a0 = self.ratio(1, &[j1c, kc], zr);
         let ainv0 = q22 / a0;
@@ -100,7 +100,7 @@ impl ThetaPlan {
             while (dir == 1 && j1 <= j1max) || (dir == -1 && j1 >= j1min) {
                 let (c, hw) = row(j1);
                 if hw >= 0.0 {
-                    let target = c.round() as i64;
+                    let target = round_i64(c);
                     while k < target {
                         e *= a;
                         a *= q22;
@@ -115,44 +115,37 @@ impl ThetaPlan {
                         bs *= q12si;
                         k -= 1;
                     }
-                    let lo = (c - hw).ceil() as i64;
-                    let hi = (c + hw).floor() as i64;
+                    let lo = ceil_i64(c - hw);
+                    let hi = floor_i64(c + hw);
                     let mut r0 = [C::new(0.0, 0.0); 4];
                     let mut r1 = [C::new(0.0, 0.0); 4];
                     let mut r2 = [C::new(0.0, 0.0); 4];
-                    // upward sweep k..=hi
-                    let (mut t, mut ra) = (e, a);
-                    let mut j = k;
-                    while j <= hi {
-                        let cls = (j & 3) as usize;
-                        r0[cls] += t;
-                        if ORDER >= 1 {
-                            let jf = j as f64;
-                            r1[cls] += t * jf;
-                            if ORDER >= 2 {
-                                r2[cls] += t * (jf * jf);
-                            }
-                        }
-                        t *= ra;
-                        ra *= q22;
-                        j += 1;
+                    // Upward sweep k..=hi and downward sweep k-1..=lo run interleaved:
+                    // two independent product chains hide the multiply latency.
+                    let (mut tu, mut au, mut ju) = (e, a, k);
+                    let (mut td, mut ad, mut jd) = (e * ainv, ainv * q22, k - 1);
+                    let both = (hi - k + 1).min(k - lo);
+                    for _ in 0..both {
+                        accumulate::<ORDER>(&mut r0, &mut r1, &mut r2, tu, ju);
+                        accumulate::<ORDER>(&mut r0, &mut r1, &mut r2, td, jd);
+                        tu *= au;
+                        au *= q22;
+                        td *= ad;
+                        ad *= q22;
+                        ju += 1;
+                        jd -= 1;
                     }
-                    // downward sweep k-1..=lo
-                    let (mut t, mut ri) = (e * ainv, ainv * q22);
-                    let mut j = k - 1;
-                    while j >= lo {
-                        let cls = (j & 3) as usize;
-                        r0[cls] += t;
-                        if ORDER >= 1 {
-                            let jf = j as f64;
-                            r1[cls] += t * jf;
-                            if ORDER >= 2 {
-                                r2[cls] += t * (jf * jf);
-                            }
-                        }
-                        t *= ri;
-                        ri *= q22;
-                        j -= 1;
+                    while ju <= hi {
+                        accumulate::<ORDER>(&mut r0, &mut r1, &mut r2, tu, ju);
+                        tu *= au;
+                        au *= q22;
+                        ju += 1;
+                    }
+                    while jd >= lo {
+                        accumulate::<ORDER>(&mut r0, &mut r1, &mut r2, td, jd);
+                        td *= ad;
+                        ad *= q22;
+                        jd -= 1;
                     }
                     let base = ((j1 & 3) as usize) * 4;
                     let j1f = j1 as f64;
@@ -209,8 +202,8 @@ impl ThetaPlan {
             .map(|k| self.ldl_l[i * g + k] * (0.5 * j[k] as f64 + wr[k]))
             .sum();
         let h = (rem / self.ldl_d[i]).sqrt();
-        let lo = (2.0 * (-t - h - wr[i])).ceil() as i64;
-        let hi = (2.0 * (-t + h - wr[i])).floor() as i64;
+        let lo = ceil_i64(2.0 * (-t - h - wr[i]));
+        let hi = floor_i64(2.0 * (-t + h - wr[i]));
         if i + 1 < g {
             for v in lo..=hi {
                 j[i] = v;
@@ -268,4 +261,41 @@ impl ThetaPlan {
             }
         }
     }
+}
+
+#[inline(always)]
+fn accumulate<const ORDER: usize>(r0: &mut [C; 4], r1: &mut [C; 4], r2: &mut [C; 4], t: C, j: i64) {
+    let cls = (j & 3) as usize;
+    r0[cls] += t;
+    if ORDER >= 1 {
+        let jf = j as f64;
+        r1[cls] += t * jf;
+        if ORDER >= 2 {
+            r2[cls] += t * (jf * jf);
+        }
+    }
+}
+
+/// `floor` without a libm call (the baseline x86-64 target has no `roundsd`);
+/// exact for |x| < 2^62, which the caller guarantees (|x| is a few hundred).
+#[inline(always)]
+pub(super) fn floor_i64(x: f64) -> i64 {
+    let t = x as i64;
+    if (t as f64) > x {
+        t - 1
+    } else {
+        t
+    }
+}
+
+/// `ceil` without a libm call, see [`floor_i64`].
+#[inline(always)]
+pub(super) fn ceil_i64(x: f64) -> i64 {
+    -floor_i64(-x)
+}
+
+/// Nearest integer (ties up) without a libm call, see [`floor_i64`].
+#[inline(always)]
+pub(super) fn round_i64(x: f64) -> i64 {
+    floor_i64(x + 0.5)
 }
