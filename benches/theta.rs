@@ -74,7 +74,7 @@ fn theta(c: &mut Criterion) {
     group.finish();
 
     let mut group = c.benchmark_group("theta_g2_batch");
-    for &n in &[1000usize] {
+    for &n in &[100usize, 10_000] {
         let zs = points(n);
         let mut v = vec![C::new(0.0, 0.0); 16 * n];
         let mut l = vec![0.0; n];

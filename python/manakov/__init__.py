@@ -7,8 +7,28 @@ Equation numbers in docstrings are the paper's.
 
 from ._core import ConvergenceError, __version__
 from .problems import Problem, benchmark_setup, problem, problem_names
+from .theta import (
+    CHARACTERISTICS,
+    PAPER_CHARACTERISTICS,
+    PAPER_TABLE_35,
+    char_index,
+    characteristics,
+    parity,
+    theta,
+    theta_all,
+    theta_jet,
+)
 
 __all__ = [
+    "CHARACTERISTICS",
+    "PAPER_CHARACTERISTICS",
+    "PAPER_TABLE_35",
+    "char_index",
+    "characteristics",
+    "parity",
+    "theta",
+    "theta_all",
+    "theta_jet",
     "ConvergenceError",
     "Problem",
     "__version__",
