@@ -411,33 +411,48 @@ impl ThetaPlan {
                 });
             }
         }
-        // Reduction z = z_r + p + τ' q.
+        // Reduction z = z_r + p + τ' q, q = round((Im τ)^{-1} Im z), p = round(Re(z - τ'q)).
         let mut zr = [Complex64::new(0.0, 0.0); MAX_GENUS];
         let mut q = [0.0f64; MAX_GENUS];
         let mut p = [0.0f64; MAX_GENUS];
+        let mut w = [0.0f64; MAX_GENUS];
         for i in 0..g {
-            let w: f64 = (0..g).map(|k| self.yinv[i * g + k] * z[k].im).sum();
-            if w.abs() > MAX_REDUCTION {
+            w[i] = (0..g).map(|k| self.yinv[i * g + k] * z[k].im).sum();
+            if w[i].abs() > MAX_REDUCTION {
                 return Err(Error::InvalidArgument {
                     what: "z",
                     reason: format!(
-                        "(Im tau)^-1 Im z has an entry {w:e}: theta is not representable"
+                        "(Im tau)^-1 Im z has an entry {:e}: theta is not representable",
+                        w[i]
                     ),
                 });
             }
-            q[i] = sum::round_i64(w) as f64;
+            q[i] = sum::round_i64(w[i]) as f64;
         }
+        let shifted = q[..g].iter().any(|&v| v != 0.0);
         for i in 0..g {
-            let shift: Complex64 = (0..g).map(|k| self.tau[i * g + k] * q[k]).sum();
-            let v = z[i] - shift;
-            if v.re.abs() > MAX_REDUCTION {
+            // z - τ'q with exact products and compensated sums: z_r is then
+            // correctly rounded, not off by eps·|τ q| (which would cost 2π|m|·eps|τq|).
+            let (re, im) = if shifted {
+                let xrow: [f64; MAX_GENUS] =
+                    std::array::from_fn(|k| if k < g { self.x[i * g + k] } else { 0.0 });
+                let yrow: [f64; MAX_GENUS] =
+                    std::array::from_fn(|k| if k < g { self.y[i * g + k] } else { 0.0 });
+                (
+                    residual(z[i].re, &xrow[..g], &q[..g]),
+                    residual(z[i].im, &yrow[..g], &q[..g]),
+                )
+            } else {
+                (z[i].re, z[i].im)
+            };
+            if re.abs() > MAX_REDUCTION {
                 return Err(Error::InvalidArgument {
                     what: "z",
                     reason: format!("Re z has an entry {:e}: theta is not determined", z[i].re),
                 });
             }
-            p[i] = sum::round_i64(v.re) as f64;
-            zr[i] = Complex64::new(v.re - p[i], v.im);
+            p[i] = sum::round_i64(re) as f64;
+            zr[i] = Complex64::new(re - p[i], im);
         }
         let zr = &zr[..g];
         let mut wr = [0.0f64; MAX_GENUS];
@@ -445,16 +460,20 @@ impl ThetaPlan {
             wr[i] = (0..g).map(|k| self.yinv[i * g + k] * zr[k].im).sum();
         }
         let wr = &wr[..g];
-        // L = π qᵀYq + 2π qᵀ Im z_r + π w_rᵀ Y w_r, φ = -π qᵀX'q - 2π qᵀ Re z_r.
+        // L = π (Im z)ᵀ (Im τ)^{-1} (Im z) = π (q + w_r)ᵀ Y (q + w_r); the first form
+        // has no cancellation between large terms.
         let mut log_scale = 0.0;
-        let mut phi = 0.0;
         for i in 0..g {
-            for k in 0..g {
-                log_scale += pi() * (q[i] * q[k] + wr[i] * wr[k]) * self.y[i * g + k];
-                phi -= pi() * q[i] * q[k] * self.x[i * g + k];
+            log_scale += pi() * z[i].im * (q[i] + wr[i]);
+        }
+        let log_scale = log_scale.max(0.0);
+        // φ = -π qᵀX'q - 2π qᵀ Re z_r, the quadratic part reduced mod 2 exactly.
+        let mut phi = 0.0;
+        if shifted {
+            phi -= pi() * quad_mod2(&self.x, &q[..g], g);
+            for i in 0..g {
+                phi -= 2.0 * pi() * q[i] * zr[i].re;
             }
-            log_scale += 2.0 * pi() * q[i] * zr[i].im;
-            phi -= 2.0 * pi() * q[i] * zr[i].re;
         }
         ws.s0.iter_mut().for_each(|v| *v = Complex64::new(0.0, 0.0));
         if order >= 1 {
@@ -612,6 +631,56 @@ fn times_i_pow(v: Complex64, p: u8) -> Complex64 {
         2 => -v,
         _ => Complex64::new(v.im, -v.re),
     }
+}
+
+/// Veltkamp split `x = hi + lo`, `hi` with 26 significant bits: `hi·n` and
+/// `lo·n` are exact for integers `|n| < 2^26`.
+fn split(x: f64) -> (f64, f64) {
+    let c = 134_217_729.0 * x; // 2^27 + 1
+    let hi = c - (c - x);
+    (hi, x - hi)
+}
+
+/// Knuth's two-sum: `a + b = s + err` exactly.
+fn two_sum(a: f64, b: f64) -> (f64, f64) {
+    let s = a + b;
+    let bb = s - a;
+    (s, (a - (s - bb)) + (b - bb))
+}
+
+/// `base - Σ_k coef_k q_k` for integers `q_k`, with exact products (for
+/// `|q_k| < 2^26`) and a compensated sum: error ≈ eps·|result|.
+fn residual(base: f64, coef: &[f64], q: &[f64]) -> f64 {
+    let (mut s, mut comp) = (base, 0.0);
+    for (&c, &n) in coef.iter().zip(q) {
+        let (hi, lo) = if n.abs() < 6.7e7 { split(c) } else { (c, 0.0) };
+        for t in [-(hi * n), -(lo * n)] {
+            let (s2, e) = two_sum(s, t);
+            s = s2;
+            comp += e;
+        }
+    }
+    s + comp
+}
+
+/// `qᵀ X q mod 2` for integers `q`: each `q_i q_k X_ik` is split so that the
+/// large part is exact and reduced mod 2 exactly (falls back to plain
+/// arithmetic for `|q| ≥ 2^13`, where nothing is accurate anyway).
+fn quad_mod2(x: &[f64], q: &[f64], g: usize) -> f64 {
+    let mut total = 0.0;
+    for i in 0..g {
+        for k in 0..g {
+            let pq = q[i] * q[k];
+            if pq.abs() < 6.7e7 {
+                let (hi, lo) = split(x[i * g + k]);
+                let t = pq * hi;
+                total += (t - 2.0 * (0.5 * t).round()) + pq * lo;
+            } else {
+                total += pq * x[i * g + k];
+            }
+        }
+    }
+    total
 }
 
 /// In-place Walsh–Hadamard transform `v_b ← Σ_h (-1)^{popcount(h & b)} v_h`.
