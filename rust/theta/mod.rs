@@ -493,11 +493,31 @@ impl ThetaPlan {
         // θ[a;b] = i^{a·b} Σ_h (-1)^{h·b} S[a + 2h]: a Walsh–Hadamard transform over h
         // per a, then one unit factor per characteristic collecting i^{a·b},
         // i^{aᵀSa} (Re τ reduction) and (-1)^{a·p + b·q} (z reduction).
-        let prefactor = Complex64::from_polar(1.0, phi);
+        let prefactor = if shifted {
+            Complex64::from_polar(1.0, phi)
+        } else {
+            Complex64::new(1.0, 0.0)
+        };
         let (mut pbits, mut qbits) = (0usize, 0usize);
         for k in 0..g {
             pbits |= ((p[k] as i64 & 1) as usize) << (g - 1 - k);
             qbits |= ((q[k] as i64 & 1) as usize) << (g - 1 - k);
+        }
+        if g == 2 && order == 0 {
+            // The hot case written out: 4 Walsh–Hadamard transforms of length 4.
+            for a in 0..4usize {
+                let r = &self.class_of[4 * a..4 * a + 4];
+                let (s0, s1, s2, s3) = (ws.s0[r[0]], ws.s0[r[1]], ws.s0[r[2]], ws.s0[r[3]]);
+                let (p0, p1, p2, p3) = (s0 + s1, s0 - s1, s2 + s3, s2 - s3);
+                let v = [p0 + p2, p1 + p3, p0 - p2, p1 - p3];
+                let sa = (a & pbits).count_ones();
+                for (b, vb) in v.iter().enumerate() {
+                    let sign = ((sa + (b & qbits).count_ones()) & 1) as u8;
+                    let u = self.unit_pow[(a << 2) | b].wrapping_add(2 * sign);
+                    values[(a << 2) | b] = times_i_pow(prefactor, u) * vb;
+                }
+            }
+            return Ok(log_scale);
         }
         let nh = 1usize << g;
         let ipi = Complex64::new(0.0, pi());

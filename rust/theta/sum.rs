@@ -76,6 +76,33 @@ impl ThetaPlan {
                 },
             )
         };
+        // (cursor target, lo, hi) of row j1; empty rows have lo > hi.
+        let bounds_of = |j1: i64| -> (i64, i64, i64) {
+            let (c, hw) = row(j1);
+            if hw < 0.0 {
+                (0, 1, 0)
+            } else {
+                (round_i64(c), ceil_i64(c - hw), floor_i64(c + hw))
+            }
+        };
+        // Rows are short (~10 terms): computing all bounds first lets the square
+        // roots overlap instead of sitting on each row's critical path.
+        const MAX_ROWS: usize = 96;
+        let nrows = (j1max - j1min + 1).max(0) as usize;
+        let mut table = [(0i64, 1i64, 0i64); MAX_ROWS];
+        let precomputed = nrows <= MAX_ROWS;
+        if precomputed {
+            for (r, slot) in table[..nrows].iter_mut().enumerate() {
+                *slot = bounds_of(j1min + r as i64);
+            }
+        }
+        let bounds = |j1: i64| {
+            if precomputed {
+                table[(j1 - j1min) as usize]
+            } else {
+                bounds_of(j1)
+            }
+        };
         let kc = round_i64(row(j1c).0);
         let e0 = self.log_term(&[j1c, kc], zr, wr).exp();
         let a0 = self.ratio(1, &[j1c, kc], zr);
@@ -98,9 +125,8 @@ impl ThetaPlan {
                 j1 -= 1;
             }
             while (dir == 1 && j1 <= j1max) || (dir == -1 && j1 >= j1min) {
-                let (c, hw) = row(j1);
-                if hw >= 0.0 {
-                    let target = round_i64(c);
+                let (target, lo, hi) = bounds(j1);
+                if lo <= hi {
                     while k < target {
                         e *= a;
                         a *= q22;
@@ -115,37 +141,64 @@ impl ThetaPlan {
                         bs *= q12si;
                         k -= 1;
                     }
-                    let lo = ceil_i64(c - hw);
-                    let hi = floor_i64(c + hw);
                     let mut r0 = [C::new(0.0, 0.0); 4];
                     let mut r1 = [C::new(0.0, 0.0); 4];
                     let mut r2 = [C::new(0.0, 0.0); 4];
                     // Upward sweep k..=hi and downward sweep k-1..=lo run interleaved:
                     // two independent product chains hide the multiply latency.
-                    let (mut tu, mut au, mut ju) = (e, a, k);
-                    let (mut td, mut ad, mut jd) = (e * ainv, ainv * q22, k - 1);
-                    let both = (hi - k + 1).min(k - lo);
-                    for _ in 0..both {
-                        accumulate::<ORDER>(&mut r0, &mut r1, &mut r2, tu, ju);
-                        accumulate::<ORDER>(&mut r0, &mut r1, &mut r2, td, jd);
-                        tu *= au;
-                        au *= q22;
-                        td *= ad;
-                        ad *= q22;
-                        ju += 1;
-                        jd -= 1;
-                    }
-                    while ju <= hi {
-                        accumulate::<ORDER>(&mut r0, &mut r1, &mut r2, tu, ju);
-                        tu *= au;
-                        au *= q22;
-                        ju += 1;
-                    }
-                    while jd >= lo {
-                        accumulate::<ORDER>(&mut r0, &mut r1, &mut r2, td, jd);
-                        td *= ad;
-                        ad *= q22;
-                        jd -= 1;
+                    if ORDER == 0 {
+                        // Unrolled by 4 so that the class of every term is static:
+                        // accu[i] collects offsets ≡ i (mod 4) from k, accd[i] from k-1 down.
+                        let (nu, nd) = (hi - k + 1, k - lo);
+                        let (mut tu, mut au) = (e, a);
+                        let (mut td, mut ad) = (e * ainv, ainv * q22);
+                        let mut accu = [C::new(0.0, 0.0); 4];
+                        let mut accd = [C::new(0.0, 0.0); 4];
+                        let both4 = (nu.min(nd).max(0) / 4) * 4;
+                        let mut i = 0;
+                        while i < both4 {
+                            for slot in 0..4 {
+                                accu[slot] += tu;
+                                accd[slot] += td;
+                                tu *= au;
+                                au *= q22;
+                                td *= ad;
+                                ad *= q22;
+                            }
+                            i += 4;
+                        }
+                        sweep_tail(&mut accu, tu, au, q22, nu - both4);
+                        sweep_tail(&mut accd, td, ad, q22, nd - both4);
+                        for slot in 0..4 {
+                            r0[((k + slot as i64) & 3) as usize] += accu[slot];
+                            r0[((k - 1 - slot as i64) & 3) as usize] += accd[slot];
+                        }
+                    } else {
+                        let (mut tu, mut au, mut ju) = (e, a, k);
+                        let (mut td, mut ad, mut jd) = (e * ainv, ainv * q22, k - 1);
+                        let both = (hi - k + 1).min(k - lo);
+                        for _ in 0..both {
+                            accumulate::<ORDER>(&mut r0, &mut r1, &mut r2, tu, ju);
+                            accumulate::<ORDER>(&mut r0, &mut r1, &mut r2, td, jd);
+                            tu *= au;
+                            au *= q22;
+                            td *= ad;
+                            ad *= q22;
+                            ju += 1;
+                            jd -= 1;
+                        }
+                        while ju <= hi {
+                            accumulate::<ORDER>(&mut r0, &mut r1, &mut r2, tu, ju);
+                            tu *= au;
+                            au *= q22;
+                            ju += 1;
+                        }
+                        while jd >= lo {
+                            accumulate::<ORDER>(&mut r0, &mut r1, &mut r2, td, jd);
+                            td *= ad;
+                            ad *= q22;
+                            jd -= 1;
+                        }
                     }
                     let base = ((j1 & 3) as usize) * 4;
                     let j1f = j1 as f64;
@@ -260,6 +313,19 @@ impl ThetaPlan {
                 }
             }
         }
+    }
+}
+
+/// The rest of a sweep of `n` terms (any `n`; nothing for `n ≤ 0`) starting at
+/// slot 0: `acc[i mod 4] += t_i`, `t_{i+1} = t_i a_i`, `a_{i+1} = a_i q`.
+#[inline(always)]
+fn sweep_tail(acc: &mut [C; 4], mut t: C, mut a: C, q: C, n: i64) {
+    let mut i = 0;
+    while i < n {
+        acc[(i & 3) as usize] += t;
+        t *= a;
+        a *= q;
+        i += 1;
     }
 }
 
