@@ -7,21 +7,29 @@ The shared batch of problems.json ("benchmark" -> "theta"): tau as given and
 maximum error relative to the largest of the 16 values at each point (truth:
 python-flint at 200 bits on a subset), and the speed ratios.
 
+All methods run on one core (BLAS threads set to 1 before numpy is imported).
+
 Run:  python benches/theta_compare.py            (about a minute)
       python benches/theta_compare.py --quick    (fewer points and repeats)
 """
 
 from __future__ import annotations
 
-import argparse
-import itertools
-import statistics
-import time
+import os
 
-import numpy as np
-from flint import acb, acb_mat, ctx
+# One core for every method (the comparison is per core): numpy's BLAS would
+# otherwise use all cores for the separable variant's matrix products.
+for _var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
+    os.environ.setdefault(_var, "1")
 
-import manakov
+import argparse  # noqa: E402
+import itertools  # noqa: E402
+import statistics  # noqa: E402
+import time  # noqa: E402
+
+import manakov  # noqa: E402
+import numpy as np  # noqa: E402
+from flint import acb, acb_mat, ctx  # noqa: E402
 
 SEED = 20261121
 
@@ -132,8 +140,14 @@ def main() -> None:
     t, vals = timed(lambda: manakov.theta_all(z, tau), repeats)
     rows.append(("manakov.theta_all", t / n, max_rel_error(vals[:n_truth], truth), n))
     t, vals = timed(lambda: flint_all(z[:n_flint], tau, 53), max(1, repeats // 2))
-    rows.append(("python-flint acb_mat.theta (prec 53)", t / n_flint,
-                 max_rel_error(vals[:n_truth], truth[:n_flint]), n_flint))
+    rows.append(
+        (
+            "python-flint acb_mat.theta (prec 53)",
+            t / n_flint,
+            max_rel_error(vals[:n_truth], truth[:n_flint]),
+            n_flint,
+        )
+    )
     t, vals = timed(lambda: numpy_brute(z, tau), max(1, repeats // 2))
     rows.append(("numpy brute force", t / n, max_rel_error(vals[:n_truth], truth), n))
     t, vals = timed(lambda: numpy_separable(z, tau), repeats)
@@ -142,7 +156,9 @@ def main() -> None:
     base = rows[0][1]
     print(f"tau = {tau.tolist()}")
     print(f"points: {n} (errors on the first {n_truth}; truth: python-flint at 200 bits)")
-    print(f"{'method':40s} {'points':>7s} {'us/point':>10s} {'x manakov':>10s} {'max rel err':>12s}")
+    print(
+        f"{'method':40s} {'points':>7s} {'us/point':>10s} {'x manakov':>10s} {'max rel err':>12s}"
+    )
     for name, per, err, npts in rows:
         print(f"{name:40s} {npts:7d} {per * 1e6:10.3f} {per / base:10.1f} {err:12.2e}")
     print(

@@ -14,11 +14,13 @@ def theta_jet(
     tau: npt.NDArray[np.complex128],
     tol: float,
     order: int,
+    scaled: bool,
 ) -> tuple[
     npt.NDArray[np.complex128],
     npt.NDArray[np.complex128],
     npt.NDArray[np.complex128],
     npt.NDArray[np.float64],
+    bool,
 ]: ...
 def theta_plan_info(
     tau: npt.NDArray[np.complex128], tol: float, order: int

@@ -181,20 +181,6 @@ def _check_tol(tol: float) -> float:
     return tol
 
 
-def _scale(values: np.ndarray, log: np.ndarray) -> np.ndarray:
-    """``values * exp(log)`` broadcast over trailing axes; OverflowError instead of inf."""
-    extra = (1,) * (values.ndim - log.ndim)
-    with np.errstate(over="ignore", invalid="ignore"):
-        out = values * np.exp(log.reshape(log.shape + extra))
-    if not np.all(np.isfinite(out)):
-        worst = float(np.max(log))
-        raise OverflowError(
-            f"theta overflows float64 (log of the exponential factor up to {worst:.6g} > "
-            f"{_LOG_MAX:.6g}); use log_scale=True"
-        )
-    return out
-
-
 def _jet(
     z2: npt.NDArray[np.complex128],
     tau_a: npt.NDArray[np.complex128],
@@ -202,8 +188,15 @@ def _jet(
     g: int,
     tol: float,
     order: int,
+    scaled: bool,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-    vals, grad, hess, log = _core.theta_jet(z2, tau_a, _check_tol(tol), order)
+    """Core call; with ``scaled`` the arrays hold theta itself (scaled in Rust)."""
+    vals, grad, hess, log, finite = _core.theta_jet(z2, tau_a, _check_tol(tol), order, scaled)
+    if not finite:
+        raise OverflowError(
+            f"theta overflows float64 (log of the exponential factor up to "
+            f"{float(np.max(log)):.6g}, double range ends at {_LOG_MAX:.6g}); use log_scale=True"
+        )
     n = 4**g
     return (
         vals.reshape(lead + (n,)),
@@ -269,10 +262,10 @@ def theta_all(
     (16,)
     """
     z2, tau_a, lead, g = _prepare(z, tau)
-    vals, _, _, log = _jet(z2, tau_a, lead, g, tol, 0)
+    vals, _, _, log = _jet(z2, tau_a, lead, g, tol, 0, not log_scale)
     if log_scale:
         return vals, _out(log, lead)
-    return _scale(vals, log)
+    return vals
 
 
 def theta(
@@ -316,7 +309,7 @@ def theta(
     d = tuple(operator.index(k) for k in derivs)
     if len(d) > 2 or any(not 0 <= k < g for k in d):
         raise ValueError(f"derivs must list at most 2 coordinates in 0..{g - 1}, got {derivs!r}")
-    vals, grad, hess, log = _jet(z2, tau_a, lead, g, tol, len(d))
+    vals, grad, hess, log = _jet(z2, tau_a, lead, g, tol, len(d), not log_scale)
     if len(d) == 0:
         out = vals[..., idx]
     elif len(d) == 1:
@@ -325,7 +318,7 @@ def theta(
         out = hess[..., idx, d[0], d[1]]
     if log_scale:
         return _out(np.asarray(out), lead), _out(log, lead)
-    return _out(_scale(np.asarray(out), log), lead)
+    return _out(np.asarray(out), lead)
 
 
 def theta_jet(
@@ -361,10 +354,10 @@ def theta_jet(
         Only if ``log_scale`` is True.
     """
     z2, tau_a, lead, g = _prepare(z, tau)
-    vals, grad, hess, log = _jet(z2, tau_a, lead, g, tol, 2)
+    vals, grad, hess, log = _jet(z2, tau_a, lead, g, tol, 2, not log_scale)
     if not all_chars:
         idx = _resolve_char(char, g)
         vals, grad, hess = vals[..., idx], grad[..., idx, :], hess[..., idx, :, :]
     if log_scale:
         return _out(np.asarray(vals), lead), grad, hess, _out(log, lead)
-    return _out(_scale(np.asarray(vals), log), lead), _scale(grad, log), _scale(hess, log)
+    return _out(np.asarray(vals), lead), grad, hess

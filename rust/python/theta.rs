@@ -6,13 +6,14 @@ use numpy::{IntoPyArray, PyArray1, PyArray2, PyArray3, PyArray4, PyReadonlyArray
 use pyo3::prelude::*;
 
 use crate::error::Error;
-use crate::theta::ThetaPlan;
+use crate::theta::{apply_scale, ThetaPlan};
 
 type Jet<'py> = (
     Bound<'py, PyArray2<Complex64>>,
     Bound<'py, PyArray3<Complex64>>,
     Bound<'py, PyArray4<Complex64>>,
     Bound<'py, PyArray1<f64>>,
+    bool,
 );
 
 fn read_tau(tau: &PyReadonlyArray2<'_, Complex64>) -> Result<(Vec<Complex64>, usize), Error> {
@@ -30,16 +31,18 @@ fn read_tau(tau: &PyReadonlyArray2<'_, Complex64>) -> Result<(Vec<Complex64>, us
 
 /// All 4^g theta values (FLINT order) and their z-derivatives up to `order` at
 /// `n` points `z` (shape (n, g)): returns (values (n, 4^g), gradient
-/// (n, 4^g, g or 0), hessian (n, 4^g, g, g or 0), log_scale (n,)), normalised
-/// so that θ = exp(log_scale) · values.
+/// (n, 4^g, g or 0), hessian (n, 4^g, g, g or 0), log_scale (n,), finite),
+/// normalised so that θ = exp(log_scale) · values; with `scaled` the arrays hold
+/// θ itself and `finite` is false if some value overflowed.
 #[pyfunction(name = "theta_jet")]
-#[pyo3(signature = (z, tau, tol, order))]
+#[pyo3(signature = (z, tau, tol, order, scaled))]
 fn theta_jet_py<'py>(
     py: Python<'py>,
     z: PyReadonlyArray2<'py, Complex64>,
     tau: PyReadonlyArray2<'py, Complex64>,
     tol: f64,
     order: usize,
+    scaled: bool,
 ) -> PyResult<Jet<'py>> {
     let (tau_v, g) = read_tau(&tau)?;
     let zv = z.as_array();
@@ -59,7 +62,7 @@ fn theta_jet_py<'py>(
         1 => (g, 0),
         _ => (g, g),
     };
-    let (values, gradient, hessian, logs) = py.detach(move || -> Result<_, Error> {
+    let (values, gradient, hessian, logs, finite) = py.detach(move || -> Result<_, Error> {
         let plan = ThetaPlan::new(&tau_v, g, tol, order)?;
         let zero = Complex64::new(0.0, 0.0);
         let mut values = vec![zero; npts * n];
@@ -67,7 +70,8 @@ fn theta_jet_py<'py>(
         let mut hessian = vec![zero; npts * n * g * hd];
         let mut logs = vec![0.0; npts];
         plan.eval_batch(&z_flat, &mut values, &mut gradient, &mut hessian, &mut logs)?;
-        Ok((values, gradient, hessian, logs))
+        let finite = !scaled || apply_scale(&mut values, &mut gradient, &mut hessian, &logs);
+        Ok((values, gradient, hessian, logs, finite))
     })?;
     let shape_err = |e: numpy::ndarray::ShapeError| Error::Shape {
         what: "theta output",
@@ -82,6 +86,7 @@ fn theta_jet_py<'py>(
         gradient.into_pyarray(py),
         hessian.into_pyarray(py),
         logs.into_pyarray(py),
+        finite,
     ))
 }
 

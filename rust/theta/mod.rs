@@ -631,6 +631,39 @@ impl ThetaPlan {
     }
 }
 
+/// Multiplies batch outputs of [`ThetaPlan::eval_batch`] by `exp(L)` in place, giving
+/// θ itself. Returns `false` (leaving the outputs partly scaled) if some value
+/// is not a finite double, i.e. θ overflows.
+pub fn apply_scale(
+    values: &mut [Complex64],
+    gradient: &mut [Complex64],
+    hessian: &mut [Complex64],
+    log_scale: &[f64],
+) -> bool {
+    let npts = log_scale.len();
+    if npts == 0 {
+        return true;
+    }
+    let (nv, ng, nh) = (
+        values.len() / npts,
+        gradient.len() / npts,
+        hessian.len() / npts,
+    );
+    let mut ok = true;
+    for (i, &l) in log_scale.iter().enumerate() {
+        let f = l.exp();
+        for v in values[i * nv..(i + 1) * nv]
+            .iter_mut()
+            .chain(gradient[i * ng..(i + 1) * ng].iter_mut())
+            .chain(hessian[i * nh..(i + 1) * nh].iter_mut())
+        {
+            *v *= f;
+            ok &= v.re.is_finite() && v.im.is_finite();
+        }
+    }
+    ok
+}
+
 /// All 4^g values `θ[a;b](z, τ)` (FLINT order) as `(Ω, L)` with `θ = exp(L) Ω`.
 /// Convenience wrapper over [`ThetaPlan`]; `tau` is row-major `g×g`, `g = z.len()`.
 pub fn theta_all(z: &[Complex64], tau: &[Complex64], tol: f64) -> Result<(Vec<Complex64>, f64)> {
