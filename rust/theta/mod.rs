@@ -109,6 +109,20 @@ pub struct ThetaJet {
     pub log_scale: f64,
 }
 
+/// A reduced point: `z = z_r + p + τ'q` and what the reduction contributes.
+#[derive(Debug, Clone, Copy)]
+struct Reduced {
+    zr: [Complex64; MAX_GENUS],
+    wr: [f64; MAX_GENUS],
+    q: [f64; MAX_GENUS],
+    log_scale: f64,
+    /// `exp(iφ)`, `φ = -π qᵀX'q - 2π qᵀ Re z_r`.
+    prefactor: Complex64,
+    /// Parities of `p` and `q` as bit masks (coordinate k at bit g-1-k).
+    pbits: usize,
+    qbits: usize,
+}
+
 /// Statistics of a plan, for tests and documentation.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct PlanInfo {
@@ -411,6 +425,30 @@ impl ThetaPlan {
                 });
             }
         }
+        let red = self.reduce(z)?;
+        let (zr, wr) = (&red.zr[..g], &red.wr[..g]);
+        ws.s0.iter_mut().for_each(|v| *v = Complex64::new(0.0, 0.0));
+        if order >= 1 {
+            ws.s1.iter_mut().for_each(|v| *v = Complex64::new(0.0, 0.0));
+        }
+        if order >= 2 {
+            ws.s2.iter_mut().for_each(|v| *v = Complex64::new(0.0, 0.0));
+        }
+        match (self.fast_g2, order) {
+            (true, 0) => self.sum_g2::<0>(zr, wr, ws),
+            (true, 1) => self.sum_g2::<1>(zr, wr, ws),
+            (true, _) => self.sum_g2::<2>(zr, wr, ws),
+            (false, 0) => self.sum_generic::<0>(zr, wr, ws),
+            (false, 1) => self.sum_generic::<1>(zr, wr, ws),
+            (false, _) => self.sum_generic::<2>(zr, wr, ws),
+        }
+        self.combine(&red, ws, order, values, gradient, hessian);
+        Ok(red.log_scale)
+    }
+
+    /// The reduction `z = z_r + p + τ'q` and the factors it contributes.
+    fn reduce(&self, z: &[Complex64]) -> Result<Reduced> {
+        let g = self.g;
         // Reduction z = z_r + p + τ' q, q = round((Im τ)^{-1} Im z), p = round(Re(z - τ'q)).
         let mut zr = [Complex64::new(0.0, 0.0); MAX_GENUS];
         let mut q = [0.0f64; MAX_GENUS];
@@ -454,12 +492,10 @@ impl ThetaPlan {
             p[i] = sum::round_i64(re) as f64;
             zr[i] = Complex64::new(re - p[i], im);
         }
-        let zr = &zr[..g];
         let mut wr = [0.0f64; MAX_GENUS];
         for i in 0..g {
             wr[i] = (0..g).map(|k| self.yinv[i * g + k] * zr[k].im).sum();
         }
-        let wr = &wr[..g];
         // L = π (Im z)ᵀ (Im τ)^{-1} (Im z) = π (q + w_r)ᵀ Y (q + w_r); the first form
         // has no cancellation between large terms.
         let mut log_scale = 0.0;
@@ -475,24 +511,6 @@ impl ThetaPlan {
                 phi -= 2.0 * pi() * q[i] * zr[i].re;
             }
         }
-        ws.s0.iter_mut().for_each(|v| *v = Complex64::new(0.0, 0.0));
-        if order >= 1 {
-            ws.s1.iter_mut().for_each(|v| *v = Complex64::new(0.0, 0.0));
-        }
-        if order >= 2 {
-            ws.s2.iter_mut().for_each(|v| *v = Complex64::new(0.0, 0.0));
-        }
-        match (self.fast_g2, order) {
-            (true, 0) => self.sum_g2::<0>(zr, wr, ws),
-            (true, 1) => self.sum_g2::<1>(zr, wr, ws),
-            (true, _) => self.sum_g2::<2>(zr, wr, ws),
-            (false, 0) => self.sum_generic::<0>(zr, wr, ws),
-            (false, 1) => self.sum_generic::<1>(zr, wr, ws),
-            (false, _) => self.sum_generic::<2>(zr, wr, ws),
-        }
-        // θ[a;b] = i^{a·b} Σ_h (-1)^{h·b} S[a + 2h]: a Walsh–Hadamard transform over h
-        // per a, then one unit factor per characteristic collecting i^{a·b},
-        // i^{aᵀSa} (Re τ reduction) and (-1)^{a·p + b·q} (z reduction).
         let prefactor = if shifted {
             Complex64::from_polar(1.0, phi)
         } else {
@@ -503,6 +521,32 @@ impl ThetaPlan {
             pbits |= ((p[k] as i64 & 1) as usize) << (g - 1 - k);
             qbits |= ((q[k] as i64 & 1) as usize) << (g - 1 - k);
         }
+        Ok(Reduced {
+            zr,
+            wr,
+            q,
+            log_scale,
+            prefactor,
+            pbits,
+            qbits,
+        })
+    }
+
+    /// Class sums in `ws` → the 4^g outputs (and derivatives) at the original point.
+    fn combine(
+        &self,
+        red: &Reduced,
+        ws: &mut Workspace,
+        order: usize,
+        values: &mut [Complex64],
+        gradient: &mut [Complex64],
+        hessian: &mut [Complex64],
+    ) {
+        let g = self.g;
+        let (prefactor, pbits, qbits, q) = (red.prefactor, red.pbits, red.qbits, &red.q);
+        // θ[a;b] = i^{a·b} Σ_h (-1)^{h·b} S[a + 2h]: a Walsh–Hadamard transform over h
+        // per a, then one unit factor per characteristic collecting i^{a·b},
+        // i^{aᵀSa} (Re τ reduction) and (-1)^{a·p + b·q} (z reduction).
         if g == 2 && order == 0 {
             // The hot case written out: 4 Walsh–Hadamard transforms of length 4.
             for a in 0..4usize {
@@ -517,7 +561,7 @@ impl ThetaPlan {
                     values[(a << 2) | b] = times_i_pow(prefactor, u) * vb;
                 }
             }
-            return Ok(log_scale);
+            return;
         }
         let nh = 1usize << g;
         let ipi = Complex64::new(0.0, pi());
@@ -580,7 +624,6 @@ impl ThetaPlan {
                 }
             }
         }
-        Ok(log_scale)
     }
 
     /// Evaluates a batch: `z` holds `npts` points of `g` entries (row-major);
