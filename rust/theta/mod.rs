@@ -31,6 +31,7 @@
 // Index loops over g ≤ 6 coordinates mirror the formulas; iterators would obscure them.
 #![allow(clippy::needless_range_loop)]
 
+mod batch;
 mod bound;
 mod chars;
 mod sum;
@@ -91,6 +92,8 @@ pub struct ThetaPlan {
     qmat: Vec<Complex64>,
     qinv: Vec<Complex64>,
     fast_g2: bool,
+    /// Genus-2 batch kernel for values (see `batch.rs`), when applicable.
+    batch2: Option<batch::Batch2>,
 }
 
 /// Values and z-derivatives of all 4^g theta functions at one point, normalised:
@@ -110,7 +113,7 @@ pub struct ThetaJet {
 }
 
 /// A reduced point: `z = z_r + p + τ'q` and what the reduction contributes.
-#[derive(Debug, Clone, Copy)]
+#[derive(Debug, Clone, Copy, Default)]
 struct Reduced {
     zr: [Complex64; MAX_GENUS],
     wr: [f64; MAX_GENUS],
@@ -292,7 +295,10 @@ impl ThetaPlan {
             qmat,
             qinv,
             fast_g2,
+            batch2: None,
         };
+        let mut plan = plan;
+        plan.batch2 = batch::Batch2::build(&plan);
         let expected = plan.info().expected_terms;
         if expected > MAX_TERMS {
             return Err(Error::InvalidArgument {
@@ -417,14 +423,6 @@ impl ThetaPlan {
                 ),
             });
         }
-        for (k, c) in z.iter().enumerate() {
-            if !(c.re.is_finite() && c.im.is_finite()) {
-                return Err(Error::NonFinite {
-                    what: "z",
-                    index: k,
-                });
-            }
-        }
         let red = self.reduce(z)?;
         let (zr, wr) = (&red.zr[..g], &red.wr[..g]);
         ws.s0.iter_mut().for_each(|v| *v = Complex64::new(0.0, 0.0));
@@ -449,6 +447,14 @@ impl ThetaPlan {
     /// The reduction `z = z_r + p + τ'q` and the factors it contributes.
     fn reduce(&self, z: &[Complex64]) -> Result<Reduced> {
         let g = self.g;
+        for (k, c) in z.iter().enumerate() {
+            if !(c.re.is_finite() && c.im.is_finite()) {
+                return Err(Error::NonFinite {
+                    what: "z",
+                    index: k,
+                });
+            }
+        }
         // Reduction z = z_r + p + τ' q, q = round((Im τ)^{-1} Im z), p = round(Re(z - τ'q)).
         let mut zr = [Complex64::new(0.0, 0.0); MAX_GENUS];
         let mut q = [0.0f64; MAX_GENUS];
@@ -648,6 +654,11 @@ impl ThetaPlan {
             });
         }
         let mut ws = self.workspace();
+        if gradient.is_empty() && hessian.is_empty() {
+            if let Some(b2) = &self.batch2 {
+                return self.eval_batch_g2(b2, z, values, log_scale, &mut ws);
+            }
+        }
         let gstride = if gradient.is_empty() { 0 } else { n * g };
         let hstride = if hessian.is_empty() { 0 } else { n * g * g };
         if gradient.len() != npts * gstride || hessian.len() != npts * hstride {
@@ -669,6 +680,54 @@ impl ThetaPlan {
                 &mut gradient[i * gstride..(i + 1) * gstride],
                 &mut hessian[i * hstride..(i + 1) * hstride],
             )?;
+        }
+        Ok(())
+    }
+}
+
+impl ThetaPlan {
+    /// Values only, genus 2: chunks of [`batch::LANES`] points through the
+    /// vectorised kernel, then the usual combination per point.
+    fn eval_batch_g2(
+        &self,
+        b2: &batch::Batch2,
+        z: &[Complex64],
+        values: &mut [Complex64],
+        log_scale: &mut [f64],
+        ws: &mut Workspace,
+    ) -> Result<()> {
+        const L: usize = batch::LANES;
+        let zero = Complex64::new(0.0, 0.0);
+        let npts = log_scale.len();
+        let mut sc = b2.scratch();
+        let mut i0 = 0;
+        while i0 < npts {
+            let m = (npts - i0).min(L);
+            let mut zr = [[zero; 2]; L];
+            let mut wr = [[0.0; 2]; L];
+            let mut reds = [Reduced::default(); L];
+            for p in 0..m {
+                let red = self.reduce(&z[2 * (i0 + p)..2 * (i0 + p) + 2])?;
+                zr[p] = [red.zr[0], red.zr[1]];
+                wr[p] = [red.wr[0], red.wr[1]];
+                reds[p] = red;
+            }
+            let mut out = [[zero; 16]; L];
+            b2.class_sums(self, &zr, &wr, &mut sc, &mut out);
+            for p in 0..m {
+                ws.s0[..16].copy_from_slice(&out[p]);
+                let k = i0 + p;
+                self.combine(
+                    &reds[p],
+                    ws,
+                    0,
+                    &mut values[16 * k..16 * k + 16],
+                    &mut [],
+                    &mut [],
+                );
+                log_scale[k] = reds[p].log_scale;
+            }
+            i0 += m;
         }
         Ok(())
     }
