@@ -147,6 +147,28 @@ def test_flint_order_and_convention_against_direct_sum():
     assert rel_err(ours, flint_theta(z, BENCH_TAU)) <= AGREE
 
 
+def test_paper_36_as_printed():
+    """(36): theta(u1,u2) = sum_{n1,n2} exp{i pi (n1 (2 u1 + n1 tau11 + n2 tau12)
+    + n2 (2 u2 + n1 tau21 + n2 tau22))}, summed literally, is theta[0;0]."""
+    rng = np.random.default_rng(36)
+    for _ in range(5):
+        tau = random_reduced_tau(rng)
+        u1, u2 = random_z(rng, 2)
+        total = 0j
+        for n1 in range(-12, 13):
+            for n2 in range(-12, 13):
+                total += np.exp(
+                    1j
+                    * np.pi
+                    * (
+                        n1 * (2 * u1 + n1 * tau[0, 0] + n2 * tau[0, 1])
+                        + n2 * (2 * u2 + n1 * tau[1, 0] + n2 * tau[1, 1])
+                    )
+                )
+        ours = theta(np.array([u1, u2]), tau)
+        assert abs(ours - total) <= AGREE * np.max(np.abs(theta_all(np.array([u1, u2]), tau)))
+
+
 def test_characteristic_table_and_parities():
     assert len(manakov.CHARACTERISTICS) == 16
     odd = [c for c in manakov.CHARACTERISTICS if parity(c) == -1]
