@@ -43,8 +43,9 @@ pub(super) struct BatchScratch {
     x1im: Vec<Lane>,
     x2re: Vec<Lane>,
     x2im: Vec<Lane>,
-    sre: Vec<Lane>,
-    sim: Vec<Lane>,
+    /// Class sums, `sre[r][p] + i sim[r][p]` for class `r` and lane `p`.
+    pub(super) sre: Vec<Lane>,
+    pub(super) sim: Vec<Lane>,
 }
 
 impl Batch2 {
@@ -150,17 +151,19 @@ impl Batch2 {
     }
 
     /// Class sums `S[r]` (r = 4 (j1 mod 4) + (j2 mod 4)), normalised by
-    /// `exp(-π w_rᵀYw_r)`, for `LANES` reduced points; writes `out[p][r]`.
+    /// `exp(-π w_rᵀYw_r)`, for `LANES` reduced points, into `sc.sre`, `sc.sim`.
     pub(super) fn class_sums(
         &self,
         plan: &ThetaPlan,
         zr: &[[Complex64; 2]; LANES],
         wr: &[[f64; 2]; LANES],
         sc: &mut BatchScratch,
-        out: &mut [[Complex64; 16]; LANES],
     ) {
         let pi = std::f64::consts::PI;
-        // power tables, the normalisation folded into X1
+        // u_k = exp(iπ z_k) per lane, the normalisation exp(-π w_rᵀYw_r) folded into X1
+        let mut u1 = [[0.0; LANES]; 2];
+        let mut u2 = [[0.0; LANES]; 2];
+        let mut norm = [0.0; LANES];
         for p in 0..LANES {
             let mut quad = 0.0;
             for i in 0..2 {
@@ -168,37 +171,42 @@ impl Batch2 {
                     quad += plan.y[i * 2 + k] * wr[p][i] * wr[p][k];
                 }
             }
-            let norm = (-pi * quad).exp();
-            fill_powers(zr[p][0], self.j1lo, norm, p, &mut sc.x1re, &mut sc.x1im);
-            fill_powers(zr[p][1], self.j2lo, 1.0, p, &mut sc.x2re, &mut sc.x2im);
+            norm[p] = (-pi * quad).exp();
+            let a = (Complex64::i() * pi * zr[p][0]).exp();
+            let b = (Complex64::i() * pi * zr[p][1]).exp();
+            u1[0][p] = a.re;
+            u1[1][p] = a.im;
+            u2[0][p] = b.re;
+            u2[1][p] = b.im;
         }
         #[cfg(target_arch = "x86_64")]
         {
             if std::is_x86_feature_detected!("avx2") {
                 // SAFETY: the CPU supports AVX2 (checked just above).
-                unsafe { self.rows_avx2(sc) };
-                return self.unpack(sc, out);
+                unsafe { self.kernel_avx2(sc, &u1, &u2, &norm) };
+                return;
             }
         }
-        self.rows_generic(sc);
-        self.unpack(sc, out);
-    }
-
-    fn unpack(&self, sc: &BatchScratch, out: &mut [[Complex64; 16]; LANES]) {
-        for (p, o) in out.iter_mut().enumerate() {
-            for r in 0..16 {
-                o[r] = Complex64::new(sc.sre[r][p], sc.sim[r][p]);
-            }
-        }
+        self.kernel_generic(sc, &u1, &u2, &norm);
     }
 
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2")]
-    unsafe fn rows_avx2(&self, sc: &mut BatchScratch) {
+    unsafe fn kernel_avx2(
+        &self,
+        sc: &mut BatchScratch,
+        u1: &[Lane; 2],
+        u2: &[Lane; 2],
+        norm: &Lane,
+    ) {
+        fill_powers(u1, self.j1lo, norm, &mut sc.x1re, &mut sc.x1im);
+        fill_powers(u2, self.j2lo, &[1.0; LANES], &mut sc.x2re, &mut sc.x2im);
         self.rows_body(sc);
     }
 
-    fn rows_generic(&self, sc: &mut BatchScratch) {
+    fn kernel_generic(&self, sc: &mut BatchScratch, u1: &[Lane; 2], u2: &[Lane; 2], norm: &Lane) {
+        fill_powers(u1, self.j1lo, norm, &mut sc.x1re, &mut sc.x1im);
+        fill_powers(u2, self.j2lo, &[1.0; LANES], &mut sc.x2re, &mut sc.x2im);
         self.rows_body(sc);
     }
 
@@ -242,24 +250,32 @@ impl Batch2 {
     }
 }
 
-/// Lane `p` of `x[j - lo] = scale · exp(iπ j z)`, `j = lo..lo+len` (`lo ≤ 0`),
-/// by products outward from `j = 0` (phases stay small near the centre).
-fn fill_powers(z: Complex64, lo: i64, scale: f64, p: usize, re: &mut [Lane], im: &mut [Lane]) {
-    let u = (Complex64::i() * std::f64::consts::PI * z).exp();
-    let uinv = u.inv();
+/// `x[j - lo] = scale · u^j` for all lanes, `j = lo..lo+len` (`lo ≤ 0`), by
+/// products outward from `j = 0` (phases stay small near the centre).
+#[inline(always)]
+fn fill_powers(u: &[Lane; 2], lo: i64, scale: &Lane, re: &mut [Lane], im: &mut [Lane]) {
     let zero = (-lo) as usize;
-    let mut v = Complex64::new(scale, 0.0);
-    re[zero][p] = v.re;
-    im[zero][p] = v.im;
-    for k in zero + 1..re.len() {
-        v *= u;
-        re[k][p] = v.re;
-        im[k][p] = v.im;
+    // 1/u = conj(u) / |u|²
+    let mut inv = [[0.0; LANES]; 2];
+    for p in 0..LANES {
+        let n2 = u[0][p] * u[0][p] + u[1][p] * u[1][p];
+        inv[0][p] = u[0][p] / n2;
+        inv[1][p] = -u[1][p] / n2;
     }
-    let mut v = Complex64::new(scale, 0.0);
+    re[zero] = *scale;
+    im[zero] = [0.0; LANES];
+    for k in zero + 1..re.len() {
+        let (pr, pi) = (re[k - 1], im[k - 1]);
+        for p in 0..LANES {
+            re[k][p] = pr[p] * u[0][p] - pi[p] * u[1][p];
+            im[k][p] = pr[p] * u[1][p] + pi[p] * u[0][p];
+        }
+    }
     for k in (0..zero).rev() {
-        v *= uinv;
-        re[k][p] = v.re;
-        im[k][p] = v.im;
+        let (pr, pi) = (re[k + 1], im[k + 1]);
+        for p in 0..LANES {
+            re[k][p] = pr[p] * inv[0][p] - pi[p] * inv[1][p];
+            im[k][p] = pr[p] * inv[1][p] + pi[p] * inv[0][p];
+        }
     }
 }

@@ -121,6 +121,8 @@ struct Reduced {
     log_scale: f64,
     /// `exp(iφ)`, `φ = -π qᵀX'q - 2π qᵀ Re z_r`.
     prefactor: Complex64,
+    /// `prefactor == 1` exactly (no shift by τ'q).
+    unit_prefactor: bool,
     /// Parities of `p` and `q` as bit masks (coordinate k at bit g-1-k).
     pbits: usize,
     qbits: usize,
@@ -533,9 +535,38 @@ impl ThetaPlan {
             q,
             log_scale,
             prefactor,
+            unit_prefactor: !shifted,
             pbits,
             qbits,
         })
+    }
+
+    /// Genus 2, values only: 4 Walsh–Hadamard transforms of length 4 (the hot
+    /// case written out; takes the class sums directly to avoid a copy).
+    fn combine_g2_values(
+        &self,
+        red: &Reduced,
+        s0: impl Fn(usize) -> Complex64,
+        values: &mut [Complex64],
+    ) {
+        let (prefactor, pbits, qbits) = (red.prefactor, red.pbits, red.qbits);
+        // The hot case written out: 4 Walsh–Hadamard transforms of length 4.
+        for a in 0..4usize {
+            let r = &self.class_of[4 * a..4 * a + 4];
+            let (s0, s1, s2, s3) = (s0(r[0]), s0(r[1]), s0(r[2]), s0(r[3]));
+            let (p0, p1, p2, p3) = (s0 + s1, s0 - s1, s2 + s3, s2 - s3);
+            let v = [p0 + p2, p1 + p3, p0 - p2, p1 - p3];
+            let sa = (a & pbits).count_ones();
+            for (b, vb) in v.iter().enumerate() {
+                let sign = ((sa + (b & qbits).count_ones()) & 1) as u8;
+                let u = self.unit_pow[(a << 2) | b].wrapping_add(2 * sign);
+                values[(a << 2) | b] = if red.unit_prefactor {
+                    times_i_pow(*vb, u)
+                } else {
+                    times_i_pow(prefactor, u) * vb
+                };
+            }
+        }
     }
 
     /// Class sums in `ws` → the 4^g outputs (and derivatives) at the original point.
@@ -554,20 +585,7 @@ impl ThetaPlan {
         // per a, then one unit factor per characteristic collecting i^{a·b},
         // i^{aᵀSa} (Re τ reduction) and (-1)^{a·p + b·q} (z reduction).
         if g == 2 && order == 0 {
-            // The hot case written out: 4 Walsh–Hadamard transforms of length 4.
-            for a in 0..4usize {
-                let r = &self.class_of[4 * a..4 * a + 4];
-                let (s0, s1, s2, s3) = (ws.s0[r[0]], ws.s0[r[1]], ws.s0[r[2]], ws.s0[r[3]]);
-                let (p0, p1, p2, p3) = (s0 + s1, s0 - s1, s2 + s3, s2 - s3);
-                let v = [p0 + p2, p1 + p3, p0 - p2, p1 - p3];
-                let sa = (a & pbits).count_ones();
-                for (b, vb) in v.iter().enumerate() {
-                    let sign = ((sa + (b & qbits).count_ones()) & 1) as u8;
-                    let u = self.unit_pow[(a << 2) | b].wrapping_add(2 * sign);
-                    values[(a << 2) | b] = times_i_pow(prefactor, u) * vb;
-                }
-            }
-            return;
+            return self.combine_g2_values(red, |r| ws.s0[r], values);
         }
         let nh = 1usize << g;
         let ipi = Complex64::new(0.0, pi());
@@ -656,7 +674,7 @@ impl ThetaPlan {
         let mut ws = self.workspace();
         if gradient.is_empty() && hessian.is_empty() {
             if let Some(b2) = &self.batch2 {
-                return self.eval_batch_g2(b2, z, values, log_scale, &mut ws);
+                return self.eval_batch_g2(b2, z, values, log_scale);
             }
         }
         let gstride = if gradient.is_empty() { 0 } else { n * g };
@@ -694,7 +712,6 @@ impl ThetaPlan {
         z: &[Complex64],
         values: &mut [Complex64],
         log_scale: &mut [f64],
-        ws: &mut Workspace,
     ) -> Result<()> {
         const L: usize = batch::LANES;
         let zero = Complex64::new(0.0, 0.0);
@@ -712,19 +729,11 @@ impl ThetaPlan {
                 wr[p] = [red.wr[0], red.wr[1]];
                 reds[p] = red;
             }
-            let mut out = [[zero; 16]; L];
-            b2.class_sums(self, &zr, &wr, &mut sc, &mut out);
+            b2.class_sums(self, &zr, &wr, &mut sc);
             for p in 0..m {
-                ws.s0[..16].copy_from_slice(&out[p]);
                 let k = i0 + p;
-                self.combine(
-                    &reds[p],
-                    ws,
-                    0,
-                    &mut values[16 * k..16 * k + 16],
-                    &mut [],
-                    &mut [],
-                );
+                let class_sum = |r: usize| Complex64::new(sc.sre[r][p], sc.sim[r][p]);
+                self.combine_g2_values(&reds[p], class_sum, &mut values[16 * k..16 * k + 16]);
                 log_scale[k] = reds[p].log_scale;
             }
             i0 += m;
