@@ -259,6 +259,22 @@ def test_longdouble_truth_agrees_with_flint():
             done += 1
 
 
+@pytest.mark.parametrize("kind", ["bench", "reduced", "far"])
+def test_batches_agree_with_flint(kind):
+    """Batches of >= 64 points take the vectorised genus-2 kernel; check every
+    40th of 400 points (flint at 200 bits), including points needing reduction."""
+    rng = np.random.default_rng({"bench": 1, "reduced": 2, "far": 3}[kind])
+    tau = {
+        "bench": BENCH_TAU,
+        "reduced": random_reduced_tau(rng),
+        "far": far_from_reduced(rng, random_reduced_tau(rng)),
+    }[kind]
+    z = rng.uniform(-2, 2, (400, 2)) + 1j * rng.uniform(-1.5, 1.5, (400, 2))
+    ours = theta_all(z, tau)
+    for i in range(0, 400, 40):
+        assert rel_err(ours[i], flint_theta(z[i], tau)) <= AGREE
+
+
 def test_agrees_with_flint_small_imaginary_part():
     """Im tau with small eigenvalues (many terms, large values)."""
     rng = np.random.default_rng(7)

@@ -24,7 +24,7 @@
 /// `I_0 ≤ min(√π/2, e^{-s²}/(2s))` (from `t/s ≥ 1` on the range), `I_1 = e^{-s²}/2`,
 /// `I_k = (k-1)/2 · I_{k-2} + s^{k-1} e^{-s²}/2` (integration by parts); all
 /// coefficients are positive, so upper bounds propagate.
-fn gaussian_moment_tails(s: f64, kmax: usize) -> Vec<f64> {
+fn gaussian_moment_tails(s: f64, out: &mut [f64]) {
     let e = (-s * s).exp();
     let half_sqrt_pi = 0.5 * std::f64::consts::PI.sqrt();
     let i0 = if s > 0.0 {
@@ -32,17 +32,21 @@ fn gaussian_moment_tails(s: f64, kmax: usize) -> Vec<f64> {
     } else {
         half_sqrt_pi
     };
-    let mut out = Vec::with_capacity(kmax + 1);
-    for k in 0..=kmax {
-        let v = match k {
+    let mut spow = 1.0; // s^{k-1}
+    for k in 0..out.len() {
+        out[k] = match k {
             0 => i0,
             1 => 0.5 * e,
-            _ => 0.5 * (k as f64 - 1.0) * out[k - 2] + 0.5 * s.powi(k as i32 - 1) * e,
+            _ => {
+                spow *= s;
+                0.5 * (k as f64 - 1.0) * out[k - 2] + 0.5 * spow * e
+            }
         };
-        out.push(v);
     }
-    out
 }
+
+/// Largest polynomial degree: `g - 1 + p ≤ MAX_GENUS - 1 + 2`.
+const MAX_DEGREE: usize = super::MAX_GENUS + 1;
 
 /// The bound of the module documentation: an upper bound for
 /// `Σ_{x ∈ v+Λ, |x| ≥ r} |x|^p e^{-|x|²}` for every translate `v` of a lattice
@@ -51,19 +55,23 @@ pub fn tail_bound(g: usize, rho: f64, r: f64, p: u32) -> f64 {
     if r < 0.5 * rho || rho <= 0.0 || g == 0 {
         return f64::INFINITY;
     }
-    // Coefficients of r^{g-1} (r + ρ/2)^p, lowest degree first.
-    let mut poly = vec![0.0; g];
-    poly[g - 1] = 1.0;
-    for _ in 0..p {
-        let mut next = vec![0.0; poly.len() + 1];
-        for (k, &v) in poly.iter().enumerate() {
-            next[k] += 0.5 * rho * v;
-            next[k + 1] += v;
-        }
-        poly = next;
+    let deg = g - 1 + p as usize;
+    if deg > MAX_DEGREE {
+        return f64::INFINITY;
     }
-    let moments = gaussian_moment_tails(r - 0.5 * rho, poly.len() - 1);
-    let integral: f64 = poly.iter().zip(&moments).map(|(c, m)| c * m).sum();
+    // Coefficients of r^{g-1} (r + ρ/2)^p, lowest degree first.
+    let mut poly = [0.0; MAX_DEGREE + 1];
+    poly[g - 1] = 1.0;
+    for step in 0..p as usize {
+        let top = g + step; // current degree + 1
+        for k in (0..=top).rev() {
+            let lower = if k > 0 { poly[k - 1] } else { 0.0 };
+            poly[k] = 0.5 * rho * poly[k] + lower;
+        }
+    }
+    let mut moments = [0.0; MAX_DEGREE + 1];
+    gaussian_moment_tails(r - 0.5 * rho, &mut moments[..=deg]);
+    let integral: f64 = poly[..=deg].iter().zip(&moments).map(|(c, m)| c * m).sum();
     let kappa = g as f64 * rho * rho / (4.0 * (g as f64 + 2.0));
     kappa.exp() * g as f64 * (2.0 / rho).powi(g as i32) * integral
 }
@@ -76,7 +84,8 @@ mod tests {
     #[test]
     fn moments_match_closed_forms() {
         let s: f64 = 2.0;
-        let m = gaussian_moment_tails(s, 3);
+        let mut m = [0.0; 4];
+        gaussian_moment_tails(s, &mut m);
         // I_1 = e^{-s²}/2 exactly; I_3 = (s²+1) e^{-s²}/2
         assert_relative_eq!(m[1], 0.5 * (-4.0f64).exp(), max_relative = 1e-15);
         assert_relative_eq!(m[3], 0.5 * 5.0 * (-4.0f64).exp(), max_relative = 1e-15);
@@ -109,5 +118,35 @@ mod tests {
         assert_eq!(tail_bound(2, 1.0, 0.4, 0), f64::INFINITY);
         // a smaller spacing is also a valid (weaker) lattice constant
         assert!(tail_bound(1, 0.5, 3.0, 0) > 0.0);
+    }
+
+    /// Genus 2: a skewed lattice with basis (1.3, 0), (0.55, 1.1), shortest vector 1.21…
+    #[test]
+    fn bound_dominates_direct_genus_two_tails() {
+        let (b1, b2) = ([1.3, 0.0], [0.55, 1.1]);
+        let rho = (0.55f64 * 0.55 + 1.1 * 1.1).sqrt().min(1.3);
+        for &shift in &[[0.0, 0.0], [0.3, -0.2], [0.5, 0.5]] {
+            for &r in &[1.0, 2.0, 3.0, 4.5] {
+                for p in 0..=2u32 {
+                    let mut direct = 0.0;
+                    for n1 in -40i32..=40 {
+                        for n2 in -40i32..=40 {
+                            let x = shift[0] + n1 as f64 * b1[0] + n2 as f64 * b2[0];
+                            let y = shift[1] + n1 as f64 * b1[1] + n2 as f64 * b2[1];
+                            let d = (x * x + y * y).sqrt();
+                            if d >= r {
+                                direct += d.powi(p as i32) * (-d * d).exp();
+                            }
+                        }
+                    }
+                    let b = tail_bound(2, rho, r, p);
+                    assert!(b >= direct, "r {r} p {p}: {b} < {direct}");
+                    assert!(
+                        b <= 1e3 * direct.max(1e-300),
+                        "r {r} p {p}: {b} vs {direct}"
+                    );
+                }
+            }
+        }
     }
 }

@@ -64,6 +64,10 @@ const MAX_REDUCTION: f64 = 4.5e15;
 /// `exp(π Im τ_kk / 2) > e^{78}`; the generic path (upward sweeps only) is used.
 const FAST_PATH_MAX_IMAG_DIAG: f64 = 50.0;
 
+/// Batches of at least this many points (values only, genus 2) use the
+/// vectorised kernel; its plan-time table costs about as much as 100 points.
+const BATCH_KERNEL_MIN_POINTS: usize = 64;
+
 /// A validated period matrix with everything the sums need that depends only
 /// on τ, the tolerance and the derivative order: build once, evaluate at many z.
 #[derive(Debug, Clone)]
@@ -92,8 +96,9 @@ pub struct ThetaPlan {
     qmat: Vec<Complex64>,
     qinv: Vec<Complex64>,
     fast_g2: bool,
-    /// Genus-2 batch kernel for values (see `batch.rs`), when applicable.
-    batch2: Option<batch::Batch2>,
+    /// Genus-2 batch kernel for values (see `batch.rs`), built on first use by
+    /// a large enough batch (its table costs ~20 µs), `None` inside if not applicable.
+    batch2: std::sync::OnceLock<Option<batch::Batch2>>,
 }
 
 /// Values and z-derivatives of all 4^g theta functions at one point, normalised:
@@ -297,10 +302,8 @@ impl ThetaPlan {
             qmat,
             qinv,
             fast_g2,
-            batch2: None,
+            batch2: std::sync::OnceLock::new(),
         };
-        let mut plan = plan;
-        plan.batch2 = batch::Batch2::build(&plan);
         let expected = plan.info().expected_terms;
         if expected > MAX_TERMS {
             return Err(Error::InvalidArgument {
@@ -672,8 +675,8 @@ impl ThetaPlan {
             });
         }
         let mut ws = self.workspace();
-        if gradient.is_empty() && hessian.is_empty() {
-            if let Some(b2) = &self.batch2 {
+        if gradient.is_empty() && hessian.is_empty() && npts >= BATCH_KERNEL_MIN_POINTS {
+            if let Some(b2) = self.batch2.get_or_init(|| batch::Batch2::build(self)) {
                 return self.eval_batch_g2(b2, z, values, log_scale);
             }
         }
@@ -890,7 +893,7 @@ fn radius_for(bound: impl Fn(f64) -> f64, r0: f64, tol: f64) -> f64 {
         lo = hi;
         hi *= 1.25;
     }
-    for _ in 0..45 {
+    for _ in 0..26 {
         let mid = 0.5 * (lo + hi);
         if bound(mid) > tol {
             lo = mid;
