@@ -266,7 +266,7 @@ impl ThetaPlan {
         // (2/ρ')^g for a later start of the integral. Keep the best radius.
         let mut radius = f64::INFINITY;
         let mut rho_used = rho;
-        for frac in [1.0, 0.85, 0.7, 0.55, 0.4, 0.25] {
+        for frac in [1.0, 0.75, 0.5, 0.3] {
             let rp = rho * frac;
             let r = radius_for(|r| output_error_bound(g, rp, r, sk, order), 0.5 * rp, tol);
             if r < radius {
@@ -884,7 +884,7 @@ fn output_error_bound(g: usize, rho: f64, r: f64, s: f64, order: usize) -> f64 {
 }
 
 /// `Γ(n/2)` for small integers `n ≥ 1`.
-/// Smallest `R ≥ r0` (to 1e-12 relative) with `bound(R) ≤ tol`; `bound` is
+/// Smallest `R ≥ r0` (to ~1e-5 relative, from above) with `bound(R) ≤ tol`; `bound` is
 /// decreasing in `R` and `+∞` below `r0`.
 fn radius_for(bound: impl Fn(f64) -> f64, r0: f64, tol: f64) -> f64 {
     let mut lo = r0;
@@ -893,7 +893,7 @@ fn radius_for(bound: impl Fn(f64) -> f64, r0: f64, tol: f64) -> f64 {
         lo = hi;
         hi *= 1.25;
     }
-    for _ in 0..26 {
+    for _ in 0..16 {
         let mid = 0.5 * (lo + hi);
         if bound(mid) > tol {
             lo = mid;
