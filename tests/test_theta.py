@@ -128,7 +128,18 @@ def kappa(z: np.ndarray, tau: np.ndarray, scale: float, nmax: int = 60) -> float
 
 
 def rel_err(got: np.ndarray, want: np.ndarray) -> float:
+    assert np.all(np.isfinite(want)), "no truth: the reference is not finite"
     return float(np.max(np.abs(got - want)) / np.max(np.abs(want)))
+
+
+def truth(z, tau) -> np.ndarray:
+    """python-flint at 200 bits; where python-flint 0.9 returns indeterminate balls
+    (it does for some far-from-reduced tau at any precision), the defining sum in
+    80-bit extended precision (genus 2; itself checked against flint below)."""
+    ref = flint_theta(z, tau)
+    if np.all(np.isfinite(ref)) or len(z) != 2:
+        return ref
+    return brute_longdouble(z, tau).astype(complex)
 
 
 def random_z(rng: np.random.Generator, g: int, imag: float = 0.5) -> np.ndarray:
@@ -216,7 +227,7 @@ def test_agrees_with_flint_far_from_reduced(block):
         tau = far_from_reduced(rng, random_reduced_tau(rng))
         for _ in range(2):
             z = random_z(rng, 2, imag=1.0)
-            worst = max(worst, rel_err(theta_all(z, tau), flint_theta(z, tau)))
+            worst = max(worst, rel_err(theta_all(z, tau), truth(z, tau)))
     assert worst <= AGREE
 
 
@@ -232,15 +243,15 @@ def test_error_follows_condition_number_when_very_far_from_reduced():
     for _ in range(40):
         tau = far_from_reduced(rng, random_reduced_tau(rng), umax=3)
         z = random_z(rng, 2, imag=1.0)
-        truth = flint_theta(z, tau)
-        if np.all(np.isfinite(truth)):
+        ref = flint_theta(z, tau)
+        if np.all(np.isfinite(ref)):
             by_flint += 1
         else:
             # python-flint 0.9 returns indeterminate balls here at any precision
-            truth = brute_longdouble(z, tau)
+            ref = brute_longdouble(z, tau)
         got = theta_all(z, tau).astype(np.clongdouble)
-        err = float(np.max(np.abs(got - truth)) / np.max(np.abs(truth)))
-        kap = kappa(z, tau, float(np.max(np.abs(truth))))
+        err = float(np.max(np.abs(got - ref)) / np.max(np.abs(ref)))
+        kap = kappa(z, tau, float(np.max(np.abs(ref))))
         assert err <= max(AGREE, 4 * eps * kap)
     assert by_flint >= 25
 
@@ -272,7 +283,7 @@ def test_batches_agree_with_flint(kind):
     z = rng.uniform(-2, 2, (400, 2)) + 1j * rng.uniform(-1.5, 1.5, (400, 2))
     ours = theta_all(z, tau)
     for i in range(0, 400, 40):
-        assert rel_err(ours[i], flint_theta(z[i], tau)) <= AGREE
+        assert rel_err(ours[i], truth(z[i], tau)) <= AGREE
 
 
 def test_agrees_with_flint_small_imaginary_part():
