@@ -128,8 +128,6 @@ struct Reduced {
     log_scale: f64,
     /// `exp(iφ)`, `φ = -π qᵀX'q - 2π qᵀ Re z_r`.
     prefactor: Complex64,
-    /// `prefactor == 1` exactly (no shift by τ'q).
-    unit_prefactor: bool,
     /// Parities of `p` and `q` as bit masks (coordinate k at bit g-1-k).
     pbits: usize,
     qbits: usize,
@@ -453,6 +451,9 @@ impl ThetaPlan {
 
     /// The reduction `z = z_r + p + τ'q` and the factors it contributes.
     fn reduce(&self, z: &[Complex64]) -> Result<Reduced> {
+        if self.g == 2 && z.len() == 2 {
+            return self.reduce2([z[0], z[1]]);
+        }
         let g = self.g;
         for (k, c) in z.iter().enumerate() {
             if !(c.re.is_finite() && c.im.is_finite()) {
@@ -540,10 +541,77 @@ impl ThetaPlan {
             q,
             log_scale,
             prefactor,
-            unit_prefactor: !shifted,
             pbits,
             qbits,
         })
+    }
+
+    /// [`ThetaPlan::reduce`] written out for genus 2 (same operations, fixed size).
+    fn reduce2(&self, z: [Complex64; 2]) -> Result<Reduced> {
+        for (k, c) in z.iter().enumerate() {
+            if !(c.re.is_finite() && c.im.is_finite()) {
+                return Err(Error::NonFinite {
+                    what: "z",
+                    index: k,
+                });
+            }
+        }
+        let (yi, x, y) = (&self.yinv, &self.x, &self.y);
+        let w = [
+            yi[0] * z[0].im + yi[1] * z[1].im,
+            yi[2] * z[0].im + yi[3] * z[1].im,
+        ];
+        for wk in w {
+            if wk.abs() > MAX_REDUCTION {
+                return Err(Error::InvalidArgument {
+                    what: "z",
+                    reason: format!(
+                        "(Im tau)^-1 Im z has an entry {wk:e}: theta is not representable"
+                    ),
+                });
+            }
+        }
+        let q = [sum::round_i64(w[0]) as f64, sum::round_i64(w[1]) as f64];
+        let shifted = q[0] != 0.0 || q[1] != 0.0;
+        let mut red = Reduced::default();
+        let mut p = [0.0; 2];
+        for i in 0..2 {
+            let (re, im) = if shifted {
+                (
+                    residual(z[i].re, &x[2 * i..2 * i + 2], &q),
+                    residual(z[i].im, &y[2 * i..2 * i + 2], &q),
+                )
+            } else {
+                (z[i].re, z[i].im)
+            };
+            if re.abs() > MAX_REDUCTION {
+                return Err(Error::InvalidArgument {
+                    what: "z",
+                    reason: format!("Re z has an entry {:e}: theta is not determined", z[i].re),
+                });
+            }
+            p[i] = sum::round_i64(re) as f64;
+            red.zr[i] = Complex64::new(re - p[i], im);
+        }
+        let (zr0, zr1) = (red.zr[0].im, red.zr[1].im);
+        red.wr[0] = yi[0] * zr0 + yi[1] * zr1;
+        red.wr[1] = yi[2] * zr0 + yi[3] * zr1;
+        red.q[0] = q[0];
+        red.q[1] = q[1];
+        let log_scale = pi() * z[0].im * (q[0] + red.wr[0]) + pi() * z[1].im * (q[1] + red.wr[1]);
+        red.log_scale = log_scale.max(0.0);
+        red.prefactor = if shifted {
+            let mut phi = -pi() * quad_mod2(x, &q, 2);
+            for i in 0..2 {
+                phi -= 2.0 * pi() * q[i] * red.zr[i].re;
+            }
+            Complex64::from_polar(1.0, phi)
+        } else {
+            Complex64::new(1.0, 0.0)
+        };
+        red.pbits = ((p[0] as i64 & 1) << 1 | (p[1] as i64 & 1)) as usize;
+        red.qbits = ((q[0] as i64 & 1) << 1 | (q[1] as i64 & 1)) as usize;
+        Ok(red)
     }
 
     /// Genus 2, values only: 4 Walsh–Hadamard transforms of length 4 (the hot
@@ -565,11 +633,8 @@ impl ThetaPlan {
             for (b, vb) in v.iter().enumerate() {
                 let sign = ((sa + (b & qbits).count_ones()) & 1) as u8;
                 let u = self.unit_pow[(a << 2) | b].wrapping_add(2 * sign);
-                values[(a << 2) | b] = if red.unit_prefactor {
-                    times_i_pow(*vb, u)
-                } else {
-                    times_i_pow(prefactor, u) * vb
-                };
+                // table lookup, not a branch: u depends on the parities of p, q
+                values[(a << 2) | b] = I_POW[(u & 3) as usize] * prefactor * vb;
             }
         }
     }
@@ -790,6 +855,14 @@ pub fn theta_all(z: &[Complex64], tau: &[Complex64], tol: f64) -> Result<(Vec<Co
 pub fn theta_jet(z: &[Complex64], tau: &[Complex64], tol: f64) -> Result<ThetaJet> {
     ThetaPlan::new(tau, z.len(), tol, 2)?.jet(z, 2)
 }
+
+/// `i^k`, `k = 0..4`.
+const I_POW: [Complex64; 4] = [
+    Complex64::new(1.0, 0.0),
+    Complex64::new(0.0, 1.0),
+    Complex64::new(-1.0, 0.0),
+    Complex64::new(0.0, -1.0),
+];
 
 /// `v · i^p` by swapping and negating parts.
 #[inline(always)]

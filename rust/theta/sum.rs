@@ -347,11 +347,8 @@ fn accumulate<const ORDER: usize>(r0: &mut [C; 4], r1: &mut [C; 4], r2: &mut [C;
 #[inline(always)]
 pub(super) fn floor_i64(x: f64) -> i64 {
     let t = x as i64;
-    if (t as f64) > x {
-        t - 1
-    } else {
-        t
-    }
+    // branch-free: the comparison is data dependent (signs of reduced coordinates)
+    t - i64::from((t as f64) > x)
 }
 
 /// `ceil` without a libm call, see [`floor_i64`].
