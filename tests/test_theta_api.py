@@ -151,6 +151,22 @@ def test_overflow_raises_and_log_scale_does_not():
     assert np.max(np.abs(om * np.exp(log) - ref)) <= 1e-13 * np.max(np.abs(ref))
 
 
+def test_overflow_in_a_large_batch():
+    """Batches of >= 64 points scale inside the vectorised kernel; one overflowing
+    point must still raise, and log_scale must still work."""
+    z = np.zeros((100, 2), complex)
+    z[:, 0] = np.linspace(0, 1, 100) + 0.1j
+    z[57] = [0.1 + 300j, 0.2 - 250j]
+    with pytest.raises(OverflowError, match="log_scale"):
+        theta_all(z, BENCH_TAU)
+    om, log = theta_all(z, BENCH_TAU, log_scale=True)
+    assert np.all(np.isfinite(om)) and log.shape == (100,) and log[57] > 709
+    ok = np.delete(np.arange(100), 57)
+    np.testing.assert_allclose(
+        theta_all(z[ok], BENCH_TAU), om[ok] * np.exp(log[ok])[:, None], rtol=1e-14, atol=0
+    )
+
+
 def test_value_error_not_panic_for_huge_imag_z():
     with pytest.raises(ValueError):
         theta_all(np.array([0.0, 1e300j]), BENCH_TAU, log_scale=True)

@@ -55,7 +55,10 @@ fn theta_jet_py<'py>(
         }
         .into());
     }
-    let z_flat: Vec<Complex64> = zv.iter().copied().collect();
+    let z_flat: Vec<Complex64> = match zv.as_slice() {
+        Some(contiguous) => contiguous.to_vec(),
+        None => zv.iter().copied().collect(),
+    };
     let n = 1usize << (2 * g);
     let (gd, hd) = match order {
         0 => (0, 0),
@@ -69,8 +72,12 @@ fn theta_jet_py<'py>(
         let mut gradient = vec![zero; npts * n * gd];
         let mut hessian = vec![zero; npts * n * g * hd];
         let mut logs = vec![0.0; npts];
-        plan.eval_batch(&z_flat, &mut values, &mut gradient, &mut hessian, &mut logs)?;
-        let finite = !scaled || apply_scale(&mut values, &mut gradient, &mut hessian, &logs);
+        let finite = if scaled && order == 0 {
+            plan.eval_batch_scaled(&z_flat, &mut values, &mut logs)?
+        } else {
+            plan.eval_batch(&z_flat, &mut values, &mut gradient, &mut hessian, &mut logs)?;
+            !scaled || apply_scale(&mut values, &mut gradient, &mut hessian, &logs)
+        };
         Ok((values, gradient, hessian, logs, finite))
     })?;
     let shape_err = |e: numpy::ndarray::ShapeError| Error::Shape {

@@ -744,7 +744,9 @@ impl ThetaPlan {
         let mut ws = self.workspace();
         if gradient.is_empty() && hessian.is_empty() && npts >= BATCH_KERNEL_MIN_POINTS {
             if let Some(b2) = self.batch2.get_or_init(|| batch::Batch2::build(self)) {
-                return self.eval_batch_g2(b2, z, values, log_scale);
+                return self
+                    .eval_batch_g2(b2, z, values, log_scale, false)
+                    .map(|_| ());
             }
         }
         let gstride = if gradient.is_empty() { 0 } else { n * g };
@@ -782,8 +784,10 @@ impl ThetaPlan {
         z: &[Complex64],
         values: &mut [Complex64],
         log_scale: &mut [f64],
-    ) -> Result<()> {
+        scaled: bool,
+    ) -> Result<bool> {
         const L: usize = batch::LANES;
+        let mut finite = true;
         let zero = Complex64::new(0.0, 0.0);
         let npts = log_scale.len();
         let mut sc = b2.scratch();
@@ -803,12 +807,42 @@ impl ThetaPlan {
             for p in 0..m {
                 let k = i0 + p;
                 let class_sum = |r: usize| Complex64::new(sc.sre[r][p], sc.sim[r][p]);
-                self.combine_g2_values(&reds[p], class_sum, &mut values[16 * k..16 * k + 16]);
-                log_scale[k] = reds[p].log_scale;
+                let mut red = reds[p];
+                if scaled {
+                    red.prefactor *= red.log_scale.exp();
+                }
+                let out = &mut values[16 * k..16 * k + 16];
+                self.combine_g2_values(&red, class_sum, out);
+                // |Ω| ≤ number of terms ≤ MAX_TERMS = 2e8, so exp(L)|Ω| < f64::MAX for L ≤ 690
+                if scaled && red.log_scale > 690.0 {
+                    finite &= out.iter().all(|v| v.re.is_finite() && v.im.is_finite());
+                }
+                log_scale[k] = red.log_scale;
             }
             i0 += m;
         }
-        Ok(())
+        Ok(finite)
+    }
+}
+
+impl ThetaPlan {
+    /// Values θ themselves (not normalised) for a batch, as [`ThetaPlan::eval_batch`]
+    /// without derivatives followed by [`apply_scale`], but with the scaling fused
+    /// into the genus-2 kernel. Returns `Ok(false)` if some value overflows.
+    pub fn eval_batch_scaled(
+        &self,
+        z: &[Complex64],
+        values: &mut [Complex64],
+        log_scale: &mut [f64],
+    ) -> Result<bool> {
+        let npts = log_scale.len();
+        if z.len() == 2 * npts && values.len() == 16 * npts && npts >= BATCH_KERNEL_MIN_POINTS {
+            if let Some(b2) = self.batch2.get_or_init(|| batch::Batch2::build(self)) {
+                return self.eval_batch_g2(b2, z, values, log_scale, true);
+            }
+        }
+        self.eval_batch(z, values, &mut [], &mut [], log_scale)?;
+        Ok(apply_scale(values, &mut [], &mut [], log_scale))
     }
 }
 
