@@ -428,6 +428,10 @@ impl ThetaPlan {
                 ),
             });
         }
+        if ws.s0.len() != n || ws.s2.len() != n * g * g {
+            // a workspace made by a plan of another genus
+            *ws = self.workspace();
+        }
         let red = self.reduce(z)?;
         let (zr, wr) = (&red.zr[..g], &red.wr[..g]);
         ws.s0.iter_mut().for_each(|v| *v = Complex64::new(0.0, 0.0));

@@ -351,3 +351,35 @@ fn batch_kernel_matches_single_point_path() {
         }
     }
 }
+
+#[test]
+fn foreign_workspace_and_extreme_imaginary_parts() {
+    let p1 = ThetaPlan::new(&[C::new(0.1, 0.9)], 1, DEFAULT_TOL, 0).unwrap();
+    let p2 = ThetaPlan::new(&bench_tau(), 2, DEFAULT_TOL, 0).unwrap();
+    let mut ws = p1.workspace();
+    let mut v = vec![C::new(0.0, 0.0); 16];
+    let z = [C::new(0.2, 0.1), C::new(0.7, -0.3)];
+    p2.eval_into(&z, &mut ws, &mut v, &mut [], &mut []).unwrap();
+    assert_eq!(v, p2.theta_all(&z).unwrap().0);
+    // Im τ = 1000: θ[0;0] = 1 + O(e^{-1000π}); Im τ = 0.01 I: ~1.4e4 terms, generic path
+    for (tau, nmax) in [
+        (
+            tau2(C::new(0.3, 1000.0), C::new(0.1, 1.0), C::new(-0.2, 900.0)),
+            2,
+        ),
+        (
+            tau2(C::new(0.3, 0.01), C::new(0.0, 0.002), C::new(-0.2, 0.012)),
+            80,
+        ),
+    ] {
+        let z = [C::new(0.13, 0.002), C::new(-0.3, 0.001)];
+        let plan = ThetaPlan::new(&tau, 2, DEFAULT_TOL, 0).unwrap();
+        let (om, l) = plan.theta_all(&z).unwrap();
+        let want = brute(&z, &tau, 2, 0, nmax, &one);
+        let got = om[0] * l.exp();
+        assert!(
+            (got - want).norm() <= AGREE * want.norm() * 10.0,
+            "{got} vs {want}"
+        );
+    }
+}
