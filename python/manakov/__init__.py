@@ -8,6 +8,17 @@ Equation numbers in docstrings are the paper's.
 from ._core import ConvergenceError, __version__
 from .curve import CurvePoints, KotterCurve, Wurzel
 from .problems import Problem, benchmark_setup, problem, problem_names
+from .theta import (
+    CHARACTERISTICS,
+    PAPER_CHARACTERISTICS,
+    PAPER_TABLE_35,
+    char_index,
+    characteristics,
+    parity,
+    theta,
+    theta_all,
+    theta_jet,
+)
 from .top import (
     METHODS,
     FrahmTop,
@@ -19,21 +30,29 @@ from .top import (
 )
 
 __all__ = [
+    "benchmark_setup",
+    "char_index",
+    "CHARACTERISTICS",
+    "characteristics",
     "ConvergenceError",
     "CurvePoints",
-    "KotterCurve",
-    "Problem",
-    "Wurzel",
     "FrahmTop",
-    "METHODS",
-    "ManakovTop",
-    "Problem",
-    "Trajectory",
-    "__version__",
-    "benchmark_setup",
     "from_matrix",
+    "KotterCurve",
+    "ManakovTop",
+    "METHODS",
+    "PAPER_CHARACTERISTICS",
+    "PAPER_TABLE_35",
+    "parity",
     "poisson_tensor",
     "problem",
+    "Problem",
     "problem_names",
+    "theta",
+    "theta_all",
+    "theta_jet",
     "to_matrix",
+    "Trajectory",
+    "Wurzel",
+    "__version__",
 ]

@@ -22,9 +22,13 @@ __all__ = [
     "manakov_integrals",
     "poisson_tensor",
     "so4_integrals",
+    "theta_jet",
+    "theta_plan_info",
     "vector_field",
     "__version__",
 ]
+
+__all__ = ["ConvergenceError", "__version__", "theta_jet", "theta_plan_info"]
 
 __version__: str
 
@@ -99,3 +103,19 @@ def integrate_many(
 def gauss_tableau(
     method: str,
 ) -> tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]: ...
+def theta_jet(
+    z: npt.NDArray[np.complex128],
+    tau: npt.NDArray[np.complex128],
+    tol: float,
+    order: int,
+    scaled: bool,
+) -> tuple[
+    npt.NDArray[np.complex128],
+    npt.NDArray[np.complex128],
+    npt.NDArray[np.complex128],
+    npt.NDArray[np.float64],
+    bool,
+]: ...
+def theta_plan_info(
+    tau: npt.NDArray[np.complex128], tol: float, order: int
+) -> tuple[float, float, float, float]: ...

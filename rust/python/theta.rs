@@ -1,8 +1,118 @@
 //! Bindings for `crate::theta`.
 
+use num_complex::Complex64;
+use numpy::ndarray::{Array2, Array3, Array4};
+use numpy::{IntoPyArray, PyArray1, PyArray2, PyArray3, PyArray4, PyReadonlyArray2};
 use pyo3::prelude::*;
 
+use crate::error::Error;
+use crate::theta::{apply_scale, ThetaPlan};
+
+type Jet<'py> = (
+    Bound<'py, PyArray2<Complex64>>,
+    Bound<'py, PyArray3<Complex64>>,
+    Bound<'py, PyArray4<Complex64>>,
+    Bound<'py, PyArray1<f64>>,
+    bool,
+);
+
+fn read_tau(tau: &PyReadonlyArray2<'_, Complex64>) -> Result<(Vec<Complex64>, usize), Error> {
+    let t = tau.as_array();
+    let (r, c) = t.dim();
+    if r != c || r == 0 {
+        return Err(Error::Shape {
+            what: "tau",
+            expected: "(g, g) with g >= 1".into(),
+            got: format!("({r}, {c})"),
+        });
+    }
+    Ok((t.iter().copied().collect(), r))
+}
+
+/// All 4^g theta values (FLINT order) and their z-derivatives up to `order` at
+/// `n` points `z` (shape (n, g)): returns (values (n, 4^g), gradient
+/// (n, 4^g, g or 0), hessian (n, 4^g, g, g or 0), log_scale (n,), finite),
+/// normalised so that θ = exp(log_scale) · values; with `scaled` the arrays hold
+/// θ itself and `finite` is false if some value overflowed.
+#[pyfunction(name = "theta_jet")]
+#[pyo3(signature = (z, tau, tol, order, scaled))]
+fn theta_jet_py<'py>(
+    py: Python<'py>,
+    z: PyReadonlyArray2<'py, Complex64>,
+    tau: PyReadonlyArray2<'py, Complex64>,
+    tol: f64,
+    order: usize,
+    scaled: bool,
+) -> PyResult<Jet<'py>> {
+    let (tau_v, g) = read_tau(&tau)?;
+    let zv = z.as_array();
+    let (npts, gz) = zv.dim();
+    if gz != g {
+        return Err(Error::Shape {
+            what: "z",
+            expected: format!("(..., {g})"),
+            got: format!("(..., {gz})"),
+        }
+        .into());
+    }
+    let z_flat: Vec<Complex64> = match zv.as_slice() {
+        Some(contiguous) => contiguous.to_vec(),
+        None => zv.iter().copied().collect(),
+    };
+    let n = 1usize << (2 * g);
+    let (gd, hd) = match order {
+        0 => (0, 0),
+        1 => (g, 0),
+        _ => (g, g),
+    };
+    let (values, gradient, hessian, logs, finite) = py.detach(move || -> Result<_, Error> {
+        let plan = ThetaPlan::new(&tau_v, g, tol, order)?;
+        let zero = Complex64::new(0.0, 0.0);
+        let mut values = vec![zero; npts * n];
+        let mut gradient = vec![zero; npts * n * gd];
+        let mut hessian = vec![zero; npts * n * g * hd];
+        let mut logs = vec![0.0; npts];
+        let finite = if scaled && order == 0 {
+            plan.eval_batch_scaled(&z_flat, &mut values, &mut logs)?
+        } else {
+            plan.eval_batch(&z_flat, &mut values, &mut gradient, &mut hessian, &mut logs)?;
+            !scaled || apply_scale(&mut values, &mut gradient, &mut hessian, &logs)
+        };
+        Ok((values, gradient, hessian, logs, finite))
+    })?;
+    let shape_err = |e: numpy::ndarray::ShapeError| Error::Shape {
+        what: "theta output",
+        expected: "consistent sizes".into(),
+        got: e.to_string(),
+    };
+    let values = Array2::from_shape_vec((npts, n), values).map_err(shape_err)?;
+    let gradient = Array3::from_shape_vec((npts, n, gd), gradient).map_err(shape_err)?;
+    let hessian = Array4::from_shape_vec((npts, n, gd, hd), hessian).map_err(shape_err)?;
+    Ok((
+        values.into_pyarray(py),
+        gradient.into_pyarray(py),
+        hessian.into_pyarray(py),
+        logs.into_pyarray(py),
+        finite,
+    ))
+}
+
+/// (radius, rho, error_bound, expected_terms) of the summation plan for `tau`.
+#[pyfunction(name = "theta_plan_info")]
+#[pyo3(signature = (tau, tol, order))]
+fn theta_plan_info_py(
+    tau: PyReadonlyArray2<'_, Complex64>,
+    tol: f64,
+    order: usize,
+) -> PyResult<(f64, f64, f64, f64)> {
+    let (tau_v, g) = read_tau(&tau)?;
+    let info = ThetaPlan::new(&tau_v, g, tol, order)?.info();
+    Ok((info.radius, info.rho, info.error_bound, info.expected_terms))
+}
+
 /// Adds this module's functions to `manakov._core`.
-pub fn register(_m: &Bound<'_, PyModule>) -> PyResult<()> {
+pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_function(wrap_pyfunction!(theta_jet_py, m)?)?;
+    m.add_function(wrap_pyfunction!(theta_plan_info_py, m)?)?;
     Ok(())
 }

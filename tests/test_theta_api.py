@@ -1,0 +1,237 @@
+"""The theta API: shapes, dtypes, exceptions, the exponential split, and the
+proven truncation bound checked against python-flint's certified values."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from flint import acb, acb_mat, ctx
+
+import manakov
+from manakov import _core, theta, theta_all, theta_jet
+
+BENCH_TAU = np.array([[0.3 + 1.1j, 0.1 + 0.4j], [0.1 + 0.4j, -0.2 + 1.3j]])
+Z0 = np.array([0.2 + 0.1j, 0.7 - 0.3j])
+
+
+def flint_theta(z, tau, prec: int = 200) -> np.ndarray:
+    old = ctx.prec
+    ctx.prec = prec
+    try:
+        t = acb_mat([[acb(complex(x).real, complex(x).imag) for x in r] for r in tau])
+        zz = acb_mat([[acb(complex(x).real, complex(x).imag)] for x in z])
+        res = t.theta(zz)
+        out = np.array([complex(res[0, i]) for i in range(res.ncols())])
+        if np.all(np.isfinite(out)):
+            # certified: the balls' radii are far below anything compared here
+            rad = max(float(res[0, i].rad()) for i in range(res.ncols()))
+            assert rad < 1e-30 * np.max(np.abs(out))
+        return out
+    finally:
+        ctx.prec = old
+
+
+# --- shapes and dtypes ------------------------------------------------------------
+
+
+def test_leading_shapes_and_scalar_out():
+    rng = np.random.default_rng(0)
+    z = rng.normal(size=(3, 4, 2)) + 1j * rng.normal(size=(3, 4, 2)) * 0.3
+    out = theta_all(z, BENCH_TAU)
+    assert out.shape == (3, 4, 16)
+    for i in range(3):
+        for j in range(4):
+            np.testing.assert_array_equal(out[i, j], theta_all(z[i, j], BENCH_TAU))
+    assert theta_all(Z0, BENCH_TAU).shape == (16,)
+    one = theta(Z0, BENCH_TAU)
+    assert isinstance(one, complex)
+    assert theta(z, BENCH_TAU, 5).shape == (3, 4)
+    assert theta(z, BENCH_TAU, 5, derivs=(0, 1)).shape == (3, 4)
+    v, g, h = theta_jet(z, BENCH_TAU, "theta0")
+    assert v.shape == (3, 4) and g.shape == (3, 4, 2) and h.shape == (3, 4, 2, 2)
+    v, g, h = theta_jet(z, BENCH_TAU, all_chars=True)
+    assert v.shape == (3, 4, 16) and g.shape == (3, 4, 16, 2) and h.shape == (3, 4, 16, 2, 2)
+    assert theta_all(np.zeros((0, 2)), BENCH_TAU).shape == (0, 16)
+
+
+def test_dtypes_readonly_noncontiguous_inputs_unchanged():
+    big = np.zeros((5, 4), complex)
+    big[:, ::2] = np.array([[0.1 + 0.2j, -0.3j]] * 5)
+    z = big[:, ::2]  # non-contiguous view
+    assert not z.flags["C_CONTIGUOUS"]
+    tau = np.asfortranarray(BENCH_TAU.copy())
+    tau.setflags(write=False)
+    zc = z.copy()
+    res = theta_all(z, tau)
+    np.testing.assert_array_equal(res, theta_all(np.ascontiguousarray(zc), BENCH_TAU))
+    np.testing.assert_array_equal(z, zc)
+    # real and integer inputs are converted
+    assert np.allclose(theta_all([0, 0], BENCH_TAU), theta_all([0j, 0j], BENCH_TAU), rtol=0, atol=0)
+    assert np.all(np.isfinite(theta_all([[0.25, 0.5]], np.array([[1j, 0], [0, 1j]]))))
+
+
+def test_genus_one_and_three_shapes():
+    assert theta_all([0.1], [[1j]]).shape == (4,)
+    assert theta_all([0.1], 1j).shape == (4,)  # a 0-d tau is genus 1
+    tau3 = np.eye(3) * 1.2j + 0.1j * (np.ones((3, 3)) - np.eye(3))
+    assert theta_all(np.zeros(3), tau3).shape == (64,)
+    assert len(manakov.characteristics(3)) == 64
+
+
+# --- exceptions ----------------------------------------------------------------------
+
+
+@pytest.mark.parametrize(
+    ("tau", "match"),
+    [
+        (np.array([[1j, 0.1j], [0.2j, 1j]]), "symmetric"),
+        (np.array([[1j, 2j], [2j, 1j]]), r"smallest eigenvalue is -1(\.0)?e0"),
+        (np.array([[-1j, 0], [0, 1j]]), "smallest eigenvalue"),
+        (np.array([[np.nan, 0], [0, 1j]]), "finite"),
+        (np.array([[np.inf * 1j, 0], [0, 1j]]), "finite"),
+        (np.ones((2, 3)) * 1j, "shape"),
+        (np.ones((2, 2, 2)) * 1j, "shape"),
+        (np.eye(7) * 1j, "genus|1..=6"),
+        (np.zeros((2, 2)), "smallest eigenvalue"),
+    ],
+)
+def test_bad_tau_raises_value_error(tau, match):
+    with pytest.raises(ValueError, match=match):
+        theta_all(np.zeros(tau.shape[0] if tau.ndim == 2 else 2), tau)
+
+
+@pytest.mark.parametrize(
+    "z",
+    [
+        np.array([np.nan, 0.0]),
+        np.array([0.0, complex(0, np.inf)]),
+        np.zeros(3),
+        np.zeros((4, 1)),
+        np.array(0.5),
+    ],
+)
+def test_bad_z_raises_value_error(z):
+    with pytest.raises(ValueError):
+        theta_all(z, BENCH_TAU)
+
+
+@pytest.mark.parametrize(
+    "char",
+    [16, -1, "theta99", ((0, 2), (0, 0)), ((0,), (0,)), ((0, 0, 0), (0, 0, 0)), "x", 1.5, True],
+)
+def test_unknown_characteristic_raises_value_error(char):
+    with pytest.raises(ValueError):
+        theta(Z0, BENCH_TAU, char)
+
+
+@pytest.mark.parametrize("derivs", [(2,), (0, 0, 1), (-1,)])
+def test_bad_derivs_raise_value_error(derivs):
+    with pytest.raises(ValueError):
+        theta(Z0, BENCH_TAU, derivs=derivs)
+
+
+@pytest.mark.parametrize("tol", [0.0, -1e-3, 1.0, np.nan])
+def test_bad_tol_raises_value_error(tol):
+    with pytest.raises(ValueError):
+        theta_all(Z0, BENCH_TAU, tol=tol)
+
+
+def test_far_too_ill_conditioned_tau_is_refused_not_hung():
+    with pytest.raises(ValueError, match="terms"):
+        theta_all(Z0, np.eye(2) * 1e-9j)
+
+
+def test_overflow_raises_and_log_scale_does_not():
+    z = np.array([0.1 + 300j, 0.2 - 250j])
+    with pytest.raises(OverflowError, match="log_scale"):
+        theta_all(z, BENCH_TAU)
+    om, log = theta_all(z, BENCH_TAU, log_scale=True)
+    assert np.all(np.isfinite(om)) and np.isfinite(log) and log > 709
+    # L = pi y^T Y^{-1} y, computed independently
+    y = z.imag
+    assert log == pytest.approx(np.pi * y @ np.linalg.solve(BENCH_TAU.imag, y), rel=1e-13)
+    # at moderate Im z the split product equals flint's theta
+    z_small = np.array([0.1 + 3j, 0.2 - 2.5j])
+    om, log = theta_all(z_small, BENCH_TAU, log_scale=True)
+    ref = flint_theta(z_small, BENCH_TAU)
+    assert np.max(np.abs(om * np.exp(log) - ref)) <= 1e-13 * np.max(np.abs(ref))
+
+
+def test_overflow_in_a_large_batch():
+    """Batches of >= 64 points scale inside the vectorised kernel; one overflowing
+    point must still raise, and log_scale must still work."""
+    z = np.zeros((100, 2), complex)
+    z[:, 0] = np.linspace(0, 1, 100) + 0.1j
+    z[57] = [0.1 + 300j, 0.2 - 250j]
+    with pytest.raises(OverflowError, match="log_scale"):
+        theta_all(z, BENCH_TAU)
+    om, log = theta_all(z, BENCH_TAU, log_scale=True)
+    assert np.all(np.isfinite(om)) and log.shape == (100,) and log[57] > 709
+    ok = np.delete(np.arange(100), 57)
+    np.testing.assert_allclose(
+        theta_all(z[ok], BENCH_TAU), om[ok] * np.exp(log[ok])[:, None], rtol=1e-14, atol=0
+    )
+
+
+def test_value_error_not_panic_for_huge_imag_z():
+    with pytest.raises(ValueError):
+        theta_all(np.array([0.0, 1e300j]), BENCH_TAU, log_scale=True)
+
+
+# --- the proven truncation bound against flint ------------------------------------
+
+
+def normalised_flint(z, tau):
+    y = np.asarray(z).imag
+    log = np.pi * y @ np.linalg.solve(tau.imag, y)
+    return flint_theta(z, tau) * np.exp(-log)
+
+
+#: Rounding error of the sum itself (about 1e-16 of the sum of |terms| <= ~4);
+#: added to tol when checking the truncation bound.
+ROUNDING = 1e-15
+
+
+@pytest.mark.parametrize("tol", [1e-3, 1e-6, 1e-9, 1e-12])
+def test_truncation_error_within_tol_against_flint(tol):
+    """Points in the fundamental cell (no z reduction), reduced and skewed tau:
+    |Omega - Omega_flint| <= tol (+ rounding) for every characteristic. The
+    largest observed error is also reported to show the bound is not vacuous."""
+    rng = np.random.default_rng(int(-np.log10(tol)))
+    worst_ratio = 0.0
+    checked = 0
+    for k in range(30):
+        q, _ = np.linalg.qr(rng.normal(size=(2, 2)))
+        y = q @ np.diag(rng.uniform(0.5, 2.0, 2)) @ q.T
+        x = rng.uniform(-0.5, 0.5, (2, 2))
+        tau = (x + x.T) / 2 + 1j * (y + y.T) / 2
+        if k % 3 == 0:
+            u = np.array([[1, 1], [0, 1]]) if k % 2 else np.array([[2, 1], [1, 1]])
+            tau = u @ tau @ u.T
+        z = rng.uniform(-0.5, 0.5, 2) + tau.imag @ rng.uniform(-0.45, 0.45, 2) * 1j
+        om, _ = theta_all(z, tau, tol=tol, log_scale=True)
+        radius, rho, bound, _ = _core.theta_plan_info(np.ascontiguousarray(tau), tol, 0)
+        assert bound <= tol
+        ref = normalised_flint(z, tau)
+        if not np.all(np.isfinite(ref)):
+            continue  # python-flint 0.9 returns indeterminate balls for some skewed tau
+        checked += 1
+        err = np.max(np.abs(om - ref))
+        assert err <= tol + ROUNDING
+        worst_ratio = max(worst_ratio, err / tol)
+    assert checked >= 20
+    # the radius is not so generous that nothing is ever truncated
+    if tol >= 1e-9:
+        assert worst_ratio > 1e-3  # measured 0.008-0.03: the bound is within ~100x
+
+
+def test_derivative_truncation_within_tol():
+    """order 2 plans bound the gradient and Hessian truncation too; compared with a
+    converged default-tol jet (itself checked against flint in test_theta.py)."""
+    rng = np.random.default_rng(3)
+    for tol in (1e-4, 1e-8):
+        z = rng.uniform(-0.5, 0.5, 2) + 1j * BENCH_TAU.imag @ rng.uniform(-0.4, 0.4, 2)
+        v, g, h, _ = theta_jet(z, BENCH_TAU, all_chars=True, tol=tol, log_scale=True)
+        v0, g0, h0, _ = theta_jet(z, BENCH_TAU, all_chars=True, log_scale=True)
+        for a, b in ((v, v0), (g, g0), (h, h0)):
+            assert np.max(np.abs(a - b)) <= tol + 1e-13
