@@ -1,1 +1,629 @@
-//! Schottky's l(s), f(s) (12)–(17) and Kötter's reduction (18)–(26), (37)–(41).
+//! Schottky's `l(s)`, `f(s)` (12)–(17) and Kötter's reduction (18)–(26),
+//! (37)–(41): from a state `l` of the top to the vectors `ξ, η`, the constants
+//! `d_j` of Kötter's quadrics (11) and of the curve (8), and back.
+//!
+//! # Notation and conventions (all of them; see `docs/kotter.md`)
+//!
+//! * State `l = (l12, l13, l14, l23, l24, l34)`; `m_j = l_kl`, `n_j = l_j4` (13)
+//!   with `(j, k, l)` cyclic in `(1, 2, 3)`: `m = (l23, l31, l12)`,
+//!   `n = (l14, l24, l34)`.
+//! * Integrals: `h0 = l12 l34 + l23 l14 + l31 l24` (6), `h1 = Σ l_jk²`, and
+//!   **`h2 = Σ_{j<k} (a_l + a_m) l_jk²`, `h3 = Σ_{j<k} a_l a_m l_jk²`** with
+//!   `{l, m}` the complement of `{j, k}` — the forms for which the closed form
+//!   (14) holds (erratum to (7)/(14), `docs/errata-kotter.md`).
+//! * `√s_j4` is the principal root of `s_j4 = (s − a_j)(s − a_4)`, and
+//!   `√s_kl := √G / √s_j4` for a chosen branch `√G` of `G(s) = Π (s − a_j)`,
+//!   so that `√s_j4 √s_kl = √G` for every `j` (the cross term of (14)).
+//! * At a root `s_p` of `F` (18), the branch of `√G` is
+//!   `σ_p = −(h1 s_p² − h2 s_p + h3)/(2 h0)`, the one on which `f(s_p) = 0`.
+//! * `√F'(s_p)` principal. Order of the roots: `s1` the non-real root of
+//!   largest imaginary part, `s2` the root nearest `conj(s1)`, `s3` the
+//!   remaining root of larger imaginary part (then larger real part), `s4`
+//!   the last; when all four are real, descending order. With this order
+//!   `l^(2) = conj(l^(1))` for real `l` whenever `s2 = conj(s1)`.
+//! * `Δ_j^(p)` (25) is the 2×2 determinant
+//!   `(√s_j4^(q) √s_kl^(r) − √s_j4^(r) √s_kl^(q)) / (√F'(s_q) √F'(s_r))`
+//!   (erratum: printed with one root over the whole difference).
+
+use nalgebra::{DMatrix, DVector};
+use num_complex::Complex64;
+
+use crate::error::{check_finite, Error, Result};
+
+type C = Complex64;
+
+const ZERO: C = C::new(0.0, 0.0);
+const ONE: C = C::new(1.0, 0.0);
+const I: C = C::new(0.0, 1.0);
+
+/// `(j, k, l)` cyclic permutations of `(1, 2, 3)`, 0-based, in the order `j = 1, 2, 3`.
+pub const CYCLIC: [(usize, usize, usize); 3] = [(0, 1, 2), (1, 2, 0), (2, 0, 1)];
+
+/// `|h1² − 4 h0²| ≤ DEGENERATE_RTOL · h1²` is treated as `h1² = 4 h0²`: the
+/// denominator of (18) vanishes. `h1² − 4h0² = |m − n|² |m + n|² ≥ 0` is a
+/// difference of rounded squares, accurate to a few ulps of `h1²`; 1e-12
+/// leaves room for that and for states given to ~12 digits.
+pub const DEGENERATE_RTOL: f64 = 1e-12;
+
+/// Roots of `F` closer than `REPEATED_ROOT_RTOL` times their scale are
+/// treated as repeated: then `F'(s_p) → 0` and `l^(p)` (19) is undefined. A
+/// double root is located only to `√ε ≈ 1.5e-8` relative, so two roots
+/// within 1e-7 are indistinguishable from a double root.
+pub const REPEATED_ROOT_RTOL: f64 = 1e-7;
+
+/// Residual (relative to the size of the data) above which the structural
+/// fits of (37)–(39) are reported as failing: the nine equations for six
+/// unknowns are consistent to rounding (a few 1e-13 on the reference tops);
+/// 1e-8 rejects a genuinely inconsistent system.
+pub const STRUCTURE_RTOL: f64 = 1e-8;
+
+/// Principal square root `−π/2 < arg √w ≤ π/2`, with `√(−x) = +i√x` for
+/// `x > 0` whatever the sign of a zero imaginary part (the curve module's
+/// convention, so both modules cut `(−∞, 0)` on the same side).
+pub fn sqrt_principal(w: C) -> C {
+    let (re, im) = (w.re, w.im + 0.0);
+    if re == 0.0 && im == 0.0 {
+        return ZERO;
+    }
+    let t = ((re.hypot(im) + re.abs()) / 2.0).sqrt();
+    if re >= 0.0 {
+        C::new(t, im / (2.0 * t))
+    } else {
+        C::new(im.abs() / (2.0 * t), t.copysign(im))
+    }
+}
+
+fn check_a(a: &[f64; 4]) -> Result<()> {
+    check_finite("a", a)?;
+    for i in 0..4 {
+        for j in (i + 1)..4 {
+            if a[i] == a[j] {
+                return Err(Error::RepeatedA { i, j, value: a[i] });
+            }
+        }
+    }
+    Ok(())
+}
+
+/// `(m, n)` of (13): `m_j = l_kl`, `n_j = l_j4`, from `l = (l12, l13, l14, l23, l24, l34)`.
+pub fn m_n(l: &[f64; 6]) -> ([f64; 3], [f64; 3]) {
+    ([l[3], -l[1], l[0]], [l[2], l[4], l[5]])
+}
+
+/// Inverse of [`m_n`]: `l = (m3, −m2, n1, m1, n2, n3)`.
+pub fn l_from_m_n(m: &[f64; 3], n: &[f64; 3]) -> [f64; 6] {
+    [m[2], -m[1], n[0], m[0], n[1], n[2]]
+}
+
+/// The integrals `(h0, h1, h2, h3)`: `H0` (6), `H1` (7), and `H2`, `H3` in the
+/// form consistent with (14): `H2 = Σ_{j<k} (a_l + a_m) l_jk²`,
+/// `H3 = Σ_{j<k} a_l a_m l_jk²`, `{l, m}` the complement of `{j, k}`.
+pub fn integrals(a: &[f64; 4], l: &[f64; 6]) -> [f64; 4] {
+    let (m, n) = m_n(l);
+    let h0 = m[0] * n[0] + m[1] * n[1] + m[2] * n[2];
+    let mut h = [h0, 0.0, 0.0, 0.0];
+    for (j, &(_, k, ll)) in CYCLIC.iter().enumerate() {
+        // m_j = l_kl has complement {j, 4}; n_j = l_j4 has complement {k, l}.
+        h[1] += m[j] * m[j] + n[j] * n[j];
+        h[2] += (a[j] + a[3]) * m[j] * m[j] + (a[k] + a[ll]) * n[j] * n[j];
+        h[3] += a[j] * a[3] * m[j] * m[j] + a[k] * a[ll] * n[j] * n[j];
+    }
+    h
+}
+
+/// `s_jk = (s − a_j)(s − a_k)` (13), 0-based indices.
+fn s_pair(s: C, a: &[f64; 4], j: usize, k: usize) -> C {
+    (s - a[j]) * (s - a[k])
+}
+
+/// `G(s) = Π_{j=1}^{4} (s − a_j)` (14).
+pub fn g_poly(a: &[f64; 4], s: C) -> C {
+    a.iter().fold(ONE, |acc, &aj| acc * (s - aj))
+}
+
+/// Schottky's vector (12) and the vector `m(s)` of (16) on the branch
+/// `√s_j4 √s_kl = sqrt_g` (`√s_j4` principal, see the module docs):
+/// `l_j(s) = √s_j4 m_j + √s_kl n_j`, `m_j(s) = √s_kl m_j + √s_j4 n_j`.
+///
+/// Errors if `s = a_j` or `s = a_4` for some `j` (then `√s_kl = √G/√s_j4` is 0/0).
+pub fn schottky(a: &[f64; 4], l: &[f64; 6], s: C, sqrt_g: C) -> Result<([C; 3], [C; 3])> {
+    let (m, n) = m_n(l);
+    let mut lv = [ZERO; 3];
+    let mut mv = [ZERO; 3];
+    for (j, _) in CYCLIC.iter().enumerate() {
+        let r = sqrt_principal(s_pair(s, a, j, 3));
+        if r == ZERO {
+            return Err(Error::InvalidArgument {
+                what: "s",
+                reason: format!(
+                    "s = {s} is a root of s_j4 (j = {}): l(s) (12) is taken at s != a_i",
+                    j + 1
+                ),
+            });
+        }
+        let q = sqrt_g / r;
+        lv[j] = r * m[j] + q * n[j];
+        mv[j] = q * m[j] + r * n[j];
+    }
+    Ok((lv, mv))
+}
+
+/// The polynomial part `h1 s² − h2 s + h3` of (14).
+pub fn p_poly(h: &[f64; 4], s: C) -> C {
+    (s * h[1] - h[2]) * s + h[3]
+}
+
+/// Coefficients of `F(s)` (18), monic, highest power first:
+/// `F = [(h1 s² − h2 s + h3)² − 4 h0² G(s)] / (h1² − 4 h0²)`.
+///
+/// Errors: `h1² = 4 h0²` (to [`DEGENERATE_RTOL`]), i.e. `m = ±n`: (18) is not
+/// defined (and `f(s)` has fewer than four zeros).
+pub fn quartic_f(a: &[f64; 4], h: &[f64; 4]) -> Result<[f64; 5]> {
+    let [h0, h1, h2, h3] = *h;
+    let den = h1 * h1 - 4.0 * h0 * h0;
+    if den.abs() <= DEGENERATE_RTOL * h1 * h1 || h1 == 0.0 {
+        return Err(Error::InvalidArgument {
+            what: "state l",
+            reason: format!(
+                "h1^2 - 4 h0^2 = {den:e} vanishes (h1 = {h1}, h0 = {h0}; the state is \
+                 self-dual or anti-self-dual, m = +-n): F(s) (18) is not defined"
+            ),
+        });
+    }
+    // G(s) = s^4 - e1 s^3 + e2 s^2 - e3 s + e4
+    let mut g = [1.0, 0.0, 0.0, 0.0, 0.0];
+    for &aj in a {
+        for i in (1..5).rev() {
+            g[i] -= aj * g[i - 1];
+        }
+    }
+    let p2 = [
+        h1 * h1,
+        -2.0 * h1 * h2,
+        h2 * h2 + 2.0 * h1 * h3,
+        -2.0 * h2 * h3,
+        h3 * h3,
+    ];
+    let mut f = [0.0; 5];
+    for i in 0..5 {
+        f[i] = (p2[i] - 4.0 * h0 * h0 * g[i]) / den;
+    }
+    Ok(f)
+}
+
+fn horner(c: &[f64; 5], s: C) -> (C, C) {
+    let mut p = C::new(c[0], 0.0);
+    let mut dp = ZERO;
+    for &ci in &c[1..] {
+        dp = dp * s + p;
+        p = p * s + ci;
+    }
+    (p, dp)
+}
+
+/// The four roots of the monic quartic `F` (18), by the Aberth–Ehrlich
+/// iteration followed by Newton polishing, in the documented order (module
+/// docs).
+///
+/// Errors: two roots closer than [`REPEATED_ROOT_RTOL`] (repeated roots of
+/// F, where (19) divides by `F'(s_p) = 0`); no convergence.
+pub fn quartic_roots(f: &[f64; 5]) -> Result<[C; 4]> {
+    check_finite("F coefficients", f)?;
+    // Cauchy bound for the initial circle.
+    let rad = 1.0 + f[1..].iter().fold(0.0f64, |m, c| m.max(c.abs()));
+    let mut z: [C; 4] =
+        std::array::from_fn(|k| C::from_polar(rad * 0.5, 0.4 + 1.5707963 * k as f64));
+    let mut converged = false;
+    let mut last = f64::INFINITY;
+    for _ in 0..500 {
+        let mut maxstep = 0.0f64;
+        for k in 0..4 {
+            let (p, dp) = horner(f, z[k]);
+            if p == ZERO {
+                continue;
+            }
+            let ratio = p / dp;
+            let mut sum = ZERO;
+            for j in 0..4 {
+                if j != k {
+                    sum += ONE / (z[k] - z[j]);
+                }
+            }
+            let w = ratio / (ONE - ratio * sum);
+            z[k] -= w;
+            maxstep = maxstep.max(w.norm() / (1.0 + z[k].norm()));
+        }
+        last = maxstep;
+        if maxstep < 1e-15 {
+            converged = true;
+            break;
+        }
+    }
+    if !converged && last > 1e-12 {
+        return Err(Error::NoConvergence {
+            what: "roots of F(s) (18)",
+            tol: 1e-15,
+            reached: last,
+            iterations: 500,
+        });
+    }
+    for zk in z.iter_mut() {
+        for _ in 0..2 {
+            let (p, dp) = horner(f, *zk);
+            if dp != ZERO {
+                *zk -= p / dp;
+            }
+        }
+    }
+    let scale = z.iter().fold(1.0f64, |m, v| m.max(v.norm()));
+    for i in 0..4 {
+        for j in (i + 1)..4 {
+            if (z[i] - z[j]).norm() <= REPEATED_ROOT_RTOL * scale {
+                return Err(Error::InvalidArgument {
+                    what: "state l",
+                    reason: format!(
+                        "F(s) (18) has a repeated root s = {} (|s_{} - s_{}| = {:e}): l^(p) (19) \
+                         divides by sqrt(F'(s_p)) = 0",
+                        z[i],
+                        i + 1,
+                        j + 1,
+                        (z[i] - z[j]).norm()
+                    ),
+                });
+            }
+        }
+    }
+    Ok(order_roots(z, scale))
+}
+
+fn order_roots(z: [C; 4], scale: f64) -> [C; 4] {
+    // A root counts as real when its imaginary part is at rounding level.
+    let is_real = |x: &C| x.im.abs() <= 1e-12 * scale;
+    let mut r: Vec<C> = z.to_vec();
+    let by_im_re = |x: &C, y: &C| {
+        x.im.partial_cmp(&y.im)
+            .unwrap_or(std::cmp::Ordering::Equal)
+            .then(x.re.partial_cmp(&y.re).unwrap_or(std::cmp::Ordering::Equal))
+    };
+    if r.iter().any(|x| !is_real(x)) {
+        let i1 = (0..4)
+            .filter(|&i| !is_real(&r[i]))
+            .max_by(|&i, &j| by_im_re(&r[i], &r[j]))
+            .unwrap_or(0);
+        let s1 = r.remove(i1);
+        let i2 = (0..3)
+            .min_by(|&i, &j| {
+                (r[i] - s1.conj())
+                    .norm()
+                    .partial_cmp(&(r[j] - s1.conj()).norm())
+                    .unwrap_or(std::cmp::Ordering::Equal)
+            })
+            .unwrap_or(0);
+        let s2 = r.remove(i2);
+        let (s3, s4) = if by_im_re(&r[0], &r[1]) == std::cmp::Ordering::Less {
+            (r[1], r[0])
+        } else {
+            (r[0], r[1])
+        };
+        [s1, s2, s3, s4]
+    } else {
+        r.sort_by(|x, y| y.re.partial_cmp(&x.re).unwrap_or(std::cmp::Ordering::Equal));
+        [
+            C::new(r[0].re, 0.0),
+            C::new(r[1].re, 0.0),
+            C::new(r[2].re, 0.0),
+            C::new(r[3].re, 0.0),
+        ]
+    }
+}
+
+/// The constants of Kötter's reduction for one level set `(a, h)`.
+///
+/// Everything here depends only on `a` and the integrals `h`, hence is
+/// constant along a trajectory; `ξ, η` ([`xi_eta`]) carry the time dependence.
+#[derive(Debug, Clone, PartialEq)]
+pub struct KotterConstants {
+    /// `(h0, h1, h2, h3)` ([`integrals`]).
+    pub h: [f64; 4],
+    /// Roots `s_1 … s_4` of `F` (18), in the documented order.
+    pub s: [C; 4],
+    /// `σ_p`, the branch of `√G(s_p)` on which `f(s_p) = 0`.
+    pub sigma: [C; 4],
+    /// `√F'(s_p)`, principal.
+    pub sqrt_fprime: [C; 4],
+    /// `u[p][j] = √s_j4(s_p) / √F'(s_p)` (coefficient of `m_j` in `l_j^(p)` (19)).
+    pub u: [[C; 3]; 4],
+    /// `v[p][j] = √s_kl(s_p) / √F'(s_p)` (coefficient of `n_j`).
+    pub v: [[C; 3]; 4],
+    /// `delta_det[p][j] = Δ_j^(p)` (25) (corrected: a 2×2 determinant), `p = 1, 2, 3`.
+    pub delta_det: [[C; 3]; 3],
+    /// `√d_j = (Δ_j^(1) − i Δ_j^(2)) / Δ_j^(3)` (26).
+    pub sqrt_d: [C; 3],
+    /// `d_j` (26), the constants of Kötter's quadrics (11) and of the curve (8).
+    pub d: [C; 3],
+    /// `α_j, β_j, γ_j, δ_j` of (23) in corrected form (24):
+    /// `m_j = α_j ξ_j + β_j η_j`, `n_j = γ_j ξ_j + δ_j η_j`.
+    pub alpha: [C; 3],
+    /// See [`KotterConstants::alpha`].
+    pub beta: [C; 3],
+    /// See [`KotterConstants::alpha`].
+    pub gamma: [C; 3],
+    /// See [`KotterConstants::alpha`].
+    pub delta: [C; 3],
+    /// `A_j` of (37)–(38): on Kötter's quadrics
+    /// `H0 = Σ_j A_j (ξ_j² − η_j²) + B_j ξ_j η_j`.
+    pub a_coef: [C; 3],
+    /// `B_j` of (37)–(38).
+    pub b_coef: [C; 3],
+    /// `(α, β, γ, δ)` of (38) (the paper's unnamed constants; not the `α_j` of (24)).
+    pub abgd38: [C; 4],
+    /// `ε` of (39)–(40), corrected: `H0 = K g² (1 − ε P_0)²` with [`KotterConstants::k`].
+    pub eps: C,
+    /// `K` of the corrected (39) (printed as `1/(4 ε d_4)`).
+    pub k: C,
+}
+
+/// Kötter's constants for the level set of the state `l` of the top with
+/// parameters `a` (only `a` and the integrals of `l` enter).
+///
+/// Errors: non-finite or repeated `a`; non-finite `l`; `h0 = 0` or
+/// `h1² = 4h0²` (F (18) not defined or with double roots); repeated roots of
+/// `F`; a root `s_p` at some `a_j` (then `√s_kl` is 0/0); `Δ_j^(3) = 0`
+/// (the pair `s1, s2` does not determine `m_j, n_j`); `d_j` zero or infinite.
+pub fn kotter_constants(a: &[f64; 4], l: &[f64; 6]) -> Result<KotterConstants> {
+    check_a(a)?;
+    check_finite("l", l)?;
+    let h = integrals(a, l);
+    constants_from_h(a, &h)
+}
+
+/// [`kotter_constants`] from the integrals `h = (h0, h1, h2, h3)` directly.
+pub fn constants_from_h(a: &[f64; 4], h: &[f64; 4]) -> Result<KotterConstants> {
+    check_a(a)?;
+    check_finite("h", h)?;
+    let f = quartic_f(a, h)?;
+    if h[0] == 0.0 || h[0].abs() <= DEGENERATE_RTOL * h[1] {
+        return Err(Error::InvalidArgument {
+            what: "state l",
+            reason: format!(
+                "h0 = {} vanishes: F(s) (18) = (h1 s^2 - h2 s + h3)^2 / h1^2 has double roots and \
+                 the branch sigma = -(h1 s^2 - h2 s + h3)/(2 h0) is undefined",
+                h[0]
+            ),
+        });
+    }
+    let s = quartic_roots(&f)?;
+    let scale_a = a.iter().fold(1.0f64, |m, v| m.max(v.abs()));
+    let mut sigma = [ZERO; 4];
+    let mut sqrt_fp = [ZERO; 4];
+    let mut u = [[ZERO; 3]; 4];
+    let mut v = [[ZERO; 3]; 4];
+    for p in 0..4 {
+        sigma[p] = -p_poly(h, s[p]) / (2.0 * h[0]);
+        sqrt_fp[p] = sqrt_principal(horner(&f, s[p]).1);
+        for (j, &aj) in a.iter().enumerate() {
+            if (s[p] - aj).norm() <= REPEATED_ROOT_RTOL * scale_a {
+                return Err(Error::InvalidArgument {
+                    what: "state l",
+                    reason: format!(
+                        "the root s_{} = {} of F (18) coincides with a_{} = {aj}: sqrt(s_kl) = \
+                         sqrt(G)/sqrt(s_j4) is 0/0 there",
+                        p + 1,
+                        s[p],
+                        j + 1
+                    ),
+                });
+            }
+        }
+        for j in 0..3 {
+            let r = sqrt_principal(s_pair(s[p], a, j, 3));
+            u[p][j] = r / sqrt_fp[p];
+            v[p][j] = sigma[p] / r / sqrt_fp[p];
+        }
+    }
+    let mut dd = [[ZERO; 3]; 3];
+    for (p, q, r) in [(0, 1, 2), (1, 2, 0), (2, 0, 1)] {
+        for j in 0..3 {
+            dd[p][j] = u[q][j] * v[r][j] - u[r][j] * v[q][j];
+        }
+    }
+    let mut sqrt_d = [ZERO; 3];
+    let mut d = [ZERO; 3];
+    let mut alpha = [ZERO; 3];
+    let mut beta = [ZERO; 3];
+    let mut gamma = [ZERO; 3];
+    let mut delta = [ZERO; 3];
+    for j in 0..3 {
+        let d3 = dd[2][j];
+        let size = (u[0][j].norm() + v[0][j].norm()) * (u[1][j].norm() + v[1][j].norm());
+        if d3.norm() <= 1e-12 * size {
+            return Err(Error::InvalidArgument {
+                what: "state l",
+                reason: format!(
+                    "Delta_{}^(3) (25) vanishes: l_j^(1), l_j^(2) do not determine m_j, n_j",
+                    j + 1
+                ),
+            });
+        }
+        sqrt_d[j] = (dd[0][j] - I * dd[1][j]) / d3;
+        d[j] = sqrt_d[j] * sqrt_d[j];
+        let (u1, v1, u2, v2) = (u[0][j], v[0][j], u[1][j], v[1][j]);
+        alpha[j] = (v2 + I * v1) / (2.0 * d3);
+        beta[j] = (v2 - I * v1) / (2.0 * d3);
+        gamma[j] = -(u2 + I * u1) / (2.0 * d3);
+        delta[j] = -(u2 - I * u1) / (2.0 * d3);
+        if !(d[j].norm() > 0.0 && d[j].norm().is_finite()) {
+            return Err(Error::InvalidArgument {
+                what: "state l",
+                reason: format!("d_{} = {} (26) is zero or infinite", j + 1, d[j]),
+            });
+        }
+    }
+    let (a_coef, b_coef, abgd38, eps, k) = h0_structure(&alpha, &beta, &gamma, &delta, &d)?;
+    Ok(KotterConstants {
+        h: *h,
+        s,
+        sigma,
+        sqrt_fprime: sqrt_fp,
+        u,
+        v,
+        delta_det: dd,
+        sqrt_d,
+        d,
+        alpha,
+        beta,
+        gamma,
+        delta,
+        a_coef,
+        b_coef,
+        abgd38,
+        eps,
+        k,
+    })
+}
+
+type H0Structure = ([C; 3], [C; 3], [C; 4], C, C);
+
+/// Least-squares solve of a small complex system, returning the solution and
+/// the residual relative to `|rhs|`.
+fn lstsq(rows: &[Vec<C>], rhs: &[C]) -> Result<(Vec<C>, f64)> {
+    let nr = rows.len();
+    let nc = rows.first().map_or(0, |r| r.len());
+    let m = DMatrix::from_fn(nr, nc, |i, j| rows[i][j]);
+    let b = DVector::from_row_slice(rhs);
+    let svd = m.clone().svd(true, true);
+    let x = svd.solve(&b, 1e-14).map_err(|e| Error::InvalidArgument {
+        what: "Koetter constants",
+        reason: format!("least-squares solve failed: {e}"),
+    })?;
+    let res = (&m * &x - &b).norm() / b.norm().max(f64::MIN_POSITIVE);
+    Ok((x.iter().copied().collect(), res))
+}
+
+/// (37)–(39): `H0 = Σ_j m_j n_j` as a quadratic form in `ξ, η`, reduced modulo
+/// Kötter's quadrics (11).
+///
+/// `H0 = Σ_j a_j ξ_j² + b_j ξ_j η_j + c_j η_j²` with `a_j = α_j γ_j`,
+/// `b_j = α_j δ_j + β_j γ_j`, `c_j = β_j δ_j` (from (23)). Adding
+/// `λ Q1 + μ Q2 + ν Q3` of (11) gives the form (37) when
+/// `a_j + λ + ν d_j = −(c_j + λ + ν/d_j) =: A_j` and `B_j = b_j + μ`; the
+/// paper's (38) then reads `A_j = α + β d_j + γ/d_j`, `B_j = δ (d_j + 1/d_j)`.
+/// The corrected (39): on the quadrics, by (30a), (30b), (31b),
+/// `H0 ≡ K/d4 Σ η_j²/(d_j − d4) + 2Kε Σ ξ_jη_j/(d_j − d4) + Kε² Σ d_j ξ_j²/(d_j − d4)`
+/// `= K g² (1 − ε P_0)²`; `(K, ε)` and the multipliers are found from the nine
+/// coefficient equations (six unknowns), whose consistency is checked.
+fn h0_structure(
+    alpha: &[C; 3],
+    beta: &[C; 3],
+    gamma: &[C; 3],
+    delta: &[C; 3],
+    d: &[C; 3],
+) -> Result<H0Structure> {
+    let d4 = d[0] * d[1] * d[2];
+    let ac: [C; 3] = std::array::from_fn(|j| alpha[j] * gamma[j]);
+    let bc: [C; 3] = std::array::from_fn(|j| alpha[j] * delta[j] + beta[j] * gamma[j]);
+    let cc: [C; 3] = std::array::from_fn(|j| beta[j] * delta[j]);
+
+    // (37): unknowns (λ, ν) from a_j + c_j + 2λ + ν (d_j + 1/d_j) = 0; μ and δ38 from
+    // b_j + μ = δ38 (d_j + 1/d_j).
+    let rows: Vec<Vec<C>> = (0..3)
+        .map(|j| vec![C::new(2.0, 0.0), d[j] + ONE / d[j]])
+        .collect();
+    let rhs: Vec<C> = (0..3).map(|j| -(ac[j] + cc[j])).collect();
+    let (x, r1) = lstsq(&rows, &rhs)?;
+    let (lam, nu) = (x[0], x[1]);
+    let a_coef: [C; 3] = std::array::from_fn(|j| ac[j] + lam + nu * d[j]);
+    let rows: Vec<Vec<C>> = (0..3).map(|j| vec![-ONE, d[j] + ONE / d[j]]).collect();
+    let (x, r2) = lstsq(&rows, &bc)?;
+    let (mu, delta38) = (x[0], x[1]);
+    let b_coef: [C; 3] = std::array::from_fn(|j| bc[j] + mu);
+    // A_j = α + β d_j + γ / d_j: three equations, three unknowns.
+    let rows: Vec<Vec<C>> = (0..3).map(|j| vec![ONE, d[j], ONE / d[j]]).collect();
+    let (x, _) = lstsq(&rows, &a_coef)?;
+    let abgd38 = [x[0], x[1], x[2], delta38];
+
+    // (39): unknowns X = (K ε², 2 K ε, K, λ', μ', ν').
+    let mut rows = Vec::with_capacity(9);
+    let mut rhs = Vec::with_capacity(9);
+    for j in 0..3 {
+        let w = ONE / (d[j] - d4);
+        rows.push(vec![d[j] * w, ZERO, ZERO, ONE, ZERO, d[j]]);
+        rhs.push(ac[j]);
+        rows.push(vec![ZERO, w, ZERO, ZERO, ONE, ZERO]);
+        rhs.push(bc[j]);
+        rows.push(vec![ZERO, ZERO, w / d4, ONE, ZERO, ONE / d[j]]);
+        rhs.push(cc[j]);
+    }
+    let (x, r3) = lstsq(&rows, &rhs)?;
+    let k = x[2];
+    let eps = x[1] / (2.0 * k);
+    let r4 = (x[0] - k * eps * eps).norm() / x[0].norm().max(f64::MIN_POSITIVE);
+    let worst = r1.max(r2).max(r3).max(r4);
+    if !(worst <= STRUCTURE_RTOL) {
+        return Err(Error::InvalidArgument {
+            what: "Koetter constants",
+            reason: format!(
+                "H0 does not reduce to the form (37)/(39) on Koetter's quadrics: relative \
+                 residual {worst:e} > {STRUCTURE_RTOL:e}"
+            ),
+        });
+    }
+    Ok((a_coef, b_coef, abgd38, eps, k))
+}
+
+/// `l^(p) = l(s_p)/√F'(s_p)` (19) for `p = 1 … 4`, on the documented branches.
+pub fn l_p(k: &KotterConstants, l: &[f64; 6]) -> [[C; 3]; 4] {
+    let (m, n) = m_n(l);
+    std::array::from_fn(|p| std::array::from_fn(|j| k.u[p][j] * m[j] + k.v[p][j] * n[j]))
+}
+
+/// Kötter's vectors (21): `ξ = l^(1) + i l^(2)`, `η = l^(1) − i l^(2)`.
+pub fn xi_eta(k: &KotterConstants, l: &[f64; 6]) -> ([C; 3], [C; 3]) {
+    let lp = l_p(k, l);
+    let xi = std::array::from_fn(|j| lp[0][j] + I * lp[1][j]);
+    let eta = std::array::from_fn(|j| lp[0][j] - I * lp[1][j]);
+    (xi, eta)
+}
+
+/// Relative size of the imaginary part above which [`l_from_xi_eta`] refuses
+/// to return a real state: a round trip leaves ~1e-15; data that do not come
+/// from a real state leave an O(1) imaginary part.
+pub const REAL_RTOL: f64 = 1e-9;
+
+/// The state from `ξ, η` by (23): `m_j = α_j ξ_j + β_j η_j`,
+/// `n_j = γ_j ξ_j + δ_j η_j`, `l = (m3, −m2, n1, m1, n2, n3)`.
+///
+/// Errors: non-finite input; an imaginary part larger than [`REAL_RTOL`]
+/// times the size of `l` (the data do not describe a real state).
+pub fn l_from_xi_eta(k: &KotterConstants, xi: &[C; 3], eta: &[C; 3]) -> Result<[f64; 6]> {
+    let mut m = [0.0; 3];
+    let mut n = [0.0; 3];
+    let mut im: f64 = 0.0;
+    let mut size: f64 = 0.0;
+    for j in 0..3 {
+        let mj = k.alpha[j] * xi[j] + k.beta[j] * eta[j];
+        let nj = k.gamma[j] * xi[j] + k.delta[j] * eta[j];
+        if !(mj.re.is_finite() && mj.im.is_finite() && nj.re.is_finite() && nj.im.is_finite()) {
+            return Err(Error::NonFinite {
+                what: "m_j, n_j from (xi, eta)",
+                index: j,
+            });
+        }
+        im = im.max(mj.im.abs()).max(nj.im.abs());
+        size = size.max(mj.norm()).max(nj.norm());
+        m[j] = mj.re;
+        n[j] = nj.re;
+    }
+    if im > REAL_RTOL * size {
+        return Err(Error::InvalidArgument {
+            what: "xi, eta",
+            reason: format!(
+                "they give a complex state: max |Im m_j, Im n_j| = {im:e} > {REAL_RTOL:e} * {size:e}"
+            ),
+        });
+    }
+    Ok(l_from_m_n(&m, &n))
+}
+
+#[cfg(test)]
+mod tests;

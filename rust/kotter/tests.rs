@@ -1,0 +1,116 @@
+use super::*;
+use approx::assert_relative_eq;
+use proptest::prelude::*;
+
+const A: [f64; 4] = [0.3, 1.1, 2.0, 3.7];
+const L0: [f64; 6] = [0.8, -0.3, 0.5, 1.1, -0.7, 0.2];
+
+fn dot(x: &[C; 3], y: &[C; 3]) -> C {
+    x[0] * y[0] + x[1] * y[1] + x[2] * y[2]
+}
+
+/// (14): f(s) = l(s)·l(s) = h1 s² − h2 s + h3 + 2 h0 √G on the branch √s_j4 √s_kl = √G.
+#[test]
+fn closed_form_14() {
+    let h = integrals(&A, &L0);
+    for s in [C::new(0.7, 0.4), C::new(-1.3, 2.0), C::new(5.0, -0.1)] {
+        for sg in [1.0, -1.0] {
+            let sqrt_g = sg * sqrt_principal(g_poly(&A, s));
+            let (lv, _) = schottky(&A, &L0, s, sqrt_g).unwrap();
+            let f = dot(&lv, &lv);
+            let closed = p_poly(&h, s) + 2.0 * h[0] * sqrt_g;
+            assert_relative_eq!(
+                (f - closed).norm(),
+                0.0,
+                epsilon = 1e-13 * closed.norm().max(1.0)
+            );
+        }
+    }
+}
+
+/// (18)–(20): f(s_p) = 0 on the branch σ_p, (l^(p))² = 0, Σ_p (l_k^(p))² = 0.
+#[test]
+fn roots_and_relations_20() {
+    let k = kotter_constants(&A, &L0).unwrap();
+    let lp = l_p(&k, &L0);
+    for p in 0..4 {
+        assert_relative_eq!(
+            (k.sigma[p] * k.sigma[p] - g_poly(&A, k.s[p])).norm(),
+            0.0,
+            epsilon = 1e-12
+        );
+        assert!(dot(&lp[p], &lp[p]).norm() < 1e-13);
+    }
+    for j in 0..3 {
+        let s: C = (0..4).map(|p| lp[p][j] * lp[p][j]).sum();
+        assert!(s.norm() < 1e-13);
+    }
+}
+
+/// (11) and the exact inverse (23).
+#[test]
+fn quadrics_11_and_inverse_23() {
+    let k = kotter_constants(&A, &L0).unwrap();
+    let (xi, eta) = xi_eta(&k, &L0);
+    let q1: C = (0..3).map(|j| xi[j] * xi[j] + eta[j] * eta[j]).sum();
+    let q2: C = (0..3).map(|j| xi[j] * eta[j]).sum();
+    let q3: C = (0..3)
+        .map(|j| k.d[j] * xi[j] * xi[j] + eta[j] * eta[j] / k.d[j])
+        .sum();
+    assert!(
+        q1.norm() < 1e-13 && q2.norm() < 1e-13 && q3.norm() < 1e-12,
+        "{q1} {q2} {q3}"
+    );
+    let back = l_from_xi_eta(&k, &xi, &eta).unwrap();
+    for i in 0..6 {
+        assert_relative_eq!(back[i], L0[i], epsilon = 1e-14);
+    }
+}
+
+#[test]
+fn degenerate_inputs_are_errors() {
+    // m = n: h1^2 = 4 h0^2
+    let sd = [1.0, -0.5, 0.3, 0.3, 0.5, 1.0];
+    let (m, n) = m_n(&sd);
+    assert_eq!(m, n);
+    assert!(matches!(
+        kotter_constants(&A, &sd),
+        Err(Error::InvalidArgument { .. })
+    ));
+    // h0 = 0
+    let z = [1.0, 0.0, 0.0, 0.0, 0.0, 0.0];
+    assert!(matches!(
+        kotter_constants(&A, &z),
+        Err(Error::InvalidArgument { .. })
+    ));
+    assert!(matches!(
+        kotter_constants(&[1.0, 1.0, 2.0, 3.0], &L0),
+        Err(Error::RepeatedA { .. })
+    ));
+    let mut bad = L0;
+    bad[2] = f64::NAN;
+    assert!(matches!(
+        kotter_constants(&A, &bad),
+        Err(Error::NonFinite { .. })
+    ));
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(64))]
+    /// The round trip l → (ξ, η) → l and the quadrics (11) for random states.
+    #[test]
+    fn round_trip_random(l in proptest::array::uniform6(-2.0f64..2.0)) {
+        let h = integrals(&A, &l);
+        prop_assume!(h[0].abs() > 0.05 && h[1] * h[1] - 4.0 * h[0] * h[0] > 0.05);
+        if let Ok(k) = kotter_constants(&A, &l) {
+            let (xi, eta) = xi_eta(&k, &l);
+            let back = l_from_xi_eta(&k, &xi, &eta).unwrap();
+            for i in 0..6 {
+                prop_assert!((back[i] - l[i]).abs() < 1e-11);
+            }
+            let q3: C = (0..3).map(|j| k.d[j] * xi[j] * xi[j] + eta[j] * eta[j] / k.d[j]).sum();
+            let size: f64 = (0..3).map(|j| (k.d[j] * xi[j] * xi[j]).norm() + (eta[j] * eta[j] / k.d[j]).norm()).sum();
+            prop_assert!(q3.norm() < 1e-10 * size);
+        }
+    }
+}
