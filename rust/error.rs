@@ -7,6 +7,8 @@
 
 use std::fmt;
 
+use num_complex::Complex64;
+
 /// Errors of the `manakov` core.
 #[derive(Debug, Clone, PartialEq)]
 #[non_exhaustive]
@@ -25,8 +27,13 @@ pub enum Error {
     NotSymmetric { what: &'static str, max_asym: f64 },
     /// Im τ is not positive definite.
     ImagNotPositiveDefinite { min_eig: f64 },
-    /// Two branch points of the curve coincide: the genus drops.
-    RepeatedBranchPoints { i: usize, j: usize, value: f64 },
+    /// Two branch points `d_i`, `d_j` of the curve (8) coincide: the genus drops.
+    /// The branch points are complex in general, hence `value: Complex64`.
+    RepeatedBranchPoints {
+        i: usize,
+        j: usize,
+        value: Complex64,
+    },
     /// Any other invalid argument, with the reason.
     InvalidArgument { what: &'static str, reason: String },
     /// An iteration did not reach its tolerance.

@@ -1,1 +1,525 @@
-//! The genus-2 curve (8), Weierstrass' Wurzelfunktionen (27)–(28), periods and Abel map.
+//! The genus-2 curve (8), Weierstrass' Wurzelfunktionen (27)–(28), their
+//! identities (29)–(33), and the inverse map from Kötter's (ξ, η) (36) back to
+//! the points of the curve.
+//!
+//! # The curve
+//!
+//! `y² = R(x) = Π_{j=0}^{4} (x − d_j)`, `d_0 = 0`, `d_4 = d_1 d_2 d_3` (8). The
+//! `d_j` are complex in general. A point of the curve is a pair `(z, y)` with
+//! `y² = R(z)`; the point carries its `y` explicitly (its sheet).
+//!
+//! # Square-root conventions (all of them)
+//!
+//! * `sqrt_principal(w)` is the principal square root, `−π < arg w ≤ π`, so
+//!   `−π/2 < arg √w ≤ π/2`; a negative real `w` (with either sign of zero in
+//!   its imaginary part) gives `+i√|w|`. Cut: `w ∈ (−∞, 0)`.
+//! * The canonical roots of a point `(z, y)`: `r_j(z) = sqrt_principal(z − d_j)`
+//!   for `j = 0, 1, 2, 3`, and `r_4(z) = ±sqrt_principal(z − d_4)` with the
+//!   sign for which `Π_{j=0}^{4} r_j(z)` is the given `y` (the sign whose
+//!   product lies on the same side as `y`: `Re(conj(Π r) · y) ≥ 0`; at a branch
+//!   point `y = 0` this gives `+`). So `r_j(z)² = z − d_j` for every `j` and
+//!   `Π_j r_j(z) = y` exactly, for either sheet.
+//! * The canonical sheet `y(x) = Π_{j=0}^{4} sqrt_principal(x − d_j)`
+//!   ([`KotterCurve::y`]); the other sheet is `−y(x)`.
+//! * The Wurzelfunktionen (27) of a pair of points, with a branch `eps ∈ {±1}⁵`
+//!   with `Π eps_j = +1` (default all `+1`):
+//!   `P_j = eps_j r_j(z1) r_j(z2)`, hence `P_j² = (z1 − d_j)(z2 − d_j)` and
+//!   **`P_0 P_1 P_2 P_3 P_4 = y1 y2`**. The 16 admissible `eps` are all the
+//!   sign choices of the `P_j` compatible with that product; which one a
+//!   trajectory needs is not a property of the two points (the `P_j` are
+//!   double-valued on the symmetric square of the curve), so it is an explicit
+//!   argument and [`KotterCurve::points_from_xi_eta`] returns it.
+//! * (28) then fixes the `P_jk`: `P_jk = eps_j eps_k (a − b)/(z1 − z2)` with
+//!   `a = r_j(z2) r_k(z2) ρ_jk(z1)`, `b = r_j(z1) r_k(z1) ρ_jk(z2)`,
+//!   `ρ_jk(z) = Π_{m ∉ {j,k}} r_m(z)`. This is (28) with
+//!   `√R(z_i) = y_i = Π_m r_m(z_i)` cancelled against the denominators, so it
+//!   has no division by `z_i − d_j` and is the continuous extension of (28) to
+//!   points at branch points.
+//!
+//! # Identities (checked in the tests; see `docs/curve.md`)
+//!
+//! With `(j, k, l)` a cyclic permutation of `(1, 2, 3)`,
+//! `c̃_j = 1/((d_j − d_k)(d_j − d_l))`, `c_j = (d_j − d_4) c̃_j` (33):
+//! (30), (31), (32) hold as printed; (29) holds with the right-hand side
+//! multiplied by `κ = Π_{m=1}^{3} (d_m − d_4)` (erratum). The inverse map uses
+//! (30a), (31b) and the two identities
+//! `Σ_j c̃_j P_kl² = z1 + z2 − d_4`, `Σ_j c̃_j d_j P_kl² = z1 z2` (30b).
+
+use num_complex::Complex64;
+
+use crate::error::{Error, Result};
+
+/// Relative residual `|y² − R(z)| / Π_j (|z| + |d_j|)` above which a point is
+/// rejected as not lying on the curve. `Π_j (|z| + |d_j|)` bounds the size of
+/// the terms of `R(z)`, so rounding in any reasonable computation of `y`
+/// leaves a residual of a few units of 1e-16; 1e-8 rejects a wrong `y` (or a
+/// wrong curve) while accepting points carried through long computations.
+pub const ON_CURVE_RTOL: f64 = 1e-8;
+
+/// Default relative tolerance of the consistency check in
+/// [`KotterCurve::points_from_xi_eta`]: the reconstructed points must
+/// reproduce the given `(ξ, η)` to `rtol · max|(ξ, η)|`. Exact data (from
+/// [`KotterCurve::xi_eta`]) come back to ~1e-14; 1e-8 leaves room for `(ξ, η)`
+/// computed elsewhere while rejecting data off Kötter's quadrics (11).
+pub const INVERSE_RTOL: f64 = 1e-8;
+
+/// Two branch points closer than this (relative to their size) are treated as
+/// coinciding: `d_4 = d_1 d_2 d_3` is a rounded product, so `d_4 = d_1` when
+/// `d_2 d_3 = 1` only up to a few ulps.
+const REPEATED_RTOL: f64 = 8.0 * f64::EPSILON;
+
+/// The cyclic permutations `(j, k, l)` of `(1, 2, 3)`, in the order `j = 1, 2, 3`.
+pub const CYCLIC: [(usize, usize, usize); 3] = [(1, 2, 3), (2, 3, 1), (3, 1, 2)];
+
+/// Principal square root, `−π/2 < arg √w ≤ π/2`, with `√(−x) = +i√x` for
+/// `x > 0` whatever the sign of the zero imaginary part.
+///
+/// Computed as `t = √((|w| + |Re w|)/2)` (Kahan's formulation), which is
+/// accurate to a few ulps in both components, unlike the polar form.
+pub fn sqrt_principal(w: Complex64) -> Complex64 {
+    let (re, im) = (w.re, w.im + 0.0); // + 0.0 maps −0.0 to +0.0: one cut side
+    if re == 0.0 && im == 0.0 {
+        return Complex64::new(0.0, 0.0);
+    }
+    let t = ((re.hypot(im) + re.abs()) / 2.0).sqrt();
+    if re >= 0.0 {
+        Complex64::new(t, im / (2.0 * t))
+    } else {
+        Complex64::new(im.abs() / (2.0 * t), t.copysign(im))
+    }
+}
+
+/// The genus-2 curve (8) `y² = R(x) = Π_{j=0}^{4} (x − d_j)`, `d_0 = 0`,
+/// `d_4 = d_1 d_2 d_3`, with distinct (complex) branch points.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct KotterCurve {
+    d: [Complex64; 5],
+}
+
+/// The Wurzelfunktionen of a pair of points: `p[j] = P_j` (27) and
+/// `pjk[j][k] = P_jk` (28), `j, k = 0..4`; `pjk` is symmetric with zero
+/// diagonal.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Wurzel {
+    /// `P_0 … P_4`, with `Π P_j = y1 y2`.
+    pub p: [Complex64; 5],
+    /// `P_jk`, symmetric, `P_jj = 0`.
+    pub pjk: [[Complex64; 5]; 5],
+}
+
+/// A pair of points of the curve, the factor `g` and the branch `eps` of the
+/// Wurzelfunktionen, as recovered by [`KotterCurve::points_from_xi_eta`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct WurzelPoints {
+    /// First point, the root of `U(x) = x² − (z1+z2) x + z1 z2` of larger modulus.
+    pub z1: Complex64,
+    /// Its `y`, `y1² = R(z1)`.
+    pub y1: Complex64,
+    /// Second point.
+    pub z2: Complex64,
+    /// Its `y`.
+    pub y2: Complex64,
+    /// The factor of (36): `ξ_j = √c_j g P_kl`, `η_j = √c_j g P_j4`.
+    pub g: Complex64,
+    /// The branch of the `P_j` (see the module docs), normalised to `eps[4] = +1`.
+    pub eps: [i8; 5],
+    /// Largest deviation `|(ξ, η) − (ξ, η)(z1, y1, z2, y2, g, eps)|`.
+    pub residual: f64,
+}
+
+fn check_finite_c(what: &'static str, x: &[Complex64]) -> Result<()> {
+    match x
+        .iter()
+        .position(|v| !(v.re.is_finite() && v.im.is_finite()))
+    {
+        Some(index) => Err(Error::NonFinite { what, index }),
+        None => Ok(()),
+    }
+}
+
+impl KotterCurve {
+    /// The curve (8) with `d_0 = 0`, `d_4 = d1 d2 d3`.
+    ///
+    /// Errors: [`Error::NonFinite`] for a NaN or infinite `d_j`;
+    /// [`Error::RepeatedBranchPoints`] when two of `d_0 … d_4` coincide (then
+    /// the curve is singular and its genus drops below 2). `d_j = 0` coincides
+    /// with `d_0`; `d_j d_k = 1` makes `d_4 = d_l`.
+    pub fn new(d1: Complex64, d2: Complex64, d3: Complex64) -> Result<Self> {
+        check_finite_c("d (d1, d2, d3)", &[d1, d2, d3])?;
+        let d4 = d1 * d2 * d3;
+        check_finite_c("d4 = d1 d2 d3", &[d4])?;
+        let d = [Complex64::new(0.0, 0.0), d1, d2, d3, d4];
+        for i in 0..5 {
+            for j in (i + 1)..5 {
+                let scale = d[i].norm().max(d[j].norm());
+                if (d[i] - d[j]).norm() <= REPEATED_RTOL * scale {
+                    return Err(Error::RepeatedBranchPoints { i, j, value: d[i] });
+                }
+            }
+        }
+        Ok(KotterCurve { d })
+    }
+
+    /// The branch points `(d_0, d_1, d_2, d_3, d_4) = (0, d1, d2, d3, d1 d2 d3)`.
+    pub fn branch_points(&self) -> [Complex64; 5] {
+        self.d
+    }
+
+    /// `R(x) = Π_{j=0}^{4} (x − d_j)` (8).
+    pub fn r(&self, x: Complex64) -> Complex64 {
+        self.d
+            .iter()
+            .fold(Complex64::new(1.0, 0.0), |acc, dj| acc * (x - dj))
+    }
+
+    /// The canonical sheet `y(x) = Π_{j=0}^{4} sqrt_principal(x − d_j)`, a
+    /// square root of `R(x)`; the other sheet is `−y(x)`.
+    pub fn y(&self, x: Complex64) -> Complex64 {
+        self.d.iter().fold(Complex64::new(1.0, 0.0), |acc, dj| {
+            acc * sqrt_principal(x - dj)
+        })
+    }
+
+    /// `c̃_j = 1/((d_j − d_k)(d_j − d_l))` (33), `j = 1, 2, 3`, `(j, k, l)` cyclic.
+    pub fn c_tilde(&self) -> [Complex64; 3] {
+        let d = &self.d;
+        CYCLIC.map(|(j, k, l)| 1.0 / ((d[j] - d[k]) * (d[j] - d[l])))
+    }
+
+    /// `c_j = (d_j − d_4)/((d_j − d_k)(d_j − d_l))` (33) — the curve's
+    /// constants, not the top's `c_ij` of (2).
+    pub fn c(&self) -> [Complex64; 3] {
+        let d = &self.d;
+        CYCLIC.map(|(j, k, l)| (d[j] - d[4]) / ((d[j] - d[k]) * (d[j] - d[l])))
+    }
+
+    /// `κ = Π_{m=1}^{3} (d_m − d_4) = −R'(d_4)/d_4`, the factor missing from
+    /// the right-hand side of (29) as printed (see `docs/errata-curve.md`).
+    pub fn kappa(&self) -> Complex64 {
+        let d = &self.d;
+        (d[1] - d[4]) * (d[2] - d[4]) * (d[3] - d[4])
+    }
+
+    /// Checks that `(z, y)` is a finite point of the curve (to [`ON_CURVE_RTOL`]).
+    pub fn check_point(&self, what: &'static str, z: Complex64, y: Complex64) -> Result<()> {
+        check_finite_c(what, &[z, y])?;
+        let scale: f64 = self.d.iter().map(|dj| z.norm() + dj.norm()).product();
+        let resid = (y * y - self.r(z)).norm();
+        // `!(a <= b)` also rejects a NaN residual (overflow of huge inputs).
+        if !(resid <= ON_CURVE_RTOL * scale) {
+            return Err(Error::InvalidArgument {
+                what,
+                reason: format!(
+                    "the point ({z}, {y}) is not on the curve y^2 = R(x): \
+                     |y^2 - R(z)| = {resid:e} > {ON_CURVE_RTOL:e} * {scale:e}"
+                ),
+            });
+        }
+        Ok(())
+    }
+
+    /// The canonical roots `r_j(z)`, `j = 0..4`, of a point `(z, y)`:
+    /// `r_j(z)² = z − d_j`, `Π_j r_j(z) = y` (see the module docs). The point
+    /// is not checked; see [`KotterCurve::check_point`].
+    pub fn roots(&self, z: Complex64, y: Complex64) -> [Complex64; 5] {
+        let mut r = self.d.map(|dj| sqrt_principal(z - dj));
+        let prod = r[0] * r[1] * r[2] * r[3] * r[4];
+        if (prod.conj() * y).re < 0.0 {
+            r[4] = -r[4];
+        }
+        r
+    }
+
+    /// The Wurzelfunktionen (27)–(28) of the points `(z1, y1)`, `(z2, y2)` in
+    /// the branch `eps` (`None` = all `+1`; see the module docs):
+    /// `P_j = eps_j √((z1 − d_j)(z2 − d_j))` with `Π P_j = y1 y2`, and
+    /// `P_jk = P_j P_k/(z1 − z2) · (√R(z1)/((z1 − d_j)(z1 − d_k)) − √R(z2)/((z2 − d_j)(z2 − d_k)))`
+    /// with `√R(z_i) = y_i`, evaluated in the division-free product form.
+    ///
+    /// Errors: non-finite input, a point off the curve, `z1 == z2` ((28)
+    /// divides by `z1 − z2`), `eps` not in `{±1}⁵` with product `+1`.
+    pub fn wurzel(
+        &self,
+        z1: Complex64,
+        y1: Complex64,
+        z2: Complex64,
+        y2: Complex64,
+        eps: Option<[i8; 5]>,
+    ) -> Result<Wurzel> {
+        self.check_point("point (z1, y1)", z1, y1)?;
+        self.check_point("point (z2, y2)", z2, y2)?;
+        if z1 == z2 {
+            return Err(Error::InvalidArgument {
+                what: "points (z1, z2)",
+                reason: format!(
+                    "z1 == z2 == {z1}: P_jk (28) divides by z1 - z2 and is undefined \
+                     (a pole, or a 0/0 when y1 == y2)"
+                ),
+            });
+        }
+        let eps = match eps {
+            None => [1.0; 5],
+            Some(e) => check_eps(e)?,
+        };
+        let r1 = self.roots(z1, y1);
+        let r2 = self.roots(z2, y2);
+        Ok(wurzel_from_roots(&r1, &r2, z1 - z2, &eps))
+    }
+
+    /// Kötter's vectors (36): `ξ_j = √c_j g P_kl`, `η_j = √c_j g P_j4`,
+    /// `(j, k, l)` cyclic, from the points, `g` and the branch `eps`.
+    /// `sqrt_c = None` takes `√c_j = sqrt_principal(c_j)`.
+    #[allow(clippy::too_many_arguments)]
+    pub fn xi_eta(
+        &self,
+        z1: Complex64,
+        y1: Complex64,
+        z2: Complex64,
+        y2: Complex64,
+        g: Complex64,
+        eps: Option<[i8; 5]>,
+        sqrt_c: Option<[Complex64; 3]>,
+    ) -> Result<([Complex64; 3], [Complex64; 3])> {
+        check_finite_c("g", &[g])?;
+        let sc = self.sqrt_c_checked(sqrt_c)?;
+        let w = self.wurzel(z1, y1, z2, y2, eps)?;
+        let mut xi = [Complex64::new(0.0, 0.0); 3];
+        let mut eta = xi;
+        for (i, &(j, k, l)) in CYCLIC.iter().enumerate() {
+            xi[i] = sc[i] * g * w.pjk[k][l];
+            eta[i] = sc[i] * g * w.pjk[j][4];
+        }
+        Ok((xi, eta))
+    }
+
+    fn sqrt_c_checked(&self, sqrt_c: Option<[Complex64; 3]>) -> Result<[Complex64; 3]> {
+        let c = self.c();
+        match sqrt_c {
+            None => Ok(c.map(sqrt_principal)),
+            Some(sc) => {
+                check_finite_c("sqrt_c", &sc)?;
+                for i in 0..3 {
+                    let err = (sc[i] * sc[i] - c[i]).norm();
+                    if !(err <= ON_CURVE_RTOL * c[i].norm()) {
+                        return Err(Error::InvalidArgument {
+                            what: "sqrt_c",
+                            reason: format!(
+                                "sqrt_c[{i}]^2 = {} differs from c_{} = {} (33)",
+                                sc[i] * sc[i],
+                                i + 1,
+                                c[i]
+                            ),
+                        });
+                    }
+                }
+                Ok(sc)
+            }
+        }
+    }
+
+    /// The inverse of (36): from `ξ_j = √c_j g P_kl`, `η_j = √c_j g P_j4`
+    /// (`j = 1, 2, 3`, `(j, k, l)` cyclic) recover `g`, the points
+    /// `(z1, y1)`, `(z2, y2)` and the branch `eps` of the `P_j`.
+    ///
+    /// With `X_j = ξ_j/√c_j = g P_kl`, `Y_j = η_j/√c_j = g P_j4`:
+    ///
+    /// * `g² = Σ_j c̃_j Y_j² / d_4` by (30a) `Σ c̃_j P_j4² = d_4`;
+    /// * `z1 + z2 = d_4 + Σ_j c̃_j X_j² / g²` and `z1 z2 = Σ_j c̃_j d_j X_j² / g²`
+    ///   (the second is (30b) with `P_0² = z1 z2`), so `z1`, `z2` are the roots
+    ///   of `U(x) = x² − (z1 + z2) x + z1 z2`;
+    /// * `y_i = ±y(z_i)`, and the signs together with `eps` are the choice
+    ///   (among the 32 candidates, `eps_4 = +1`) that reproduces `(X, Y)`.
+    ///
+    /// `g` is determined only up to sign: `(g, y1, y2)` and `(−g, −y1, −y2)`
+    /// give the same `(ξ, η)` (the hyperelliptic involution flips every
+    /// `P_jk`). The sign of `g` is the one nearer `g_ref` if given, otherwise
+    /// that of `sqrt_principal(g²)`; the `y_i` follow.
+    ///
+    /// Errors: non-finite input; `g² = 0`; `z1 = z2` (a double root of `U`,
+    /// where (28) is undefined); data that the reconstruction does not
+    /// reproduce to `rtol · max|(ξ, η)|` (not on Kötter's quadrics (11), or a
+    /// `sqrt_c` branch inconsistent with the data).
+    pub fn points_from_xi_eta(
+        &self,
+        xi: [Complex64; 3],
+        eta: [Complex64; 3],
+        sqrt_c: Option<[Complex64; 3]>,
+        g_ref: Option<Complex64>,
+        rtol: f64,
+    ) -> Result<WurzelPoints> {
+        check_finite_c("xi", &xi)?;
+        check_finite_c("eta", &eta)?;
+        if let Some(gr) = g_ref {
+            check_finite_c("g_ref", &[gr])?;
+        }
+        if !(rtol.is_finite() && rtol > 0.0) {
+            return Err(Error::InvalidArgument {
+                what: "rtol",
+                reason: format!("must be finite and positive, got {rtol}"),
+            });
+        }
+        let sc = self.sqrt_c_checked(sqrt_c)?;
+        let ct = self.c_tilde();
+        let d = &self.d;
+        let x: [Complex64; 3] = std::array::from_fn(|i| xi[i] / sc[i]);
+        let yv: [Complex64; 3] = std::array::from_fn(|i| eta[i] / sc[i]);
+
+        let g2 = (0..3).map(|i| ct[i] * yv[i] * yv[i]).sum::<Complex64>() / d[4];
+        let scale = xi
+            .iter()
+            .chain(eta.iter())
+            .map(|v| v.norm())
+            .fold(0.0, f64::max);
+        if g2 == Complex64::new(0.0, 0.0) || scale == 0.0 {
+            return Err(Error::InvalidArgument {
+                what: "xi, eta",
+                reason: "g^2 = sum_j c~_j (eta_j/sqrt c_j)^2 / d_4 vanishes (30a): \
+                         no point pair has these Wurzelfunktionen"
+                    .into(),
+            });
+        }
+        let sum1 = (0..3).map(|i| ct[i] * x[i] * x[i]).sum::<Complex64>() / g2 + d[4];
+        let sum2 = CYCLIC
+            .iter()
+            .enumerate()
+            .map(|(i, &(j, _, _))| ct[i] * d[j] * x[i] * x[i])
+            .sum::<Complex64>()
+            / g2;
+        let (z1, z2) = quadratic_roots(sum1, sum2)?;
+
+        let mut g = sqrt_principal(g2);
+        if let Some(gr) = g_ref {
+            if (gr.conj() * g).re < 0.0 {
+                g = -g;
+            }
+        }
+        let target: [Complex64; 6] = [x[0], x[1], x[2], yv[0], yv[1], yv[2]];
+        let yc1 = self.y(z1);
+        let yc2 = self.y(z2);
+        let mut best: Option<WurzelPoints> = None;
+        for s1 in [1.0, -1.0] {
+            for s2 in [1.0, -1.0] {
+                let (y1, y2) = (yc1 * s1, yc2 * s2);
+                let r1 = self.roots(z1, y1);
+                let r2 = self.roots(z2, y2);
+                let w = wurzel_from_roots(&r1, &r2, z1 - z2, &[1.0; 5]);
+                for bits in 0..8u8 {
+                    let e = |b: u8| if bits & (1 << b) == 0 { 1.0 } else { -1.0 };
+                    let eps = [e(0) * e(1) * e(2), e(0), e(1), e(2), 1.0];
+                    let mut resid = 0.0f64;
+                    for (i, &(j, k, l)) in CYCLIC.iter().enumerate() {
+                        let pkl = g * eps[k] * eps[l] * w.pjk[k][l];
+                        let pj4 = g * eps[j] * w.pjk[j][4];
+                        resid = resid
+                            .max(((target[i] - pkl) * sc[i]).norm())
+                            .max(((target[i + 3] - pj4) * sc[i]).norm());
+                    }
+                    if best.as_ref().is_none_or(|b| resid < b.residual) {
+                        best = Some(WurzelPoints {
+                            z1,
+                            y1,
+                            z2,
+                            y2,
+                            g,
+                            eps: eps.map(|v| v as i8),
+                            residual: resid,
+                        });
+                    }
+                }
+            }
+        }
+        match best {
+            Some(b) if b.residual <= rtol * scale => Ok(b),
+            Some(b) => Err(Error::InvalidArgument {
+                what: "xi, eta",
+                reason: format!(
+                    "no pair of points reproduces them: best residual {:e} > rtol {rtol:e} * \
+                     max|(xi, eta)| {scale:e}; (xi, eta) are not on Koetter's quadrics (11) \
+                     of this curve, or sqrt_c has another branch",
+                    b.residual
+                ),
+            }),
+            None => unreachable_error(),
+        }
+    }
+}
+
+fn unreachable_error<T>() -> Result<T> {
+    Err(Error::InvalidArgument {
+        what: "xi, eta",
+        reason: "internal: no candidate evaluated".into(),
+    })
+}
+
+/// Checks a branch vector: entries `±1`, product `+1`.
+fn check_eps(e: [i8; 5]) -> Result<[f64; 5]> {
+    if e.iter().any(|&v| v != 1 && v != -1) {
+        return Err(Error::InvalidArgument {
+            what: "eps",
+            reason: format!("entries must be +1 or -1, got {e:?}"),
+        });
+    }
+    if e.iter().map(|&v| v as i32).product::<i32>() != 1 {
+        return Err(Error::InvalidArgument {
+            what: "eps",
+            reason: format!(
+                "the product of the signs must be +1 (so that P_0 ... P_4 = y1 y2), got {e:?}"
+            ),
+        });
+    }
+    Ok(e.map(f64::from))
+}
+
+/// The roots of `x² − s x + p`, the one of larger modulus first, computed
+/// without cancellation (`z1 = (s ± √(s² − 4p))/2` with the sign that adds
+/// moduli, `z2 = p/z1`).
+fn quadratic_roots(s: Complex64, p: Complex64) -> Result<(Complex64, Complex64)> {
+    let sq = sqrt_principal(s * s - 4.0 * p);
+    let q = if (s.conj() * sq).re >= 0.0 {
+        s + sq
+    } else {
+        s - sq
+    };
+    let z1 = q / 2.0;
+    // A double root: the two points have the same z (|q| ≥ |sq| makes q = 0 imply sq = 0).
+    if sq.norm() <= 4.0 * f64::EPSILON * z1.norm() || z1 == Complex64::new(0.0, 0.0) {
+        return Err(Error::InvalidArgument {
+            what: "xi, eta",
+            reason: format!(
+                "they give z1 == z2 == {z1} (a double root of x^2 - (z1+z2) x + z1 z2): \
+                 P_jk (28) is undefined there"
+            ),
+        });
+    }
+    Ok((z1, p / z1))
+}
+
+/// (27)–(28) from the canonical roots of the two points, in the branch `eps`.
+fn wurzel_from_roots(
+    r1: &[Complex64; 5],
+    r2: &[Complex64; 5],
+    dz: Complex64,
+    eps: &[f64; 5],
+) -> Wurzel {
+    let zero = Complex64::new(0.0, 0.0);
+    let p: [Complex64; 5] = std::array::from_fn(|j| eps[j] * r1[j] * r2[j]);
+    let mut pjk = [[zero; 5]; 5];
+    for j in 0..5 {
+        for k in (j + 1)..5 {
+            let (mut rho1, mut rho2) = (Complex64::new(1.0, 0.0), Complex64::new(1.0, 0.0));
+            for m in (0..5).filter(|&m| m != j && m != k) {
+                rho1 *= r1[m];
+                rho2 *= r2[m];
+            }
+            let a = r2[j] * r2[k] * rho1;
+            let b = r1[j] * r1[k] * rho2;
+            let v = eps[j] * eps[k] * (a - b) / dz;
+            pjk[j][k] = v;
+            pjk[k][j] = v;
+        }
+    }
+    Wurzel { p, pjk }
+}
+
+#[cfg(test)]
+mod tests;

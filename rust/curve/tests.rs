@@ -1,0 +1,329 @@
+//! Tests of the curve (8), the Wurzelfunktionen (27)–(28), the identities
+//! (29)–(33) and the inverse of (36).
+
+use super::*;
+use approx::assert_relative_eq;
+use proptest::prelude::*;
+
+type C = Complex64;
+
+fn c(re: f64, im: f64) -> C {
+    C::new(re, im)
+}
+
+/// Identities are compared relative to the sum of the moduli of their terms.
+/// Each term is a product of ~20 rounded factors (relative error ~1e-15) and
+/// `P_jk` loses at most a factor `|a|/|a − b|` (≲ 1e2 for the separated
+/// points drawn here) to cancellation; 1e-11 leaves a margin of ~10.
+const IDENTITY_RTOL: f64 = 1e-11;
+
+/// The round trip `(z, y) → (ξ, η) → (z, y)` is a handful of well-conditioned
+/// rational operations and one square root for separated points; 1e-12
+/// relative to the size of the data is the claim.
+const ROUNDTRIP_RTOL: f64 = 1e-12;
+
+fn close(a: C, b: C, scale: f64, rtol: f64) -> bool {
+    (a - b).norm() <= rtol * scale.max(f64::MIN_POSITIVE)
+}
+
+fn cplx(lo: f64, hi: f64) -> impl Strategy<Value = C> {
+    (lo..hi, lo..hi).prop_map(|(a, b)| C::new(a, b))
+}
+
+/// Curves with branch points separated by at least `sep`.
+fn separated(curve: &KotterCurve, sep: f64) -> bool {
+    let d = curve.branch_points();
+    (0..5).all(|i| ((i + 1)..5).all(|j| (d[i] - d[j]).norm() >= sep))
+}
+
+fn min_dist(z: C, d: &[C; 5]) -> f64 {
+    d.iter()
+        .map(|dj| (z - dj).norm())
+        .fold(f64::INFINITY, f64::min)
+}
+
+#[test]
+fn sqrt_principal_branch() {
+    assert_eq!(sqrt_principal(c(4.0, 0.0)), c(2.0, 0.0));
+    assert_eq!(sqrt_principal(c(-4.0, 0.0)), c(0.0, 2.0));
+    // The signed zero does not move a negative real to the other side of the cut.
+    assert_eq!(sqrt_principal(c(-4.0, -0.0)), c(0.0, 2.0));
+    assert_eq!(sqrt_principal(c(0.0, 0.0)), c(0.0, 0.0));
+    let w = c(-3.0, -4.0);
+    let r = sqrt_principal(w);
+    assert_eq!(r, c(1.0, -2.0));
+    assert_relative_eq!((r * r - w).norm(), 0.0, epsilon = 1e-15);
+}
+
+#[test]
+fn construction_and_validation() {
+    let k = KotterCurve::new(c(2.0, 0.0), c(3.0, 0.0), c(-0.5, 1.0)).unwrap();
+    let d = k.branch_points();
+    assert_eq!(d[0], c(0.0, 0.0));
+    assert_eq!(d[4], c(2.0, 0.0) * c(3.0, 0.0) * c(-0.5, 1.0));
+    // R vanishes at every branch point and is monic of degree 5.
+    for dj in d {
+        assert_eq!(k.r(dj), c(0.0, 0.0));
+    }
+    let x = c(0.3, -0.7);
+    let direct = x * (x - d[1]) * (x - d[2]) * (x - d[3]) * (x - d[4]);
+    assert_relative_eq!((k.r(x) - direct).norm(), 0.0, epsilon = 1e-14);
+    assert_relative_eq!((k.y(x) * k.y(x) - k.r(x)).norm(), 0.0, epsilon = 1e-13);
+
+    // d_j = 0 coincides with d_0.
+    assert!(matches!(
+        KotterCurve::new(c(0.0, 0.0), c(3.0, 0.0), c(5.0, 0.0)),
+        Err(Error::RepeatedBranchPoints { i: 0, j: 1, .. })
+    ));
+    assert!(matches!(
+        KotterCurve::new(c(2.0, 1.0), c(2.0, 1.0), c(5.0, 0.0)),
+        Err(Error::RepeatedBranchPoints { i: 1, j: 2, .. })
+    ));
+    // d2 d3 = 1 makes d4 = d1 (up to rounding of the product).
+    assert!(matches!(
+        KotterCurve::new(c(7.0, 0.5), c(3.0, 0.0), c(1.0 / 3.0, 0.0)),
+        Err(Error::RepeatedBranchPoints { i: 1, j: 4, .. })
+    ));
+    assert!(matches!(
+        KotterCurve::new(c(f64::NAN, 0.0), c(3.0, 0.0), c(5.0, 0.0)),
+        Err(Error::NonFinite { .. })
+    ));
+    assert!(matches!(
+        KotterCurve::new(c(1e200, 0.0), c(1e200, 1.0), c(5.0, 0.0)),
+        Err(Error::NonFinite { .. })
+    ));
+    let msg = KotterCurve::new(c(0.0, 0.0), c(3.0, 0.0), c(5.0, 0.0))
+        .unwrap_err()
+        .to_string();
+    assert!(msg.contains("d0 and d1"), "{msg}");
+}
+
+#[test]
+fn bad_points_are_rejected() {
+    let k = KotterCurve::new(c(2.0, 0.0), c(3.0, 0.0), c(-0.5, 1.0)).unwrap();
+    let (z1, z2) = (c(0.3, 0.2), c(-1.0, 0.5));
+    let (y1, y2) = (k.y(z1), k.y(z2));
+    assert!(k.wurzel(z1, y1 * 1.01, z2, y2, None).is_err());
+    assert!(k.wurzel(z1, y1, z1, y1, None).is_err());
+    assert!(k.wurzel(z1, y1, c(f64::INFINITY, 0.0), y2, None).is_err());
+    assert!(k.wurzel(z1, y1, z2, y2, Some([1, 1, 1, 1, -1])).is_err());
+    assert!(k.wurzel(z1, y1, z2, y2, Some([1, 1, 1, 2, 2])).is_err());
+    assert!(k.wurzel(z1, y1, z2, y2, Some([1, -1, 1, 1, -1])).is_ok());
+    // At a branch point (28) as printed is 0/0; the product form is finite.
+    let w = k.wurzel(c(2.0, 0.0), c(0.0, 0.0), z2, y2, None).unwrap();
+    assert!(w
+        .pjk
+        .iter()
+        .flatten()
+        .all(|v| v.re.is_finite() && v.im.is_finite()));
+    assert_eq!(w.p[1], c(0.0, 0.0));
+}
+
+#[test]
+fn inverse_rejects_bad_data() {
+    let k = KotterCurve::new(c(2.0, 0.0), c(3.0, 0.0), c(-0.5, 1.0)).unwrap();
+    let zero = [c(0.0, 0.0); 3];
+    assert!(k
+        .points_from_xi_eta(zero, zero, None, None, INVERSE_RTOL)
+        .is_err());
+    let (z1, z2) = (c(0.3, 0.2), c(-1.0, 0.5));
+    let (xi, eta) = k
+        .xi_eta(z1, k.y(z1), z2, k.y(z2), c(1.3, 0.1), None, None)
+        .unwrap();
+    assert!(k
+        .points_from_xi_eta(xi, eta, None, None, INVERSE_RTOL)
+        .is_ok());
+    // Off the quadrics (11): perturb one component.
+    let mut bad = xi;
+    bad[0] *= 1.1;
+    let e = k
+        .points_from_xi_eta(bad, eta, None, None, INVERSE_RTOL)
+        .unwrap_err();
+    assert!(e.to_string().contains("quadrics"), "{e}");
+    let mut nan = eta;
+    nan[2] = c(f64::NAN, 0.0);
+    assert!(matches!(
+        k.points_from_xi_eta(xi, nan, None, None, INVERSE_RTOL),
+        Err(Error::NonFinite { .. })
+    ));
+}
+
+/// The printed (29), `RHS = s/Π_{j=1}^4 (s − d_j)`, fails on a concrete pair.
+#[test]
+fn printed_29_fails() {
+    let k = KotterCurve::new(c(2.0, 0.5), c(3.0, -1.0), c(-0.5, 1.0)).unwrap();
+    let (z1, z2) = (c(0.3, 0.2), c(-1.0, 0.5));
+    let w = k.wurzel(z1, k.y(z1), z2, k.y(z2), None).unwrap();
+    let s = c(0.7, -0.4);
+    let (lhs, _) = lhs_29(&k, &w, s);
+    let d = k.branch_points();
+    let printed = s / ((s - d[1]) * (s - d[2]) * (s - d[3]) * (s - d[4]));
+    assert!((lhs - printed).norm() > 0.1 * printed.norm());
+    assert!(close(lhs, k.kappa() * printed, lhs.norm(), IDENTITY_RTOL));
+}
+
+/// Left-hand side of (29) and the sum of the moduli of its terms.
+fn lhs_29(k: &KotterCurve, w: &Wurzel, s: C) -> (C, f64) {
+    let d = k.branch_points();
+    let cc = k.c();
+    let (mut v, mut scale) = (c(0.0, 0.0), 0.0);
+    for (i, &(j, kk, l)) in CYCLIC.iter().enumerate() {
+        let t1 = cc[i] * w.pjk[kk][l].powi(2) / ((s - d[kk]) * (s - d[l]));
+        let t2 = cc[i] * w.pjk[j][4].powi(2) / ((s - d[j]) * (s - d[4]));
+        v += t1 + t2;
+        scale += t1.norm() + t2.norm();
+    }
+    (v, scale)
+}
+
+/// (28) exactly as printed, with `√R(z_i) = y_i`.
+fn pjk_printed(k: &KotterCurve, w: &Wurzel, z1: C, y1: C, z2: C, y2: C, j: usize, m: usize) -> C {
+    let d = k.branch_points();
+    w.p[j] * w.p[m] / (z1 - z2)
+        * (y1 / ((z1 - d[j]) * (z1 - d[m])) - y2 / ((z2 - d[j]) * (z2 - d[m])))
+}
+
+fn eps_strategy() -> impl Strategy<Value = [i8; 5]> {
+    (0u8..16).prop_map(|bits| {
+        let e = |b: u8| if bits & (1 << b) == 0 { 1i8 } else { -1 };
+        [e(0) * e(1) * e(2) * e(3), e(0), e(1), e(2), e(3)]
+    })
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(256))]
+
+    /// (27), (28) as printed vs the product form, and the symmetry of P_jk.
+    #[test]
+    fn wurzel_definitions(d1 in cplx(-2.0, 2.0), d2 in cplx(-2.0, 2.0), d3 in cplx(-2.0, 2.0),
+                          z1 in cplx(-3.0, 3.0), z2 in cplx(-3.0, 3.0),
+                          s1 in prop::bool::ANY, s2 in prop::bool::ANY, eps in eps_strategy()) {
+        let k = KotterCurve::new(d1, d2, d3);
+        prop_assume!(k.is_ok());
+        let k = k.unwrap();
+        let d = k.branch_points();
+        prop_assume!(separated(&k, 0.1) && (z1 - z2).norm() > 0.1);
+        prop_assume!(min_dist(z1, &d) > 0.05 && min_dist(z2, &d) > 0.05);
+        let y1 = if s1 { k.y(z1) } else { -k.y(z1) };
+        let y2 = if s2 { k.y(z2) } else { -k.y(z2) };
+        let w = k.wurzel(z1, y1, z2, y2, Some(eps)).unwrap();
+        let prod: C = w.p.iter().product();
+        prop_assert!(close(prod, y1 * y2, (y1 * y2).norm(), IDENTITY_RTOL));
+        for j in 0..5 {
+            let p2 = (z1 - d[j]) * (z2 - d[j]);
+            prop_assert!(close(w.p[j] * w.p[j], p2, p2.norm(), IDENTITY_RTOL));
+            prop_assert_eq!(w.pjk[j][j], c(0.0, 0.0));
+            for m in 0..5 {
+                prop_assert_eq!(w.pjk[j][m], w.pjk[m][j]);
+                if m != j {
+                    let pr = pjk_printed(&k, &w, z1, y1, z2, y2, j, m);
+                    let scale = w.p[j].norm() * w.p[m].norm() / (z1 - z2).norm()
+                        * ((y1 / ((z1 - d[j]) * (z1 - d[m]))).norm()
+                            + (y2 / ((z2 - d[j]) * (z2 - d[m]))).norm());
+                    prop_assert!(close(w.pjk[j][m], pr, scale, IDENTITY_RTOL),
+                        "P_{}{}: {} vs printed {}", j, m, w.pjk[j][m], pr);
+                }
+            }
+        }
+    }
+
+    /// (29) corrected, (30)–(32) as printed, and the two identities of the inverse map.
+    #[test]
+    fn identities_29_to_33(d1 in cplx(-2.0, 2.0), d2 in cplx(-2.0, 2.0), d3 in cplx(-2.0, 2.0),
+                           z1 in cplx(-3.0, 3.0), z2 in cplx(-3.0, 3.0), s in cplx(-3.0, 3.0),
+                           s1 in prop::bool::ANY, s2 in prop::bool::ANY, eps in eps_strategy()) {
+        let k = KotterCurve::new(d1, d2, d3);
+        prop_assume!(k.is_ok());
+        let k = k.unwrap();
+        let d = k.branch_points();
+        prop_assume!(separated(&k, 0.1) && (z1 - z2).norm() > 0.1);
+        prop_assume!(min_dist(s, &d) > 0.05);
+        let y1 = if s1 { k.y(z1) } else { -k.y(z1) };
+        let y2 = if s2 { k.y(z2) } else { -k.y(z2) };
+        let w = k.wurzel(z1, y1, z2, y2, Some(eps)).unwrap();
+        let (cc, ct) = (k.c(), k.c_tilde());
+        let p = |a: usize, b: usize| w.pjk[a][b];
+
+        // (29), corrected: RHS = κ s / Π_{j=1}^4 (s − d_j).
+        let (lhs, scale) = lhs_29(&k, &w, s);
+        let rhs = k.kappa() * s / ((s - d[1]) * (s - d[2]) * (s - d[3]) * (s - d[4]));
+        prop_assert!(close(lhs, rhs, scale, IDENTITY_RTOL), "(29): {} vs {}", lhs, rhs);
+
+        let mut sums = [c(0.0, 0.0); 7];
+        let mut scales = [0.0f64; 7];
+        for (i, &(j, kk, l)) in CYCLIC.iter().enumerate() {
+            let terms = [
+                ct[i] * p(j, 4).powi(2),                       // (30a)
+                d[j] * ct[i] * p(kk, l).powi(2),               // (30b)
+                cc[i] * p(j, 4) * p(kk, l),                    // (31a)
+                ct[i] * p(j, 4) * p(kk, l),                    // (31b)
+                cc[i] * (p(j, 4).powi(2) / d[j] + d[j] * p(kk, l).powi(2)), // (32)
+                ct[i] * p(kk, l).powi(2),                      // Σ c̃ P_kl² = z1 + z2 − d4
+                cc[i] * p(kk, l).powi(2),                      // Σ c P_kl² = P_4²
+            ];
+            for t in 0..7 {
+                sums[t] += terms[t];
+                scales[t] += terms[t].norm();
+            }
+        }
+        let expected = [d[4], w.p[0].powi(2), c(0.0, 0.0), -w.p[0], c(0.0, 0.0),
+                        z1 + z2 - d[4], w.p[4].powi(2)];
+        for t in 0..7 {
+            let sc = scales[t] + expected[t].norm();
+            prop_assert!(close(sums[t], expected[t], sc, IDENTITY_RTOL),
+                "identity {}: {} vs {}", t, sums[t], expected[t]);
+        }
+    }
+
+    /// (z1, y1, z2, y2, g, eps) → (ξ, η) (36) → back, with g's sign from g_ref.
+    #[test]
+    fn inverse_round_trip(d1 in cplx(-2.0, 2.0), d2 in cplx(-2.0, 2.0), d3 in cplx(-2.0, 2.0),
+                          z1 in cplx(-3.0, 3.0), z2 in cplx(-3.0, 3.0), g in cplx(-2.0, 2.0),
+                          s1 in prop::bool::ANY, s2 in prop::bool::ANY, eps in eps_strategy()) {
+        let k = KotterCurve::new(d1, d2, d3);
+        prop_assume!(k.is_ok());
+        let k = k.unwrap();
+        prop_assume!(separated(&k, 0.1) && (z1 - z2).norm() > 0.1 && g.norm() > 0.1);
+        let y1 = if s1 { k.y(z1) } else { -k.y(z1) };
+        let y2 = if s2 { k.y(z2) } else { -k.y(z2) };
+        let (xi, eta) = k.xi_eta(z1, y1, z2, y2, g, Some(eps), None).unwrap();
+        let back = k.points_from_xi_eta(xi, eta, None, Some(g), INVERSE_RTOL).unwrap();
+        // The points are an unordered pair.
+        let (b1, bz1, b2, bz2) = if (back.z1 - z1).norm() <= (back.z1 - z2).norm() {
+            (back.y1, back.z1, back.y2, back.z2)
+        } else {
+            (back.y2, back.z2, back.y1, back.z1)
+        };
+        let zs = z1.norm().max(z2.norm()).max(1.0);
+        prop_assert!(close(bz1, z1, zs, ROUNDTRIP_RTOL), "z1 {} vs {}", bz1, z1);
+        prop_assert!(close(bz2, z2, zs, ROUNDTRIP_RTOL), "z2 {} vs {}", bz2, z2);
+        let ys = y1.norm().max(y2.norm()).max(1.0);
+        prop_assert!(close(b1, y1, ys, ROUNDTRIP_RTOL), "y1 {} vs {}", b1, y1);
+        prop_assert!(close(b2, y2, ys, ROUNDTRIP_RTOL), "y2 {} vs {}", b2, y2);
+        prop_assert!(close(back.g, g, g.norm(), ROUNDTRIP_RTOL));
+        let scale = xi.iter().chain(eta.iter()).map(|v| v.norm()).fold(0.0, f64::max);
+        let (x1, e1) = k.xi_eta(back.z1, back.y1, back.z2, back.y2, back.g, Some(back.eps), None).unwrap();
+        for i in 0..3 {
+            prop_assert!(close(x1[i], xi[i], scale, ROUNDTRIP_RTOL));
+            prop_assert!(close(e1[i], eta[i], scale, ROUNDTRIP_RTOL));
+        }
+        // eps is recovered modulo the flip of P_1 … P_4 that leaves every P_jk
+        // unchanged — unless a point sits on a cut of the principal roots, where
+        // the rounding of the recovered z decides the side and eps compensates.
+        let d = k.branch_points();
+        let on_cut = |z: C| d.iter().any(|dj| (z - dj).im.abs() < 1e-9 && (z - dj).re < 0.0);
+        if !on_cut(z1) && !on_cut(z2) {
+            let sgn = i8::from(eps[4] > 0) * 2 - 1;
+            let norm_eps = [eps[0], eps[1] * sgn, eps[2] * sgn, eps[3] * sgn, 1];
+            prop_assert_eq!(back.eps, norm_eps);
+        }
+        // Without g_ref, the pair (−g, −y1, −y2) is just as good: same (ξ, η).
+        let alt = k.points_from_xi_eta(xi, eta, None, Some(-g), INVERSE_RTOL).unwrap();
+        prop_assert!(close(alt.g, -g, g.norm(), ROUNDTRIP_RTOL));
+        let (x2, e2) = k.xi_eta(alt.z1, alt.y1, alt.z2, alt.y2, alt.g, Some(alt.eps), None).unwrap();
+        for i in 0..3 {
+            prop_assert!(close(x2[i], xi[i], scale, ROUNDTRIP_RTOL));
+            prop_assert!(close(e2[i], eta[i], scale, ROUNDTRIP_RTOL));
+        }
+    }
+}
