@@ -7,12 +7,16 @@ Equation numbers in docstrings are the paper's.
 
 from ._core import ConvergenceError, __version__
 from .problems import Problem, benchmark_setup, problem, problem_names
+from .kotter import Kotter, from_kotter, kotter  # noqa: E402  (shadows the submodule name)
 
 __all__ = [
     "ConvergenceError",
+    "Kotter",
     "Problem",
     "__version__",
     "benchmark_setup",
+    "from_kotter",
+    "kotter",
     "problem",
     "problem_names",
 ]

@@ -28,6 +28,7 @@
 use nalgebra::{DMatrix, DVector};
 use num_complex::Complex64;
 
+use crate::curve::{KotterCurve, WurzelPoints};
 use crate::error::{check_finite, Error, Result};
 
 type C = Complex64;
@@ -211,8 +212,9 @@ pub fn quartic_roots(f: &[f64; 5]) -> Result<[C; 4]> {
     check_finite("F coefficients", f)?;
     // Cauchy bound for the initial circle.
     let rad = 1.0 + f[1..].iter().fold(0.0f64, |m, c| m.max(c.abs()));
-    let mut z: [C; 4] =
-        std::array::from_fn(|k| C::from_polar(rad * 0.5, 0.4 + 1.5707963 * k as f64));
+    let mut z: [C; 4] = std::array::from_fn(|k| {
+        C::from_polar(rad * 0.5, 0.4 + std::f64::consts::FRAC_PI_2 * k as f64)
+    });
     let mut converged = false;
     let mut last = f64::INFINITY;
     for _ in 0..500 {
@@ -452,7 +454,7 @@ pub fn constants_from_h(a: &[f64; 4], h: &[f64; 4]) -> Result<KotterConstants> {
         beta[j] = (v2 - I * v1) / (2.0 * d3);
         gamma[j] = -(u2 + I * u1) / (2.0 * d3);
         delta[j] = -(u2 - I * u1) / (2.0 * d3);
-        if !(d[j].norm() > 0.0 && d[j].norm().is_finite()) {
+        if d[j].norm() == 0.0 || !d[j].norm().is_finite() {
             return Err(Error::InvalidArgument {
                 what: "state l",
                 reason: format!("d_{} = {} (26) is zero or infinite", j + 1, d[j]),
@@ -559,7 +561,7 @@ fn h0_structure(
     let eps = x[1] / (2.0 * k);
     let r4 = (x[0] - k * eps * eps).norm() / x[0].norm().max(f64::MIN_POSITIVE);
     let worst = r1.max(r2).max(r3).max(r4);
-    if !(worst <= STRUCTURE_RTOL) {
+    if worst.is_nan() || worst > STRUCTURE_RTOL {
         return Err(Error::InvalidArgument {
             what: "Koetter constants",
             reason: format!(
@@ -596,6 +598,10 @@ pub const REAL_RTOL: f64 = 1e-9;
 /// Errors: non-finite input; an imaginary part larger than [`REAL_RTOL`]
 /// times the size of `l` (the data do not describe a real state).
 pub fn l_from_xi_eta(k: &KotterConstants, xi: &[C; 3], eta: &[C; 3]) -> Result<[f64; 6]> {
+    real_state(&k.coefficients23(), xi, eta)
+}
+
+fn real_state(k: &Coefficients23, xi: &[C; 3], eta: &[C; 3]) -> Result<[f64; 6]> {
     let mut m = [0.0; 3];
     let mut n = [0.0; 3];
     let mut im: f64 = 0.0;
@@ -623,6 +629,165 @@ pub fn l_from_xi_eta(k: &KotterConstants, xi: &[C; 3], eta: &[C; 3]) -> Result<[
         });
     }
     Ok(l_from_m_n(&m, &n))
+}
+
+/// Tolerance for the inverse map of the curve module
+/// ([`KotterCurve::points_from_xi_eta`]) and for the corrected (41): exact
+/// data reproduce `(ξ, η)` to ~1e-14 relative; 1e-8 rejects inconsistent data.
+pub const UNIFORM_RTOL: f64 = 1e-8;
+
+/// A state in Kötter's coordinates: the constants of its level set, the
+/// vectors `l^(p)`, `ξ, η`, the curve (8) and the point pair with `g` (36), (41).
+#[derive(Debug, Clone, PartialEq)]
+pub struct KotterState {
+    /// Constants of the level set.
+    pub constants: KotterConstants,
+    /// `l^(p)` (19), `p = 1 … 4`.
+    pub l_p: [[C; 3]; 4],
+    /// `ξ` (21).
+    pub xi: [C; 3],
+    /// `η` (21).
+    pub eta: [C; 3],
+    /// The curve (8) with the `d_j` of (26).
+    pub curve: KotterCurve,
+    /// `P_0 = √(z1 z2)` in the curve's branch, from (31b): `P_0 = −Σ_j c̃_j P_j4 P_kl`.
+    pub p0: C,
+    /// The points, `g` and the branch of the `P_j` (see [`crate::curve`]),
+    /// with `ξ_j = √c_j g P_kl`, `η_j = √c_j g P_j4` (36); the sign of `g` is
+    /// fixed by the corrected (41): `g (1 − ε P_0) = √(h0/K)` (principal root).
+    pub points: WurzelPoints,
+}
+
+/// From a state `l` of the top with parameters `a` to Kötter's coordinates
+/// and the points of the curve (the algebraic uniformization (36), (41)).
+///
+/// `g` (36) is fixed up to sign by (30a), `g² = Σ_j c̃_j (η_j/√c_j)² / d4`;
+/// the corrected (39) reads `h0 = K g² (1 − ε P_0)²`, so the corrected (41)
+/// is `g = √(h0/K) / (1 − ε P_0)`, which fixes the sign (and is checked).
+///
+/// Errors: those of [`kotter_constants`], of [`KotterCurve::new`] (coinciding
+/// branch points `d_j`: the genus drops) and of the inverse map of the curve
+/// module (`z1 = z2`, data off the quadrics); and `1 − ε P_0 = 0` (then (41)
+/// puts `g` at infinity: `ξ, η` are not finite multiples of the `P_jk`).
+pub fn kotter(a: &[f64; 4], l: &[f64; 6]) -> Result<KotterState> {
+    let constants = kotter_constants(a, l)?;
+    kotter_with(constants, l)
+}
+
+/// [`kotter`] for a state whose level-set constants are already known
+/// (e.g. along a trajectory). The constants must belong to `l`'s level set.
+pub fn kotter_with(constants: KotterConstants, l: &[f64; 6]) -> Result<KotterState> {
+    check_finite("l", l)?;
+    let lp = l_p(&constants, l);
+    let (xi, eta) = xi_eta(&constants, l);
+    let [d1, d2, d3] = constants.d;
+    let curve = KotterCurve::new(d1, d2, d3)?;
+    let ct = curve.c_tilde();
+    let sc = curve.c().map(crate::curve::sqrt_principal);
+    let d4 = curve.branch_points()[4];
+    let x: [C; 3] = std::array::from_fn(|j| xi[j] / sc[j]);
+    let y: [C; 3] = std::array::from_fn(|j| eta[j] / sc[j]);
+    let g2: C = (0..3).map(|j| ct[j] * y[j] * y[j]).sum::<C>() / d4;
+    let g2p0: C = -(0..3).map(|j| ct[j] * x[j] * y[j]).sum::<C>();
+    let p0 = g2p0 / g2;
+    let one_m = ONE - constants.eps * p0;
+    let size = 1.0 + (constants.eps * p0).norm();
+    if one_m.norm().is_nan() || one_m.norm() <= 1e-12 * size {
+        return Err(Error::InvalidArgument {
+            what: "state l",
+            reason: format!("1 - eps P_0 = {one_m} vanishes: g (41) is infinite at this state"),
+        });
+    }
+    let g41 = sqrt_principal(C::new(constants.h[0], 0.0) / constants.k) / one_m;
+    let points = curve.points_from_xi_eta(xi, eta, None, Some(g41), UNIFORM_RTOL)?;
+    let mis = (points.g - g41).norm();
+    if mis.is_nan() || mis > UNIFORM_RTOL * g41.norm() {
+        return Err(Error::InvalidArgument {
+            what: "state l",
+            reason: format!(
+                "the corrected (41) g = sqrt(h0/K)/(1 - eps P0) = {g41} disagrees with g = {} \
+                 from (30a) (|difference| = {mis:e})",
+                points.g
+            ),
+        });
+    }
+    Ok(KotterState {
+        constants,
+        l_p: lp,
+        xi,
+        eta,
+        curve,
+        p0,
+        points,
+    })
+}
+
+/// The inverse of [`kotter`]: the state `l` from the curve's points, `g`
+/// and the branch of the `P_j` by (36) and (23):
+/// `ξ_j = √c_j g P_kl`, `η_j = √c_j g P_j4`, `m_j = α_j ξ_j + β_j η_j`,
+/// `n_j = γ_j ξ_j + δ_j η_j`, `l = (m3, −m2, n1, m1, n2, n3)`.
+///
+/// Errors: those of [`KotterCurve::xi_eta`] (points off the curve, `z1 = z2`,
+/// a bad branch) and of [`l_from_xi_eta`] (a complex state).
+#[allow(clippy::too_many_arguments)]
+pub fn from_kotter(
+    coef: &Coefficients23,
+    d: [C; 3],
+    z1: C,
+    y1: C,
+    z2: C,
+    y2: C,
+    g: C,
+    branch: [i8; 5],
+) -> Result<[f64; 6]> {
+    let curve = KotterCurve::new(d[0], d[1], d[2])?;
+    let (xi, eta) = curve.xi_eta(z1, y1, z2, y2, g, Some(branch), None)?;
+    coef.state(&xi, &eta)
+}
+
+/// The coefficients `α_j, β_j, γ_j, δ_j` of (23), the linear map `(ξ, η) → (m, n)`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Coefficients23 {
+    /// `α_j`.
+    pub alpha: [C; 3],
+    /// `β_j`.
+    pub beta: [C; 3],
+    /// `γ_j`.
+    pub gamma: [C; 3],
+    /// `δ_j`.
+    pub delta: [C; 3],
+}
+
+impl Coefficients23 {
+    /// The state of (23); see [`l_from_xi_eta`].
+    pub fn state(&self, xi: &[C; 3], eta: &[C; 3]) -> Result<[f64; 6]> {
+        for (what, v) in [
+            ("alpha", &self.alpha),
+            ("beta", &self.beta),
+            ("gamma", &self.gamma),
+            ("delta", &self.delta),
+        ] {
+            if let Some(index) = v
+                .iter()
+                .position(|z| !(z.re.is_finite() && z.im.is_finite()))
+            {
+                return Err(Error::NonFinite { what, index });
+            }
+        }
+        real_state(self, xi, eta)
+    }
+}
+
+impl KotterConstants {
+    /// The coefficients of (23).
+    pub fn coefficients23(&self) -> Coefficients23 {
+        Coefficients23 {
+            alpha: self.alpha,
+            beta: self.beta,
+            gamma: self.gamma,
+            delta: self.delta,
+        }
+    }
 }
 
 #[cfg(test)]

@@ -1,3 +1,4 @@
+#![allow(clippy::needless_range_loop)]
 use super::*;
 use approx::assert_relative_eq;
 use proptest::prelude::*;
@@ -113,4 +114,33 @@ proptest! {
             prop_assert!(q3.norm() < 1e-10 * size);
         }
     }
+}
+
+/// Uniformization round trip l → (z1, y1, z2, y2, g) → l and the corrected (41).
+#[test]
+fn uniformization_round_trip() {
+    let st = kotter(&A, &L0).unwrap();
+    let p = st.points;
+    let back = from_kotter(
+        &st.constants.coefficients23(),
+        st.constants.d,
+        p.z1,
+        p.y1,
+        p.z2,
+        p.y2,
+        p.g,
+        p.eps,
+    )
+    .unwrap();
+    for i in 0..6 {
+        assert_relative_eq!(back[i], L0[i], epsilon = 1e-12);
+    }
+    let w = st
+        .curve
+        .wurzel(p.z1, p.y1, p.z2, p.y2, Some(p.eps))
+        .unwrap();
+    assert_relative_eq!((w.p[0] - st.p0).norm(), 0.0, epsilon = 1e-10 * st.p0.norm());
+    let k = &st.constants;
+    let lhs = k.k * p.g * p.g * (ONE - k.eps * w.p[0]) * (ONE - k.eps * w.p[0]);
+    assert_relative_eq!((lhs - k.h[0]).norm(), 0.0, epsilon = 1e-10);
 }
