@@ -1,8 +1,7 @@
 """Shared fixtures: the reference problems, as the package carries them."""
 
-import pytest
-
 import manakov
+import pytest
 
 PROBLEM_NAMES = ("generic", "physical", "wide", "near_degenerate")
 

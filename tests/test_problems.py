@@ -3,10 +3,9 @@
 import json
 from pathlib import Path
 
+import manakov
 import numpy as np
 import pytest
-
-import manakov
 from conftest import PROBLEM_NAMES
 
 SHARED = Path(__file__).resolve().parents[2] / "shared" / "reference" / "problems.json"

@@ -6,8 +6,8 @@ Equation numbers in docstrings are the paper's.
 """
 
 from ._core import ConvergenceError, __version__
-from .problems import Problem, benchmark_setup, problem, problem_names
 from .kotter import Kotter, from_kotter, kotter  # noqa: E402  (shadows the submodule name)
+from .problems import Problem, benchmark_setup, problem, problem_names
 
 __all__ = [
     "ConvergenceError",

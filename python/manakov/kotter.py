@@ -1,3 +1,4 @@
+# ruff: noqa: E741  (l is the paper's name for the state)
 """Schottky's l(s) and Kötter's reduction: from a state l to the curve (8) and back.
 
 The chain, with the paper's equation numbers (details and every convention in
@@ -197,7 +198,8 @@ class Kotter:
     sqrt_d, d : ndarray (3,) complex
         ``sqrt(d_j)`` and ``d_j`` (26).
     alpha, beta, gamma, delta : ndarray (3,) complex
-        (23): ``m_j = alpha_j xi_j + beta_j eta_j``, ``n_j = gamma_j xi_j + delta_j eta_j`` (24 corrected).
+        (23): ``m_j = alpha_j xi_j + beta_j eta_j``,
+        ``n_j = gamma_j xi_j + delta_j eta_j`` ((24) corrected).
     A, B : ndarray (3,) complex
         (37): on the quadrics (11), ``H0 = sum_j A_j (xi_j^2 - eta_j^2) + B_j xi_j eta_j``.
     abgd38 : ndarray (4,) complex

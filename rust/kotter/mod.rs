@@ -241,14 +241,6 @@ pub fn quartic_roots(f: &[f64; 5]) -> Result<[C; 4]> {
             break;
         }
     }
-    if !converged && last > 1e-12 {
-        return Err(Error::NoConvergence {
-            what: "roots of F(s) (18)",
-            tol: 1e-15,
-            reached: last,
-            iterations: 500,
-        });
-    }
     for zk in z.iter_mut() {
         for _ in 0..2 {
             let (p, dp) = horner(f, *zk);
@@ -258,6 +250,8 @@ pub fn quartic_roots(f: &[f64; 5]) -> Result<[C; 4]> {
         }
     }
     let scale = z.iter().fold(1.0f64, |m, v| m.max(v.norm()));
+    // A cluster is reported as a repeated root even when the iteration has not
+    // met its tolerance: Aberth converges only linearly to a multiple root.
     for i in 0..4 {
         for j in (i + 1)..4 {
             if (z[i] - z[j]).norm() <= REPEATED_ROOT_RTOL * scale {
@@ -275,21 +269,39 @@ pub fn quartic_roots(f: &[f64; 5]) -> Result<[C; 4]> {
             }
         }
     }
+    if !converged && last > 1e-12 {
+        return Err(Error::NoConvergence {
+            what: "roots of F(s) (18)",
+            tol: 1e-15,
+            reached: last,
+            iterations: 500,
+        });
+    }
     Ok(order_roots(z, scale))
 }
 
 fn order_roots(z: [C; 4], scale: f64) -> [C; 4] {
-    // A root counts as real when its imaginary part is at rounding level.
-    let is_real = |x: &C| x.im.abs() <= 1e-12 * scale;
-    let mut r: Vec<C> = z.to_vec();
+    // F has real coefficients: a root whose imaginary part is at rounding
+    // level is real (made exactly real, so that the order below does not
+    // depend on the sign of rounding noise), and the partner of a non-real
+    // root is its exact conjugate. Genuinely complex roots this close to the
+    // axis would form a pair closer than REPEATED_ROOT_RTOL (already rejected).
+    let snap = |x: C| {
+        if x.im.abs() <= 1e-12 * scale {
+            C::new(x.re, 0.0)
+        } else {
+            x
+        }
+    };
+    let mut r: Vec<C> = z.iter().map(|&x| snap(x)).collect();
     let by_im_re = |x: &C, y: &C| {
         x.im.partial_cmp(&y.im)
             .unwrap_or(std::cmp::Ordering::Equal)
             .then(x.re.partial_cmp(&y.re).unwrap_or(std::cmp::Ordering::Equal))
     };
-    if r.iter().any(|x| !is_real(x)) {
+    if r.iter().any(|x| x.im != 0.0) {
         let i1 = (0..4)
-            .filter(|&i| !is_real(&r[i]))
+            .filter(|&i| r[i].im != 0.0)
             .max_by(|&i, &j| by_im_re(&r[i], &r[j]))
             .unwrap_or(0);
         let s1 = r.remove(i1);
@@ -301,21 +313,20 @@ fn order_roots(z: [C; 4], scale: f64) -> [C; 4] {
                     .unwrap_or(std::cmp::Ordering::Equal)
             })
             .unwrap_or(0);
-        let s2 = r.remove(i2);
-        let (s3, s4) = if by_im_re(&r[0], &r[1]) == std::cmp::Ordering::Less {
+        r.remove(i2);
+        let (s3, mut s4) = if by_im_re(&r[0], &r[1]) == std::cmp::Ordering::Less {
             (r[1], r[0])
         } else {
             (r[0], r[1])
         };
-        [s1, s2, s3, s4]
+        if s3.im != 0.0 {
+            // the second conjugate pair: s4 = conj(s3) exactly
+            s4 = s3.conj();
+        }
+        [s1, s1.conj(), s3, s4]
     } else {
         r.sort_by(|x, y| y.re.partial_cmp(&x.re).unwrap_or(std::cmp::Ordering::Equal));
-        [
-            C::new(r[0].re, 0.0),
-            C::new(r[1].re, 0.0),
-            C::new(r[2].re, 0.0),
-            C::new(r[3].re, 0.0),
-        ]
+        [r[0], r[1], r[2], r[3]]
     }
 }
 

@@ -1,3 +1,4 @@
+# ruff: noqa: E741, B007, E501  (l is the paper's name for the state)
 """Exploration: check the Schottky-Koetter formulas (12)-(41) as printed, numerically.
 
 Pure numpy/scipy, independent of the package. Run: python tests/data/kotter_explore.py

@@ -1,3 +1,4 @@
+# ruff: noqa: E741  (l is the paper's name for the state)
 """Independent numpy reference for the Schottky-Koetter reduction (tests only).
 
 Written from the paper's formulas (12)-(41) and the corrections pinned down in
@@ -132,17 +133,21 @@ def F_roots(a, h):
 
 
 def order_roots(r):
-    r = list(r)
-    nonreal = [x for x in r if abs(x.imag) > 1e-12 * max(1.0, abs(x))]
+    """The documented order; roots with |Im| at rounding level are made real and
+    conjugate partners exact conjugates (F has real coefficients)."""
+    scale = max(1.0, np.max(np.abs(r)))
+    r = [complex(x.real, 0.0) if abs(x.imag) <= 1e-12 * scale else complex(x) for x in r]
+    nonreal = [x for x in r if x.imag != 0.0]
     if nonreal:
         s1 = max(nonreal, key=lambda x: (x.imag, x.real))
         r.remove(s1)
         s2 = min(r, key=lambda x: abs(x - np.conj(s1)))
         r.remove(s2)
         s3, s4 = sorted(r, key=lambda x: (x.imag, x.real), reverse=True)
-    else:
-        s1, s2, s3, s4 = sorted(r, key=lambda x: x.real, reverse=True)
-    return np.array([s1, s2, s3, s4])
+        if s3.imag != 0.0:
+            s4 = np.conj(s3)
+        return np.array([s1, np.conj(s1), s3, s4])
+    return np.array(sorted(r, key=lambda x: x.real, reverse=True))
 
 
 def sigma(sp, h):
@@ -193,3 +198,35 @@ def xi_eta(l, a, h, s):
     L1 = l_p(s[0], a, h, l)
     L2 = l_p(s[1], a, h, l)
     return L1 + 1j * L2, L1 - 1j * L2
+
+
+def curve_c(d):
+    """c~_j and c_j of (33) for d = (d1, d2, d3), d4 = d1 d2 d3."""
+    d = np.asarray(d, complex)
+    d4 = np.prod(d)
+    ct = np.array([1 / ((d[j] - d[k]) * (d[j] - d[ll])) for (j, k, ll) in CYC])
+    return ct, (d - d4) * ct, d4
+
+
+def wurzel(d, z1, y1, z2, y2, branch):
+    """P_j (27) and P_jk (28) literally, j, k = 0..4, with P_j = branch_j r_j(z1) r_j(z2),
+    r_j = principal sqrt(z - d_j) for j < 4 and r_4 signed so that prod_j r_j(z) = y
+    (the curve module's convention: prod_j P_j = y1 y2)."""
+    dd = np.concatenate([[0.0], np.asarray(d, complex), [np.prod(d)]])
+
+    def roots(z, y):
+        r = np.sqrt(z - dd + 0j)
+        if (np.conj(np.prod(r)) * y).real < 0:
+            r[4] = -r[4]
+        return r
+
+    r1, r2 = roots(z1, y1), roots(z2, y2)
+    P = np.asarray(branch) * r1 * r2
+    Pjk = np.zeros((5, 5), complex)
+    for j in range(5):
+        for k in range(5):
+            if j != k:
+                Pjk[j, k] = P[j] * P[k] / (z1 - z2) * (
+                    y1 / ((z1 - dd[j]) * (z1 - dd[k])) - y2 / ((z2 - dd[j]) * (z2 - dd[k]))
+                )
+    return P, Pjk
