@@ -6,13 +6,17 @@ Equation numbers in docstrings are the paper's.
 """
 
 from ._core import ConvergenceError, __version__
-from .kotter import Kotter, from_kotter, kotter  # noqa: E402  (shadows the submodule name)
+from .curve import CurvePoints, KotterCurve, Wurzel
+from .kotter import Kotter, from_kotter, kotter  # (shadows the submodule name)
 from .problems import Problem, benchmark_setup, problem, problem_names
 
 __all__ = [
     "ConvergenceError",
+    "CurvePoints",
     "Kotter",
+    "KotterCurve",
     "Problem",
+    "Wurzel",
     "__version__",
     "benchmark_setup",
     "from_kotter",

@@ -7,6 +7,44 @@ __version__: str
 
 class ConvergenceError(RuntimeError): ...
 
+# --- curve (rust/python/curve.rs) ---
+
+def curve_branch_points(d: npt.NDArray[np.complex128]) -> npt.NDArray[np.complex128]: ...
+def curve_constants(
+    d: npt.NDArray[np.complex128],
+) -> tuple[
+    npt.NDArray[np.complex128], npt.NDArray[np.complex128], npt.NDArray[np.complex128]
+]: ...
+def curve_eval(
+    d: npt.NDArray[np.complex128], x: npt.NDArray[np.complex128]
+) -> tuple[npt.NDArray[np.complex128], npt.NDArray[np.complex128]]: ...
+def curve_wurzel(
+    d: npt.NDArray[np.complex128],
+    z1: npt.NDArray[np.complex128],
+    y1: npt.NDArray[np.complex128],
+    z2: npt.NDArray[np.complex128],
+    y2: npt.NDArray[np.complex128],
+    eps: npt.NDArray[np.int8] | None = None,
+) -> tuple[npt.NDArray[np.complex128], npt.NDArray[np.complex128]]: ...
+def curve_xi_eta(
+    d: npt.NDArray[np.complex128],
+    z1: npt.NDArray[np.complex128],
+    y1: npt.NDArray[np.complex128],
+    z2: npt.NDArray[np.complex128],
+    y2: npt.NDArray[np.complex128],
+    g: npt.NDArray[np.complex128],
+    eps: npt.NDArray[np.int8] | None = None,
+    sqrt_c: npt.NDArray[np.complex128] | None = None,
+) -> tuple[npt.NDArray[np.complex128], npt.NDArray[np.complex128]]: ...
+def curve_points_from_xi_eta(
+    d: npt.NDArray[np.complex128],
+    xi: npt.NDArray[np.complex128],
+    eta: npt.NDArray[np.complex128],
+    sqrt_c: npt.NDArray[np.complex128] | None = None,
+    g_ref: npt.NDArray[np.complex128] | None = None,
+    rtol: float = 1e-08,
+) -> tuple[npt.NDArray[np.complex128], npt.NDArray[np.int8], npt.NDArray[np.float64]]: ...
+
 # --- kotter (rust/python/kotter.rs) ---
 
 def kotter_integrals(

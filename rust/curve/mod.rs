@@ -205,8 +205,8 @@ impl KotterCurve {
         check_finite_c(what, &[z, y])?;
         let scale: f64 = self.d.iter().map(|dj| z.norm() + dj.norm()).product();
         let resid = (y * y - self.r(z)).norm();
-        // `!(a <= b)` also rejects a NaN residual (overflow of huge inputs).
-        if !(resid <= ON_CURVE_RTOL * scale) {
+        // A NaN residual (overflow of huge inputs) is rejected too.
+        if resid.is_nan() || resid > ON_CURVE_RTOL * scale {
             return Err(Error::InvalidArgument {
                 what,
                 reason: format!(
@@ -300,7 +300,7 @@ impl KotterCurve {
                 check_finite_c("sqrt_c", &sc)?;
                 for i in 0..3 {
                     let err = (sc[i] * sc[i] - c[i]).norm();
-                    if !(err <= ON_CURVE_RTOL * c[i].norm()) {
+                    if err.is_nan() || err > ON_CURVE_RTOL * c[i].norm() {
                         return Err(Error::InvalidArgument {
                             what: "sqrt_c",
                             reason: format!(
@@ -352,7 +352,7 @@ impl KotterCurve {
         if let Some(gr) = g_ref {
             check_finite_c("g_ref", &[gr])?;
         }
-        if !(rtol.is_finite() && rtol > 0.0) {
+        if !rtol.is_finite() || rtol <= 0.0 {
             return Err(Error::InvalidArgument {
                 what: "rtol",
                 reason: format!("must be finite and positive, got {rtol}"),
@@ -428,9 +428,14 @@ impl KotterCurve {
                 }
             }
         }
-        match best {
-            Some(b) if b.residual <= rtol * scale => Ok(b),
-            Some(b) => Err(Error::InvalidArgument {
+        let Some(best) = best else {
+            return unreachable_error();
+        };
+        let b = self.refine(best, &target, &sc);
+        if b.residual <= rtol * scale {
+            Ok(b)
+        } else {
+            Err(Error::InvalidArgument {
                 what: "xi, eta",
                 reason: format!(
                     "no pair of points reproduces them: best residual {:e} > rtol {rtol:e} * \
@@ -438,8 +443,119 @@ impl KotterCurve {
                      of this curve, or sqrt_c has another branch",
                     b.residual
                 ),
-            }),
-            None => unreachable_error(),
+            })
+        }
+    }
+}
+
+impl KotterCurve {
+    /// Gauss–Newton polish of `(z1, z2, g)` for [`KotterCurve::points_from_xi_eta`].
+    ///
+    /// The closed form goes through `Σ c̃_j X_j²`, whose terms cancel heavily
+    /// when the `P_kl` are nearly equal (points far out or close together);
+    /// that costs up to ~1e3 over the conditioning of the map itself. A
+    /// least-squares Newton step on the six equations `X = g P_kl`,
+    /// `Y = g P_j4` recovers the intrinsic accuracy. The roots `r_j(z_i)` are
+    /// continued holomorphically, `r_j(z + δ) = r_j(z) √(1 + δ/(z − d_j))`,
+    /// so the step never crosses a cut of the principal roots; the final
+    /// branch is expressed again as `eps` relative to the canonical roots.
+    fn refine(
+        &self,
+        start: WurzelPoints,
+        target: &[Complex64; 6],
+        sc: &[Complex64; 3],
+    ) -> WurzelPoints {
+        let d = self.d;
+        let eps_f = start.eps.map(f64::from);
+        // The branch of the start, folded into the roots of the first point:
+        // P_j = (eps_j r_j(z1)) r_j(z2).
+        let mut r1 = self.roots(start.z1, start.y1);
+        for j in 0..5 {
+            r1[j] *= eps_f[j];
+        }
+        let mut r2 = self.roots(start.z2, start.y2);
+        let (mut z1, mut z2, mut g) = (start.z1, start.z2, start.g);
+        let resid_of = |f: &[Complex64; 6]| -> f64 {
+            (0..6)
+                .map(|i| ((target[i] - f[i]) * sc[i % 3]).norm())
+                .fold(0.0, f64::max)
+        };
+        let six = |r1: &[Complex64; 5], r2: &[Complex64; 5], dz: Complex64, g: Complex64| {
+            let w = wurzel_from_roots(r1, r2, dz, &[1.0; 5]);
+            let mut f = [Complex64::new(0.0, 0.0); 6];
+            for (i, &(j, k, l)) in CYCLIC.iter().enumerate() {
+                f[i] = g * w.pjk[k][l];
+                f[i + 3] = g * w.pjk[j][4];
+            }
+            f
+        };
+        let cont = |r: &[Complex64; 5], z: Complex64, dz: Complex64| -> [Complex64; 5] {
+            std::array::from_fn(|j| r[j] * sqrt_principal(1.0 + dz / (z - d[j])))
+        };
+        let mut f = six(&r1, &r2, z1 - z2, g);
+        let mut resid = resid_of(&f);
+        for _ in 0..3 {
+            // Continuation needs the points off the branch points and apart.
+            let rho = d
+                .iter()
+                .map(|dj| (z1 - dj).norm().min((z2 - dj).norm()))
+                .fold((z1 - z2).norm(), f64::min);
+            if rho.is_nan() || rho <= 0.0 || g == Complex64::new(0.0, 0.0) {
+                break;
+            }
+            let h = 1e-6 * rho;
+            let mut jac = nalgebra::SMatrix::<Complex64, 6, 3>::zeros();
+            let hc = Complex64::new(h, 0.0);
+            let fp1 = six(&cont(&r1, z1, hc), &r2, z1 + hc - z2, g);
+            let fm1 = six(&cont(&r1, z1, -hc), &r2, z1 - hc - z2, g);
+            let fp2 = six(&r1, &cont(&r2, z2, hc), z1 - z2 - hc, g);
+            let fm2 = six(&r1, &cont(&r2, z2, -hc), z1 - z2 + hc, g);
+            let mut rhs = nalgebra::SVector::<Complex64, 6>::zeros();
+            for i in 0..6 {
+                let w = sc[i % 3];
+                jac[(i, 0)] = w * (fp1[i] - fm1[i]) / (2.0 * h);
+                jac[(i, 1)] = w * (fp2[i] - fm2[i]) / (2.0 * h);
+                jac[(i, 2)] = w * f[i] / g;
+                rhs[i] = w * (target[i] - f[i]);
+            }
+            let Ok(step) = jac.svd(true, true).solve(&rhs, 1e-14) else {
+                break;
+            };
+            let (nz1, nz2, ng) = (z1 + step[0], z2 + step[1], g + step[2]);
+            let (nr1, nr2) = (cont(&r1, z1, step[0]), cont(&r2, z2, step[1]));
+            let nf = six(&nr1, &nr2, nz1 - nz2, ng);
+            let nres = resid_of(&nf);
+            if nres.is_nan() || nres >= resid {
+                break;
+            }
+            (z1, z2, g, r1, r2, f, resid) = (nz1, nz2, ng, nr1, nr2, nf, nres);
+        }
+        if resid >= start.residual {
+            return start;
+        }
+        // Express the continued roots as (y_i, eps) relative to the canonical roots.
+        // Π_j eps_j = +1, so the product of the branch-folded roots is y1.
+        let y1: Complex64 = r1.iter().product();
+        let y2: Complex64 = r2.iter().product();
+        let c1 = self.roots(z1, y1);
+        let c2 = self.roots(z2, y2);
+        let mut eps = [1i8; 5];
+        for j in 0..5 {
+            let ratio = (r1[j] * r2[j]) / (c1[j] * c2[j]);
+            eps[j] = if ratio.re >= 0.0 { 1 } else { -1 };
+        }
+        if eps[4] < 0 {
+            eps = eps.map(|e| -e);
+            eps[0] = -eps[0];
+        }
+        WurzelPoints {
+            z1,
+            y1,
+            z2,
+            y2,
+            g,
+            eps,
+            residual: resid,
         }
     }
 }

@@ -177,6 +177,7 @@ fn lhs_29(k: &KotterCurve, w: &Wurzel, s: C) -> (C, f64) {
 }
 
 /// (28) exactly as printed, with `√R(z_i) = y_i`.
+#[allow(clippy::too_many_arguments)]
 fn pjk_printed(k: &KotterCurve, w: &Wurzel, z1: C, y1: C, z2: C, y2: C, j: usize, m: usize) -> C {
     let d = k.branch_points();
     w.p[j] * w.p[m] / (z1 - z2)
@@ -326,4 +327,64 @@ proptest! {
             prop_assert!(close(e2[i], eta[i], scale, ROUNDTRIP_RTOL));
         }
     }
+}
+
+#[test]
+#[ignore]
+fn stats_forward_error() {
+    use proptest::test_runner::TestRunner;
+    let mut runner = TestRunner::deterministic();
+    let strat = (
+        cplx(-2.0, 2.0),
+        cplx(-2.0, 2.0),
+        cplx(-2.0, 2.0),
+        cplx(-3.0, 3.0),
+        cplx(-3.0, 3.0),
+        cplx(-2.0, 2.0),
+    );
+    let mut worst = vec![0.0f64; 6];
+    for _ in 0..20000 {
+        let (d1, d2, d3, z1, z2, g) =
+            proptest::strategy::ValueTree::current(&strat.new_tree(&mut runner).unwrap());
+        let Ok(k) = KotterCurve::new(d1, d2, d3) else {
+            continue;
+        };
+        if !separated(&k, 0.1) || g.norm() < 0.1 {
+            continue;
+        }
+        let sep = (z1 - z2).norm();
+        let bin = if sep < 0.1 {
+            continue;
+        } else if sep < 0.3 {
+            0
+        } else if sep < 0.6 {
+            1
+        } else if sep < 1.0 {
+            2
+        } else if sep < 2.0 {
+            3
+        } else {
+            4
+        };
+        let (y1, y2) = (k.y(z1), -k.y(z2));
+        let (xi, eta) = k.xi_eta(z1, y1, z2, y2, g, None, None).unwrap();
+        let b = k
+            .points_from_xi_eta(xi, eta, None, Some(g), INVERSE_RTOL)
+            .unwrap();
+        let (bz1, by1) = if (b.z1 - z1).norm() < (b.z2 - z1).norm() {
+            (b.z1, b.y1)
+        } else {
+            (b.z2, b.y2)
+        };
+        let ez = (bz1 - z1).norm() / z1.norm().max(1.0);
+        let ey = (by1 - y1).norm() / y1.norm().max(1.0);
+        worst[bin] = worst[bin].max(ez.max(ey));
+        let scale = xi
+            .iter()
+            .chain(eta.iter())
+            .map(|v| v.norm())
+            .fold(0.0, f64::max);
+        worst[5] = worst[5].max(b.residual / scale);
+    }
+    println!("worst forward error by |z1-z2| bin [.1,.3,.6,1,2,inf], backward: {worst:?}");
 }

@@ -7,6 +7,7 @@
 
 use pyo3::prelude::*;
 
+mod curve;
 mod errors;
 mod kotter;
 mod so4;
@@ -25,6 +26,7 @@ mod _core {
         so4::register(m)?;
         theta::register(m)?;
         kotter::register(m)?;
+        curve::register(m)?;
         Ok(())
     }
 }

@@ -1,0 +1,384 @@
+"""The genus-2 curve (8) and Weierstrass' Wurzelfunktionen (27)-(28).
+
+The curve of the paper is
+
+.. math::
+    y^2 = R(x) = \\prod_{j=0}^{4} (x - d_j), \\qquad d_0 = 0, \\quad d_4 = d_1 d_2 d_3 \\quad (8)
+
+with complex branch points in general. A point of the curve is a pair
+``(z, y)`` with ``y**2 == R(z)``: the point carries its ``y`` (its sheet).
+
+Square-root conventions (all of them; see ``docs/curve.md``)
+------------------------------------------------------------
+* ``sqrt`` is the principal square root, ``-pi/2 < arg sqrt(w) <= pi/2``; a
+  negative real ``w`` gives ``+1j*sqrt(-w)`` whatever the sign of the zero
+  imaginary part.
+* Canonical roots of a point ``(z, y)``: ``r_j(z) = sqrt(z - d_j)`` for
+  ``j = 0..3`` and ``r_4(z) = +-sqrt(z - d_4)``, the sign making
+  ``prod_j r_j(z) == y``.
+* Canonical sheet: ``KotterCurve.y(x) = prod_j sqrt(x - d_j)``; the other sheet
+  is ``-y(x)``.
+* Wurzelfunktionen (27) in the branch ``eps`` (five signs, product ``+1``,
+  default all ``+1``): ``P_j = eps_j r_j(z1) r_j(z2)``, so that
+  ``P_j**2 = (z1 - d_j)(z2 - d_j)`` and ``P_0 P_1 P_2 P_3 P_4 = y1 y2``.
+  The 16 admissible ``eps`` are all sign choices compatible with that product;
+  the canonical choice jumps where a point crosses a cut
+  ``z in d_j + (-inf, 0]``, and a continuous choice along a trajectory is
+  carried by ``eps`` (``points_from_wurzel`` returns it).
+* (28) fixes the ``P_jk`` from the ``P_j`` and ``sqrt(R(z_i)) = y_i``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from . import _core
+
+__all__ = ["CurvePoints", "KotterCurve", "Wurzel", "INVERSE_RTOL"]
+
+#: Default relative tolerance of the consistency check of
+#: :meth:`KotterCurve.points_from_wurzel`: the recovered points must reproduce
+#: ``(xi, eta)`` to ``rtol * max|(xi, eta)|``. Exact data come back to ~1e-14;
+#: 1e-8 admits data computed elsewhere and rejects data off Kötter's quadrics (11).
+INVERSE_RTOL = 1e-8
+
+
+def _c(x: Any) -> np.ndarray:
+    return np.asarray(x, dtype=np.complex128)
+
+
+def _frozen(a: np.ndarray) -> np.ndarray:
+    a = np.ascontiguousarray(a)
+    a.flags.writeable = False
+    return a
+
+
+def _scalar_or(a: np.ndarray, scalar: bool) -> Any:
+    return a[()] if scalar else _frozen(a)
+
+
+def _eps_rows(eps: Any, shape: tuple[int, ...]) -> np.ndarray | None:
+    if eps is None:
+        return None
+    e = np.asarray(eps)
+    if e.shape[-1:] != (5,):
+        raise ValueError(f"eps must have last axis of length 5, got shape {e.shape}")
+    if not np.all((e == 1) | (e == -1)):
+        raise ValueError("eps entries must be +1 or -1")
+    e = np.broadcast_to(e, (*shape, 5))
+    return np.ascontiguousarray(e.reshape(-1, 5), dtype=np.int8)
+
+
+@dataclass(frozen=True)
+class Wurzel:
+    """The Wurzelfunktionen of point pairs, (27)-(28).
+
+    Attributes
+    ----------
+    P : ndarray, complex, shape (..., 5)
+        ``P_j = eps_j sqrt((z1 - d_j)(z2 - d_j))`` (27), ``j = 0..4``, with
+        ``prod_j P_j = y1 y2``.
+    Pjk : ndarray, complex, shape (..., 5, 5)
+        ``P_jk = P_j P_k/(z1 - z2) (y1/((z1 - d_j)(z1 - d_k)) - y2/((z2 - d_j)(z2 - d_k)))``
+        (28); symmetric, zero diagonal.
+    """
+
+    P: np.ndarray
+    Pjk: np.ndarray
+
+
+@dataclass(frozen=True)
+class CurvePoints:
+    """Points of the curve, factor ``g`` and branch ``eps`` recovered from (36).
+
+    Attributes
+    ----------
+    z1, y1, z2, y2 : complex or ndarray
+        The two points; ``z1`` is the root of ``x**2 - (z1+z2) x + z1 z2`` of
+        larger modulus (the pair is unordered: (27)-(28) are symmetric).
+    g : complex or ndarray
+        The factor of (36): ``xi_j = sqrt(c_j) g P_kl``, ``eta_j = sqrt(c_j) g P_j4``.
+    eps : ndarray of int8, shape (..., 5)
+        The branch of the Wurzelfunktionen (product +1, normalised to
+        ``eps[..., 4] == 1``): ``curve.wurzel(z1, y1, z2, y2, eps=eps)``
+        reproduces the data.
+    residual : float or ndarray
+        ``max |(xi, eta) - (xi, eta)(z1, y1, z2, y2, g, eps)|``.
+    """
+
+    z1: Any
+    y1: Any
+    z2: Any
+    y2: Any
+    g: Any
+    eps: np.ndarray
+    residual: Any
+
+
+class KotterCurve:
+    """The genus-2 curve (8) ``y**2 = R(x) = prod_{j=0}^4 (x - d_j)``.
+
+    Parameters
+    ----------
+    d1, d2, d3 : complex
+        Branch points; ``d_0 = 0`` and ``d_4 = d1 d2 d3`` (8).
+
+    Raises
+    ------
+    ValueError
+        If a ``d_j`` is not finite, or two of ``d_0 .. d_4`` coincide (the
+        genus drops; ``d_j = 0`` coincides with ``d_0``, ``d_k d_l = 1`` makes
+        ``d_4 = d_j``). The message names the pair.
+
+    Notes
+    -----
+    The identities (29)-(33) of the paper, with
+    ``c~_j = 1/((d_j - d_k)(d_j - d_l))``, ``c_j = (d_j - d_4) c~_j`` (33),
+    ``(j, k, l)`` cyclic in ``(1, 2, 3)``, hold for :meth:`wurzel` in every
+    branch ``eps``, except that the right-hand side of (29) carries the factor
+    :attr:`kappa` ``= prod_{m=1}^3 (d_m - d_4)`` (see ``docs/errata-curve.md``).
+    """
+
+    __slots__ = ("_d", "_c", "_ct", "_kappa")
+
+    def __init__(self, d1: complex, d2: complex, d3: complex) -> None:
+        d = _c([d1, d2, d3])
+        if d.shape != (3,):
+            raise ValueError("d1, d2, d3 must be scalars")
+        self._d = _frozen(_core.curve_branch_points(d))
+        c, ct, kappa = _core.curve_constants(d)
+        self._c = _frozen(c)
+        self._ct = _frozen(ct)
+        self._kappa = complex(kappa[0])
+
+    def _d123(self) -> np.ndarray:
+        return np.ascontiguousarray(self._d[1:4])
+
+    @property
+    def branch_points(self) -> np.ndarray:
+        """``(d_0, d_1, d_2, d_3, d_4) = (0, d1, d2, d3, d1 d2 d3)``, read-only."""
+        return self._d
+
+    @property
+    def d(self) -> tuple[complex, complex, complex]:
+        """``(d1, d2, d3)``."""
+        return (complex(self._d[1]), complex(self._d[2]), complex(self._d[3]))
+
+    @property
+    def c(self) -> np.ndarray:
+        """``c_j = (d_j - d_4)/((d_j - d_k)(d_j - d_l))`` (33), ``j = 1, 2, 3``.
+
+        The curve's constants, not the top's ``c_ij`` of (2).
+        """
+        return self._c
+
+    @property
+    def c_tilde(self) -> np.ndarray:
+        """``c~_j = 1/((d_j - d_k)(d_j - d_l))`` (33), ``j = 1, 2, 3``."""
+        return self._ct
+
+    @property
+    def kappa(self) -> complex:
+        """``kappa = prod_{m=1}^3 (d_m - d_4) = -R'(d_4)/d_4``, the factor of (29) corrected."""
+        return self._kappa
+
+    def __repr__(self) -> str:
+        d1, d2, d3 = self.d
+        return f"KotterCurve(d1={d1!r}, d2={d2!r}, d3={d3!r})"
+
+    def __eq__(self, other: object) -> bool:
+        if not isinstance(other, KotterCurve):
+            return NotImplemented
+        return bool(np.array_equal(self._d, other._d))
+
+    def __hash__(self) -> int:
+        return hash(self.d)
+
+    def R(self, x: Any) -> Any:
+        """``R(x) = prod_{j=0}^4 (x - d_j)`` (8), elementwise; scalar in, scalar out."""
+        xa = _c(x)
+        r, _ = _core.curve_eval(self._d123(), xa.reshape(-1))
+        return _scalar_or(r.reshape(xa.shape), xa.ndim == 0)
+
+    def y(self, x: Any, *, sheet: int = 1) -> Any:
+        """A square root of ``R(x)``: ``sheet * prod_{j=0}^4 sqrt(x - d_j)``.
+
+        Parameters
+        ----------
+        x : complex or array_like
+        sheet : {1, -1}, keyword-only
+            ``+1`` is the canonical sheet (product of principal roots), ``-1`` the other.
+        """
+        if sheet not in (1, -1):
+            raise ValueError(f"sheet must be +1 or -1, got {sheet!r}")
+        xa = _c(x)
+        _, y = _core.curve_eval(self._d123(), xa.reshape(-1))
+        return _scalar_or(sheet * y.reshape(xa.shape), xa.ndim == 0)
+
+    def wurzel(self, z1: Any, y1: Any, z2: Any, y2: Any, *, eps: Any = None) -> Wurzel:
+        """Weierstrass' Wurzelfunktionen (27)-(28) of the point pairs ``(z1, y1), (z2, y2)``.
+
+        .. math::
+            P_j = \\epsilon_j \\sqrt{(z_1 - d_j)(z_2 - d_j)} \\quad (27), \\qquad
+            P_{jk} = \\frac{P_j P_k}{z_1 - z_2}\\left(\\frac{y_1}{(z_1-d_j)(z_1-d_k)}
+                   - \\frac{y_2}{(z_2-d_j)(z_2-d_k)}\\right) \\quad (28)
+
+        with ``sqrt(R(z_i)) = y_i`` and ``P_j = eps_j r_j(z1) r_j(z2)`` (canonical
+        roots, see the module docstring), so that ``prod_j P_j = y1 y2``. (28) is
+        evaluated in the equivalent division-free form
+        ``P_jk = eps_j eps_k (r_j(z2) r_k(z2) rho_jk(z1) - r_j(z1) r_k(z1) rho_jk(z2))/(z1 - z2)``,
+        ``rho_jk = prod_{m not in {j, k}} r_m``, which is finite at branch points.
+
+        Parameters
+        ----------
+        z1, y1, z2, y2 : complex or array_like
+            Points of the curve; broadcast together.
+        eps : array_like of {+1, -1}, shape (..., 5), optional, keyword-only
+            Branch of the ``P_j`` (product must be +1); default all +1.
+
+        Returns
+        -------
+        Wurzel
+            ``P`` of shape ``(..., 5)``, ``Pjk`` of shape ``(..., 5, 5)``.
+
+        Raises
+        ------
+        ValueError
+            Non-finite input, a point off the curve (``|y**2 - R(z)|`` above
+            1e-8 of the size of the terms of ``R``), ``z1 == z2`` where (28)
+            divides by zero, or an invalid ``eps``.
+        """
+        z1a, y1a, z2a, y2a = np.broadcast_arrays(_c(z1), _c(y1), _c(z2), _c(y2))
+        shape = z1a.shape
+        e = _eps_rows(eps, shape)
+        if e is not None and eps is not None:
+            shape = np.broadcast_shapes(shape, np.shape(eps)[:-1])
+            z1a, y1a, z2a, y2a = (np.broadcast_to(a, shape) for a in (z1a, y1a, z2a, y2a))
+            e = _eps_rows(eps, shape)
+        flat = [np.ascontiguousarray(a.reshape(-1)) for a in (z1a, y1a, z2a, y2a)]
+        p, pjk = _core.curve_wurzel(self._d123(), *flat, e)
+        return Wurzel(P=_frozen(p.reshape(*shape, 5)), Pjk=_frozen(pjk.reshape(*shape, 5, 5)))
+
+    def xi_eta(
+        self,
+        z1: Any,
+        y1: Any,
+        z2: Any,
+        y2: Any,
+        g: Any,
+        *,
+        eps: Any = None,
+        sqrt_c: Any = None,
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """Kötter's vectors from points of the curve, (36).
+
+        .. math:: \\xi_j = \\sqrt{c_j}\\, g\\, P_{kl}, \\qquad \\eta_j = \\sqrt{c_j}\\, g\\, P_{j4}
+
+        with ``(j, k, l)`` cyclic in ``(1, 2, 3)`` and ``c_j`` of (33).
+
+        Parameters
+        ----------
+        z1, y1, z2, y2, g : complex or array_like
+            Points and factor, broadcast together.
+        eps : array_like, shape (..., 5), optional, keyword-only
+            Branch of the Wurzelfunktionen, as in :meth:`wurzel`.
+        sqrt_c : array_like, shape (3,), optional, keyword-only
+            The square roots of ``c_j`` to use; default the principal roots.
+
+        Returns
+        -------
+        xi, eta : ndarray, complex, shape (..., 3)
+        """
+        arrs = np.broadcast_arrays(_c(z1), _c(y1), _c(z2), _c(y2), _c(g))
+        shape = arrs[0].shape
+        if eps is not None:
+            shape = np.broadcast_shapes(shape, np.shape(eps)[:-1])
+            arrs = [np.broadcast_to(a, shape) for a in arrs]
+        e = _eps_rows(eps, shape)
+        flat = [np.ascontiguousarray(a.reshape(-1)) for a in arrs]
+        sc = None if sqrt_c is None else np.ascontiguousarray(_c(sqrt_c).reshape(-1))
+        xi, eta = _core.curve_xi_eta(self._d123(), *flat, e, sc)
+        return _frozen(xi.reshape(*shape, 3)), _frozen(eta.reshape(*shape, 3))
+
+    def points_from_wurzel(
+        self,
+        xi: Any,
+        eta: Any,
+        *,
+        sqrt_c: Any = None,
+        g_ref: Any = None,
+        rtol: float = INVERSE_RTOL,
+    ) -> CurvePoints:
+        """Invert (36): points ``(z1, y1), (z2, y2)``, ``g`` and branch ``eps`` from ``xi, eta``.
+
+        Given ``xi_j = sqrt(c_j) g P_kl`` and ``eta_j = sqrt(c_j) g P_j4``
+        (``j = 1, 2, 3``, ``(j, k, l)`` cyclic), put ``X_j = xi_j/sqrt(c_j)``,
+        ``Y_j = eta_j/sqrt(c_j)``. Then
+
+        * ``g**2 = sum_j c~_j Y_j**2 / d_4``  (from (30a): ``sum c~_j P_j4**2 = d_4``),
+        * ``z1 + z2 = d_4 + sum_j c~_j X_j**2 / g**2``,
+          ``z1 z2 = sum_j c~_j d_j X_j**2 / g**2``  ((30b), ``P_0**2 = z1 z2``),
+
+        so ``z1, z2`` are the roots of ``x**2 - (z1 + z2) x + z1 z2``;
+        ``y_i = +-y(z_i)`` and ``eps`` are the choice that reproduces the data,
+        and a Gauss-Newton step on the six equations polishes ``(z1, z2, g)``
+        (the sums above cancel when the ``P_kl`` are nearly equal). See
+        ``docs/curve.md`` for the derivation.
+
+        ``(g, y1, y2)`` and ``(-g, -y1, -y2)`` give the same ``(xi, eta)``; the
+        sign of ``g`` is that nearer ``g_ref`` if given, else that of the
+        principal ``sqrt(g**2)``.
+
+        Parameters
+        ----------
+        xi, eta : array_like, complex, shape (..., 3)
+        sqrt_c : array_like, shape (3,), optional, keyword-only
+            The square roots of ``c_j`` used to make ``xi, eta``; default principal.
+        g_ref : complex or array_like, optional, keyword-only
+            Selects the sign of ``g`` (e.g. ``g = 1/(1 - eps P_0)`` of (41)).
+        rtol : float, keyword-only
+            The recovered points must reproduce ``(xi, eta)`` to
+            ``rtol * max|(xi, eta)|``.
+
+        Returns
+        -------
+        CurvePoints
+
+        Raises
+        ------
+        ValueError
+            Non-finite input, ``g**2 = 0``, ``z1 == z2`` (a double root, where
+            (28) is undefined), or data that no point pair reproduces (not on
+            Kötter's quadrics (11) of this curve, or another branch of ``sqrt_c``).
+        """
+        xa, ea = _c(xi), _c(eta)
+        if xa.shape[-1:] != (3,) or ea.shape[-1:] != (3,):
+            raise ValueError(
+                f"xi and eta must have last axis of length 3, got {xa.shape} and {ea.shape}"
+            )
+        shape = np.broadcast_shapes(xa.shape[:-1], ea.shape[:-1])
+        if g_ref is not None:
+            shape = np.broadcast_shapes(shape, np.shape(g_ref))
+        scalar = len(shape) == 0
+        xr = np.ascontiguousarray(np.broadcast_to(xa, (*shape, 3)).reshape(-1, 3))
+        er = np.ascontiguousarray(np.broadcast_to(ea, (*shape, 3)).reshape(-1, 3))
+        gr = None
+        if g_ref is not None:
+            gr = np.ascontiguousarray(np.broadcast_to(_c(g_ref), shape).reshape(-1))
+        sc = None if sqrt_c is None else np.ascontiguousarray(_c(sqrt_c).reshape(-1))
+        pts, eps, res = _core.curve_points_from_xi_eta(
+            self._d123(), xr, er, sc, gr, float(rtol)
+        )
+        cols = [pts[:, i].reshape(shape) for i in range(5)]
+        return CurvePoints(
+            z1=_scalar_or(cols[0], scalar),
+            y1=_scalar_or(cols[1], scalar),
+            z2=_scalar_or(cols[2], scalar),
+            y2=_scalar_or(cols[3], scalar),
+            g=_scalar_or(cols[4], scalar),
+            eps=_frozen(eps.reshape(*shape, 5)),
+            residual=res.reshape(shape)[()] if scalar else _frozen(res.reshape(shape)),
+        )

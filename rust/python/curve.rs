@@ -1,0 +1,248 @@
+//! Bindings for `crate::curve`.
+//!
+//! The curve is passed as `d = (d1, d2, d3)`, a complex array of length 3,
+//! and validated on every call (cheap); batches are 1-D (or `(n, k)`) arrays
+//! that the Python layer has broadcast and flattened.
+
+use numpy::ndarray::{Array1, Array2, Array3};
+use numpy::{
+    Complex64, IntoPyArray, PyArray1, PyArray2, PyArray3, PyReadonlyArray1, PyReadonlyArray2,
+};
+use pyo3::prelude::*;
+
+use crate::curve::KotterCurve;
+use crate::error::Error;
+
+type C = Complex64;
+
+fn shape_err(what: &'static str, expected: String, got: &[usize]) -> PyErr {
+    Error::Shape {
+        what,
+        expected,
+        got: format!("{got:?}"),
+    }
+    .into()
+}
+
+fn curve_of(d: &PyReadonlyArray1<'_, C>) -> PyResult<KotterCurve> {
+    let v = d.as_array();
+    if v.len() != 3 {
+        return Err(shape_err("d", "(3,)".into(), v.shape()));
+    }
+    Ok(KotterCurve::new(v[0], v[1], v[2])?)
+}
+
+fn vec1(a: &PyReadonlyArray1<'_, C>, what: &'static str, n: usize) -> PyResult<Vec<C>> {
+    let v = a.as_array();
+    if v.len() != n {
+        return Err(shape_err(what, format!("({n},)"), v.shape()));
+    }
+    Ok(v.to_vec())
+}
+
+fn rows<T: Copy + numpy::Element, const K: usize>(
+    a: &PyReadonlyArray2<'_, T>,
+    what: &'static str,
+    n: usize,
+) -> PyResult<Vec<[T; K]>> {
+    let v = a.as_array();
+    if v.shape() != [n, K] {
+        return Err(shape_err(what, format!("({n}, {K})"), v.shape()));
+    }
+    Ok(v.rows()
+        .into_iter()
+        .map(|r| std::array::from_fn(|k| r[k]))
+        .collect())
+}
+
+/// `(d0, …, d4)` of the curve (8) with the given `(d1, d2, d3)`, validated.
+#[pyfunction(name = "curve_branch_points")]
+fn curve_branch_points_py<'py>(
+    py: Python<'py>,
+    d: PyReadonlyArray1<'py, C>,
+) -> PyResult<Bound<'py, PyArray1<C>>> {
+    let k = curve_of(&d)?;
+    Ok(Array1::from(k.branch_points().to_vec()).into_pyarray(py))
+}
+
+/// `(c_1, c_2, c_3)`, `(c̃_1, c̃_2, c̃_3)` (33) and `κ = Π_m (d_m − d_4)` (as a
+/// length-1 array).
+#[pyfunction(name = "curve_constants")]
+#[allow(clippy::type_complexity)]
+fn curve_constants_py<'py>(
+    py: Python<'py>,
+    d: PyReadonlyArray1<'py, C>,
+) -> PyResult<(
+    Bound<'py, PyArray1<C>>,
+    Bound<'py, PyArray1<C>>,
+    Bound<'py, PyArray1<C>>,
+)> {
+    let k = curve_of(&d)?;
+    Ok((
+        Array1::from(k.c().to_vec()).into_pyarray(py),
+        Array1::from(k.c_tilde().to_vec()).into_pyarray(py),
+        Array1::from(vec![k.kappa()]).into_pyarray(py),
+    ))
+}
+
+/// `R(x)` and the canonical sheet `y(x)` at each `x`.
+#[pyfunction(name = "curve_eval")]
+#[allow(clippy::type_complexity)]
+fn curve_eval_py<'py>(
+    py: Python<'py>,
+    d: PyReadonlyArray1<'py, C>,
+    x: PyReadonlyArray1<'py, C>,
+) -> PyResult<(Bound<'py, PyArray1<C>>, Bound<'py, PyArray1<C>>)> {
+    let k = curve_of(&d)?;
+    let xs = x.as_array().to_vec();
+    let (r, y): (Vec<C>, Vec<C>) = py.detach(|| xs.iter().map(|&x| (k.r(x), k.y(x))).unzip());
+    Ok((
+        Array1::from(r).into_pyarray(py),
+        Array1::from(y).into_pyarray(py),
+    ))
+}
+
+/// The Wurzelfunktionen (27)–(28) of `n` point pairs: `P (n, 5)`, `Pjk (n, 5, 5)`.
+#[pyfunction(name = "curve_wurzel")]
+#[pyo3(signature = (d, z1, y1, z2, y2, eps=None))]
+#[allow(clippy::type_complexity)]
+fn curve_wurzel_py<'py>(
+    py: Python<'py>,
+    d: PyReadonlyArray1<'py, C>,
+    z1: PyReadonlyArray1<'py, C>,
+    y1: PyReadonlyArray1<'py, C>,
+    z2: PyReadonlyArray1<'py, C>,
+    y2: PyReadonlyArray1<'py, C>,
+    eps: Option<PyReadonlyArray2<'py, i8>>,
+) -> PyResult<(Bound<'py, PyArray2<C>>, Bound<'py, PyArray3<C>>)> {
+    let k = curve_of(&d)?;
+    let n = z1.as_array().len();
+    let (z1, y1) = (vec1(&z1, "z1", n)?, vec1(&y1, "y1", n)?);
+    let (z2, y2) = (vec1(&z2, "z2", n)?, vec1(&y2, "y2", n)?);
+    let eps: Option<Vec<[i8; 5]>> = eps.map(|e| rows(&e, "eps", n)).transpose()?;
+    let out = py.detach(|| -> Result<(Array2<C>, Array3<C>), Error> {
+        let mut p = Array2::<C>::zeros((n, 5));
+        let mut pjk = Array3::<C>::zeros((n, 5, 5));
+        for i in 0..n {
+            let w = k.wurzel(z1[i], y1[i], z2[i], y2[i], eps.as_ref().map(|e| e[i]))?;
+            for j in 0..5 {
+                p[[i, j]] = w.p[j];
+                for m in 0..5 {
+                    pjk[[i, j, m]] = w.pjk[j][m];
+                }
+            }
+        }
+        Ok((p, pjk))
+    })?;
+    Ok((out.0.into_pyarray(py), out.1.into_pyarray(py)))
+}
+
+/// Kötter's `ξ, η` (36) of `n` point pairs with factors `g`: two `(n, 3)` arrays.
+#[pyfunction(name = "curve_xi_eta")]
+#[pyo3(signature = (d, z1, y1, z2, y2, g, eps=None, sqrt_c=None))]
+#[allow(clippy::too_many_arguments, clippy::type_complexity)]
+fn curve_xi_eta_py<'py>(
+    py: Python<'py>,
+    d: PyReadonlyArray1<'py, C>,
+    z1: PyReadonlyArray1<'py, C>,
+    y1: PyReadonlyArray1<'py, C>,
+    z2: PyReadonlyArray1<'py, C>,
+    y2: PyReadonlyArray1<'py, C>,
+    g: PyReadonlyArray1<'py, C>,
+    eps: Option<PyReadonlyArray2<'py, i8>>,
+    sqrt_c: Option<PyReadonlyArray1<'py, C>>,
+) -> PyResult<(Bound<'py, PyArray2<C>>, Bound<'py, PyArray2<C>>)> {
+    let k = curve_of(&d)?;
+    let n = z1.as_array().len();
+    let (z1, y1) = (vec1(&z1, "z1", n)?, vec1(&y1, "y1", n)?);
+    let (z2, y2) = (vec1(&z2, "z2", n)?, vec1(&y2, "y2", n)?);
+    let g = vec1(&g, "g", n)?;
+    let eps: Option<Vec<[i8; 5]>> = eps.map(|e| rows(&e, "eps", n)).transpose()?;
+    let sqrt_c: Option<[C; 3]> = match sqrt_c {
+        None => None,
+        Some(s) => {
+            let v = vec1(&s, "sqrt_c", 3)?;
+            Some([v[0], v[1], v[2]])
+        }
+    };
+    let out = py.detach(|| -> Result<(Array2<C>, Array2<C>), Error> {
+        let mut xi = Array2::<C>::zeros((n, 3));
+        let mut eta = Array2::<C>::zeros((n, 3));
+        for i in 0..n {
+            let e = eps.as_ref().map(|e| e[i]);
+            let (x, h) = k.xi_eta(z1[i], y1[i], z2[i], y2[i], g[i], e, sqrt_c)?;
+            for j in 0..3 {
+                xi[[i, j]] = x[j];
+                eta[[i, j]] = h[j];
+            }
+        }
+        Ok((xi, eta))
+    })?;
+    Ok((out.0.into_pyarray(py), out.1.into_pyarray(py)))
+}
+
+/// The inverse of (36) for `n` rows of `(ξ, η)`: `z1, y1, z2, y2, g, residual`
+/// (each `(n,)`) and `eps` `(n, 5)`.
+#[pyfunction(name = "curve_points_from_xi_eta")]
+#[pyo3(signature = (d, xi, eta, sqrt_c=None, g_ref=None, rtol=1e-8))]
+#[allow(clippy::type_complexity)]
+fn curve_points_from_xi_eta_py<'py>(
+    py: Python<'py>,
+    d: PyReadonlyArray1<'py, C>,
+    xi: PyReadonlyArray2<'py, C>,
+    eta: PyReadonlyArray2<'py, C>,
+    sqrt_c: Option<PyReadonlyArray1<'py, C>>,
+    g_ref: Option<PyReadonlyArray1<'py, C>>,
+    rtol: f64,
+) -> PyResult<(
+    Bound<'py, PyArray2<C>>,
+    Bound<'py, PyArray2<i8>>,
+    Bound<'py, PyArray1<f64>>,
+)> {
+    let k = curve_of(&d)?;
+    let n = xi.as_array().shape()[0];
+    let xi: Vec<[C; 3]> = rows(&xi, "xi", n)?;
+    let eta: Vec<[C; 3]> = rows(&eta, "eta", n)?;
+    let g_ref = g_ref.map(|g| vec1(&g, "g_ref", n)).transpose()?;
+    let sqrt_c: Option<[C; 3]> = match sqrt_c {
+        None => None,
+        Some(s) => {
+            let v = vec1(&s, "sqrt_c", 3)?;
+            Some([v[0], v[1], v[2]])
+        }
+    };
+    let out = py.detach(|| -> Result<(Array2<C>, Array2<i8>, Array1<f64>), Error> {
+        // Columns: z1, y1, z2, y2, g.
+        let mut pts = Array2::<C>::zeros((n, 5));
+        let mut eps = Array2::<i8>::zeros((n, 5));
+        let mut res = Array1::<f64>::zeros(n);
+        for i in 0..n {
+            let gr = g_ref.as_ref().map(|g| g[i]);
+            let b = k.points_from_xi_eta(xi[i], eta[i], sqrt_c, gr, rtol)?;
+            for (j, v) in [b.z1, b.y1, b.z2, b.y2, b.g].into_iter().enumerate() {
+                pts[[i, j]] = v;
+            }
+            for j in 0..5 {
+                eps[[i, j]] = b.eps[j];
+            }
+            res[i] = b.residual;
+        }
+        Ok((pts, eps, res))
+    })?;
+    Ok((
+        out.0.into_pyarray(py),
+        out.1.into_pyarray(py),
+        out.2.into_pyarray(py),
+    ))
+}
+
+/// Adds this module's functions to `manakov._core`.
+pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_function(wrap_pyfunction!(curve_branch_points_py, m)?)?;
+    m.add_function(wrap_pyfunction!(curve_constants_py, m)?)?;
+    m.add_function(wrap_pyfunction!(curve_eval_py, m)?)?;
+    m.add_function(wrap_pyfunction!(curve_wurzel_py, m)?)?;
+    m.add_function(wrap_pyfunction!(curve_xi_eta_py, m)?)?;
+    m.add_function(wrap_pyfunction!(curve_points_from_xi_eta_py, m)?)?;
+    Ok(())
+}
