@@ -11,18 +11,16 @@ demonstrate the failure (see docs/errata-kotter.md).
 from __future__ import annotations
 
 import sys
-from functools import lru_cache
+from functools import cache
 from pathlib import Path
 
+import manakov
 import numpy as np
 import pytest
-
-import manakov
 from manakov.kotter import integrals, lax_pair, quartic, schottky
 
 sys.path.insert(0, str(Path(__file__).parent / "data"))
 import kotter_ref as ref  # noqa: E402
-
 from conftest import PROBLEM_NAMES  # noqa: E402
 
 # Identities evaluated on O(1) data in double precision: a few hundred ulps.
@@ -39,7 +37,7 @@ FAIL_MIN = 1e-6
 TIMES = np.linspace(0.0, 20.0, 81)
 
 
-@lru_cache(maxsize=None)
+@cache
 def _traj(name: str) -> np.ndarray:
     p = manakov.problem(name)
     return ref.trajectory(p.a, p.b, p.l0, TIMES)
@@ -416,10 +414,6 @@ def test_37_38_h0_form(name):
     assert rel(k.B, de[:, None] * (k.d + 1 / k.d)) < 1e-10
 
 
-def _p0_g(k, x_ref_d):
-    pass
-
-
 @pytest.mark.parametrize("name", PROBLEM_NAMES)
 def test_36_xi_eta_are_wurzelfunktionen(name):
     """(36): xi_j = sqrt(c_j) g P_kl, eta_j = sqrt(c_j) g P_j4 with P_jk from (28) evaluated
@@ -503,23 +497,54 @@ def test_39_40_41_printed_fail():
 # ---------------------------------------------------------------- round trip
 
 
-@pytest.mark.parametrize("name", PROBLEM_NAMES)
-def test_round_trip_along_trajectories(name):
-    """l -> (z1, y1, z2, y2, g) -> l closes to 1e-12 at 81 times on t in [0, 20]."""
+def _round_trip(name):
     p = manakov.problem(name)
     X = traj(name)
     k = manakov.kotter(p.a, p.b, X)
     back = manakov.from_kotter(p.a, p.b, k)
     err = np.max(np.abs(back - X), axis=-1) / np.max(np.abs(X), axis=-1)
+    return k, err
+
+
+NEAR_DEGENERATE_XFAIL = pytest.mark.xfail(
+    reason="near_degenerate: d1 and d2 are 3.8e-5 apart (a1 ~ a2) and z2 moves between "
+    "them, so a double-precision z2 fixes the P_j only to ~u |z| / |z2 - d_j| ~ 1e-10 "
+    "(measured max 2.2e-10, median 2.3e-12); see docs/kotter.md, 'Accuracy'",
+    strict=True,
+)
+
+
+@pytest.mark.parametrize(
+    "name",
+    [n if n != "near_degenerate" else pytest.param(n, marks=NEAR_DEGENERATE_XFAIL)
+     for n in PROBLEM_NAMES],
+)
+def test_round_trip_along_trajectories(name):
+    """l -> (z1, y1, z2, y2, g) -> l closes to 1e-12 at 81 times on t in [0, 20]."""
+    _, err = _round_trip(name)
     assert np.max(err) < ROUND_TRIP_TOL, f"max {np.max(err):.2e} at t = {TIMES[np.argmax(err)]}"
 
 
+# The conditioning of the (z, y) representation: a point at distance r from a branch
+# point d_j carries sqrt(z - d_j) only to relative u |z| / r (u the unit roundoff), and the
+# P_j, P_jk inherit it. The measured round-trip error stays below 10 u S / r, S the size
+# of the branch points and points (largest measured ratio: 3.1 on 'generic').
+ROUND_TRIP_CONDITION_FACTOR = 10.0
+
+
+@pytest.mark.parametrize("name", PROBLEM_NAMES)
+def test_round_trip_within_conditioning_bound(name):
+    k, err = _round_trip(name)
+    bp = np.array([c.branch_points for c in k.curve])
+    dist = np.minimum(np.min(np.abs(k.z1[:, None] - bp), -1),
+                      np.min(np.abs(k.z2[:, None] - bp), -1))
+    size = np.maximum(np.maximum(np.abs(k.z1), np.abs(k.z2)), np.max(np.abs(bp), -1))
+    u = np.finfo(float).eps
+    bound = np.maximum(ROUND_TRIP_TOL, ROUND_TRIP_CONDITION_FACTOR * u * size / dist)
+    assert np.all(err < bound)
+
+
 # ---------------------------------------------------------------- conventions
-
-
-def _constants_with_order(a, h, s):
-    K = ref.kotter_constants(a, h, s)
-    return K
 
 
 @pytest.mark.parametrize("name", PROBLEM_NAMES)

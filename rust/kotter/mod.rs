@@ -387,13 +387,89 @@ pub fn kotter_constants(a: &[f64; 4], l: &[f64; 6]) -> Result<KotterConstants> {
     check_a(a)?;
     check_finite("l", l)?;
     let h = integrals(a, l);
-    constants_from_h(a, &h)
+    let (m, n) = m_n(l);
+    // P(a_i) = h1 a_i^2 - h2 a_i + h3 from the state itself: the sum of the
+    // non-vanishing terms s_j4 m_j^2 + s_kl n_j^2 at s = a_i, without the
+    // cancellation of the form in h (it is small exactly when a root of F is
+    // near a_i, which is when it is needed to full relative accuracy).
+    let p_at_a: [f64; 4] = std::array::from_fn(|i| {
+        let x = a[i];
+        CYCLIC
+            .iter()
+            .enumerate()
+            .map(|(j, &(_, k, ll))| {
+                (x - a[j]) * (x - a[3]) * m[j] * m[j] + (x - a[k]) * (x - a[ll]) * n[j] * n[j]
+            })
+            .sum()
+    });
+    constants_impl(a, &h, &p_at_a)
 }
 
 /// [`kotter_constants`] from the integrals `h = (h0, h1, h2, h3)` directly.
+///
+/// A root `s_p` close to some `a_i` is then known only to an absolute
+/// accuracy of a few ulps of the coefficients, so `s_p − a_i` (and with it
+/// `√s_j4`, `l^(p)`) loses relative accuracy; [`kotter_constants`] avoids this.
 pub fn constants_from_h(a: &[f64; 4], h: &[f64; 4]) -> Result<KotterConstants> {
-    check_a(a)?;
     check_finite("h", h)?;
+    let p_at_a: [f64; 4] = std::array::from_fn(|i| (h[1] * a[i] - h[2]) * a[i] + h[3]);
+    constants_impl(a, h, &p_at_a)
+}
+
+/// The offsets `s_p − a_i` to full relative accuracy, and `P(s_p)`.
+///
+/// When `s_p` is nearer to `a_i` than a tenth of the distance from `a_i` to the
+/// other `a`'s, `t = s_p − a_i` is re-solved by Newton's method on
+/// `(P(a_i) + P'(a_i) t + h1 t²)² − 4 h0² t Π_{m≠i}(a_i − a_m + t) = 0`
+/// (the numerator of (18) at `s = a_i + t`, using `G(a_i) = 0`), whose terms
+/// are all of the size of `t`; the other offsets are `(a_i − a_m) + t`.
+fn root_offsets(a: &[f64; 4], h: &[f64; 4], p_at_a: &[f64; 4], sp: C) -> ([C; 4], C) {
+    let mut best = 0;
+    for i in 1..4 {
+        if (sp - a[i]).norm() < (sp - a[best]).norm() {
+            best = i;
+        }
+    }
+    let ai = a[best];
+    let gap = (0..4)
+        .filter(|&m| m != best)
+        .map(|m| (a[m] - ai).abs())
+        .fold(f64::INFINITY, f64::min);
+    let plain = |s: C| -> ([C; 4], C) { (std::array::from_fn(|m| s - a[m]), p_poly(h, s)) };
+    if (sp - ai).norm() >= 0.1 * gap {
+        return plain(sp);
+    }
+    let [h0, h1, h2, _] = *h;
+    let pa = p_at_a[best];
+    let dpa = 2.0 * h1 * ai - h2;
+    let mut t = sp - ai;
+    for _ in 0..4 {
+        let pt = pa + (h1 * t + dpa) * t;
+        let dpt = dpa + 2.0 * h1 * t;
+        let mut prod = ONE;
+        let mut dprod = ZERO;
+        for m in (0..4).filter(|&m| m != best) {
+            let f = ai - a[m] + t;
+            dprod = dprod * f + prod;
+            prod *= f;
+        }
+        let val = pt * pt - 4.0 * h0 * h0 * t * prod;
+        let der = 2.0 * pt * dpt - 4.0 * h0 * h0 * (prod + t * dprod);
+        if der == ZERO {
+            break;
+        }
+        let step = val / der;
+        t -= step;
+        if step.norm() <= f64::EPSILON * t.norm() {
+            break;
+        }
+    }
+    let diffs = std::array::from_fn(|m| if m == best { t } else { (ai - a[m]) + t });
+    (diffs, pa + (h1 * t + dpa) * t)
+}
+
+fn constants_impl(a: &[f64; 4], h: &[f64; 4], p_at_a: &[f64; 4]) -> Result<KotterConstants> {
+    check_a(a)?;
     let f = quartic_f(a, h)?;
     if h[0] == 0.0 || h[0].abs() <= DEGENERATE_RTOL * h[1] {
         return Err(Error::InvalidArgument {
@@ -412,10 +488,12 @@ pub fn constants_from_h(a: &[f64; 4], h: &[f64; 4]) -> Result<KotterConstants> {
     let mut u = [[ZERO; 3]; 4];
     let mut v = [[ZERO; 3]; 4];
     for p in 0..4 {
-        sigma[p] = -p_poly(h, s[p]) / (2.0 * h[0]);
+        // (conjugate roots give exactly conjugate offsets: the arithmetic is symmetric)
+        let (diff, p_sp) = root_offsets(a, h, p_at_a, s[p]);
+        sigma[p] = -p_sp / (2.0 * h[0]);
         sqrt_fp[p] = sqrt_principal(horner(&f, s[p]).1);
         for (j, &aj) in a.iter().enumerate() {
-            if (s[p] - aj).norm() <= REPEATED_ROOT_RTOL * scale_a {
+            if diff[j].norm() <= REPEATED_ROOT_RTOL * scale_a {
                 return Err(Error::InvalidArgument {
                     what: "state l",
                     reason: format!(
@@ -429,7 +507,7 @@ pub fn constants_from_h(a: &[f64; 4], h: &[f64; 4]) -> Result<KotterConstants> {
             }
         }
         for j in 0..3 {
-            let r = sqrt_principal(s_pair(s[p], a, j, 3));
+            let r = sqrt_principal(diff[j] * diff[3]);
             u[p][j] = r / sqrt_fp[p];
             v[p][j] = sigma[p] / r / sqrt_fp[p];
         }
