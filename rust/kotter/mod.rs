@@ -52,11 +52,20 @@ pub const DEGENERATE_RTOL: f64 = 1e-12;
 /// within 1e-7 are indistinguishable from a double root.
 pub const REPEATED_ROOT_RTOL: f64 = 1e-7;
 
+/// Roots within a relative distance `δ` of each other are determined only to
+/// about `u/δ` (u the unit roundoff), and the Aberth iteration then jitters
+/// at that level instead of reaching 1e-15. Steps still larger than 1e-8
+/// after 500 sweeps mean no convergence (roots closer than ~1e-8 are
+/// reported as repeated anyway).
+pub const ROOT_STAGNATION: f64 = 1e-8;
+
 /// Residual (relative to the size of the data) above which the structural
 /// fits of (37)–(39) are reported as failing: the nine equations for six
-/// unknowns are consistent to rounding (a few 1e-13 on the reference tops);
-/// 1e-8 rejects a genuinely inconsistent system.
-pub const STRUCTURE_RTOL: f64 = 1e-8;
+/// unknowns are consistent to rounding (a few 1e-13 on the reference tops,
+/// up to ~1e-7 when two `d_j` nearly coincide, which amplifies rounding in
+/// `α_j … δ_j` by `1/|d_j − d_k|`); 1e-6 still rejects an inconsistent
+/// system, whose residual is O(1).
+pub const STRUCTURE_RTOL: f64 = 1e-6;
 
 /// Principal square root `−π/2 < arg √w ≤ π/2`, with `√(−x) = +i√x` for
 /// `x > 0` whatever the sign of a zero imaginary part (the curve module's
@@ -269,10 +278,10 @@ pub fn quartic_roots(f: &[f64; 5]) -> Result<[C; 4]> {
             }
         }
     }
-    if !converged && last > 1e-12 {
+    if !converged && last > ROOT_STAGNATION {
         return Err(Error::NoConvergence {
             what: "roots of F(s) (18)",
-            tol: 1e-15,
+            tol: ROOT_STAGNATION,
             reached: last,
             iterations: 500,
         });
@@ -493,7 +502,9 @@ fn constants_impl(a: &[f64; 4], h: &[f64; 4], p_at_a: &[f64; 4]) -> Result<Kotte
         sigma[p] = -p_sp / (2.0 * h[0]);
         sqrt_fp[p] = sqrt_principal(horner(&f, s[p]).1);
         for (j, &aj) in a.iter().enumerate() {
-            if diff[j].norm() <= REPEATED_ROOT_RTOL * scale_a {
+            // the offsets are accurate to a few ulps relative (root_offsets):
+            // only a root indistinguishable from a_j in double precision is 0/0
+            if diff[j].norm() <= 4.0 * f64::EPSILON * scale_a {
                 return Err(Error::InvalidArgument {
                     what: "state l",
                     reason: format!(
@@ -580,15 +591,28 @@ type H0Structure = ([C; 3], [C; 3], [C; 4], C, C);
 fn lstsq(rows: &[Vec<C>], rhs: &[C]) -> Result<(Vec<C>, f64)> {
     let nr = rows.len();
     let nc = rows.first().map_or(0, |r| r.len());
-    let m = DMatrix::from_fn(nr, nc, |i, j| rows[i][j]);
+    // Columns are equilibrated first: the unknowns (K ε², 2Kε, K, ...) differ
+    // by many orders of magnitude, and an unscaled SVD cut-off would discard
+    // the small ones.
+    let colnorm: Vec<f64> = (0..nc)
+        .map(|j| {
+            let n = rows.iter().map(|r| r[j].norm_sqr()).sum::<f64>().sqrt();
+            if n > 0.0 {
+                n
+            } else {
+                1.0
+            }
+        })
+        .collect();
+    let m = DMatrix::from_fn(nr, nc, |i, j| rows[i][j] / colnorm[j]);
     let b = DVector::from_row_slice(rhs);
     let svd = m.clone().svd(true, true);
-    let x = svd.solve(&b, 1e-14).map_err(|e| Error::InvalidArgument {
+    let y = svd.solve(&b, 1e-14).map_err(|e| Error::InvalidArgument {
         what: "Koetter constants",
         reason: format!("least-squares solve failed: {e}"),
     })?;
-    let res = (&m * &x - &b).norm() / b.norm().max(f64::MIN_POSITIVE);
-    Ok((x.iter().copied().collect(), res))
+    let res = (&m * &y - &b).norm() / b.norm().max(f64::MIN_POSITIVE);
+    Ok(((0..nc).map(|j| y[j] / colnorm[j]).collect(), res))
 }
 
 /// (37)–(39): `H0 = Σ_j m_j n_j` as a quadratic form in `ξ, η`, reduced modulo
@@ -646,10 +670,12 @@ fn h0_structure(
         rhs.push(cc[j]);
     }
     let (x, r3) = lstsq(&rows, &rhs)?;
+    // ε from 2Kε and K; that the K ε² column then agrees (the perfect square
+    // of (39)) is a property checked in the tests and, per state, through
+    // the corrected (41) in `kotter_with`.
     let k = x[2];
     let eps = x[1] / (2.0 * k);
-    let r4 = (x[0] - k * eps * eps).norm() / x[0].norm().max(f64::MIN_POSITIVE);
-    let worst = r1.max(r2).max(r3).max(r4);
+    let worst = r1.max(r2).max(r3);
     if worst.is_nan() || worst > STRUCTURE_RTOL {
         return Err(Error::InvalidArgument {
             what: "Koetter constants",
@@ -677,9 +703,10 @@ pub fn xi_eta(k: &KotterConstants, l: &[f64; 6]) -> ([C; 3], [C; 3]) {
 }
 
 /// Relative size of the imaginary part above which [`l_from_xi_eta`] refuses
-/// to return a real state: a round trip leaves ~1e-15; data that do not come
-/// from a real state leave an O(1) imaginary part.
-pub const REAL_RTOL: f64 = 1e-9;
+/// to return a real state: a round trip leaves ~1e-15 on well-conditioned
+/// curves and up to ~1e-8 near coinciding branch points; data that do not
+/// come from a real state leave an O(1) imaginary part.
+pub const REAL_RTOL: f64 = 1e-6;
 
 /// The state from `ξ, η` by (23): `m_j = α_j ξ_j + β_j η_j`,
 /// `n_j = γ_j ξ_j + δ_j η_j`, `l = (m3, −m2, n1, m1, n2, n3)`.
@@ -720,10 +747,19 @@ fn real_state(k: &Coefficients23, xi: &[C; 3], eta: &[C; 3]) -> Result<[f64; 6]>
     Ok(l_from_m_n(&m, &n))
 }
 
-/// Tolerance for the inverse map of the curve module
-/// ([`KotterCurve::points_from_xi_eta`]) and for the corrected (41): exact
-/// data reproduce `(ξ, η)` to ~1e-14 relative; 1e-8 rejects inconsistent data.
-pub const UNIFORM_RTOL: f64 = 1e-8;
+/// Tolerance passed to the inverse map of the curve module
+/// ([`KotterCurve::points_from_xi_eta`]): exact data reproduce `(ξ, η)` to
+/// ~1e-14 relative on well-conditioned curves, to ~1e-7 when two branch
+/// points nearly coincide (points trapped between them); data off the
+/// quadrics miss by O(1), so 1e-6 separates the two.
+pub const UNIFORM_RTOL: f64 = 1e-6;
+
+/// Relative agreement required between `g` from (30a) (the curve's inverse
+/// map) and the corrected (41). The sign choice needs only `|Δg| ≪ |g|`; the
+/// accuracy of `K`, `ε` (a least-squares fit of (37)–(39)) degrades with the
+/// conditioning of the `d_j` (clustered roots of F give ~1e-8), so 1e-6 flags
+/// a wrong structure, not rounding.
+pub const G41_RTOL: f64 = 1e-6;
 
 /// A state in Kötter's coordinates: the constants of its level set, the
 /// vectors `l^(p)`, `ξ, η`, the curve (8) and the point pair with `g` (36), (41).
@@ -790,7 +826,7 @@ pub fn kotter_with(constants: KotterConstants, l: &[f64; 6]) -> Result<KotterSta
     let g41 = sqrt_principal(C::new(constants.h[0], 0.0) / constants.k) / one_m;
     let points = curve.points_from_xi_eta(xi, eta, None, Some(g41), UNIFORM_RTOL)?;
     let mis = (points.g - g41).norm();
-    if mis.is_nan() || mis > UNIFORM_RTOL * g41.norm() {
+    if mis.is_nan() || mis > G41_RTOL * g41.norm() {
         return Err(Error::InvalidArgument {
             what: "state l",
             reason: format!(
