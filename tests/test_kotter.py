@@ -699,3 +699,23 @@ def test_from_kotter_rejects_points_off_the_curve():
     bad = dataclasses.replace(k, y1=k.y1 * 1.01)
     with pytest.raises(ValueError, match="not on the curve"):
         manakov.from_kotter(p.a, p.b, bad)
+
+
+def test_from_kotter_coinciding_branch_points():
+    """Coinciding branch points (the genus drops) -> ValueError naming them."""
+    import dataclasses
+
+    p = generic()
+    k = manakov.kotter(p.a, p.b, p.l0)
+    d = np.array(k.d)
+    d[1] = d[0]
+    with pytest.raises(ValueError, match="coincide"):
+        manakov.from_kotter(p.a, p.b, dataclasses.replace(k, d=d))
+
+
+def test_curve_field_is_the_curve_of_the_d():
+    p = generic()
+    k = manakov.kotter(p.a, p.b, p.l0)
+    assert isinstance(k.curve, manakov.KotterCurve)
+    bp = np.asarray(k.curve.branch_points)
+    assert rel(bp, np.array([0, *k.d, np.prod(k.d)])) < EXACT_TOL
