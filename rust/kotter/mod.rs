@@ -67,21 +67,10 @@ pub const ROOT_STAGNATION: f64 = 1e-8;
 /// system, whose residual is O(1).
 pub const STRUCTURE_RTOL: f64 = 1e-6;
 
-/// Principal square root `−π/2 < arg √w ≤ π/2`, with `√(−x) = +i√x` for
-/// `x > 0` whatever the sign of a zero imaginary part (the curve module's
-/// convention, so both modules cut `(−∞, 0)` on the same side).
-pub fn sqrt_principal(w: C) -> C {
-    let (re, im) = (w.re, w.im + 0.0);
-    if re == 0.0 && im == 0.0 {
-        return ZERO;
-    }
-    let t = ((re.hypot(im) + re.abs()) / 2.0).sqrt();
-    if re >= 0.0 {
-        C::new(t, im / (2.0 * t))
-    } else {
-        C::new(im.abs() / (2.0 * t), t.copysign(im))
-    }
-}
+/// The principal square root of the curve module (`−π/2 < arg √w ≤ π/2`,
+/// `√(−x) = +i√x` whatever the sign of a zero imaginary part), so that both
+/// modules cut `(−∞, 0)` on the same side.
+pub use crate::curve::sqrt_principal;
 
 fn check_a(a: &[f64; 4]) -> Result<()> {
     check_finite("a", a)?;
@@ -808,7 +797,7 @@ pub fn kotter_with(constants: KotterConstants, l: &[f64; 6]) -> Result<KotterSta
     let [d1, d2, d3] = constants.d;
     let curve = KotterCurve::new(d1, d2, d3)?;
     let ct = curve.c_tilde();
-    let sc = curve.c().map(crate::curve::sqrt_principal);
+    let sc = curve.c().map(sqrt_principal);
     let d4 = curve.branch_points()[4];
     let x: [C; 3] = std::array::from_fn(|j| xi[j] / sc[j]);
     let y: [C; 3] = std::array::from_fn(|j| eta[j] / sc[j]);

@@ -144,3 +144,65 @@ fn uniformization_round_trip() {
     let lhs = k.k * p.g * p.g * (ONE - k.eps * w.p[0]) * (ONE - k.eps * w.p[0]);
     assert_relative_eq!((lhs - k.h[0]).norm(), 0.0, epsilon = 1e-10);
 }
+
+/// A state with a root of F at 8e-6 from a_3 (found by proptest): the
+/// offsets s_p − a_i are re-solved to full relative accuracy, so the third
+/// quadric holds to rounding (it held only to 4e-10 with s_p − a_3 formed by
+/// subtraction).
+#[test]
+fn root_near_a_j_keeps_accuracy() {
+    let l = [
+        0.0,
+        0.3001954042337765,
+        1.492521782957833,
+        0.9726016280674399,
+        -0.30541071596704544,
+        -1.3666729134014255,
+    ];
+    let k = kotter_constants(&A, &l).unwrap();
+    assert!(k.s.iter().any(|s| (s - A[2]).norm() < 1e-4));
+    let (xi, eta) = xi_eta(&k, &l);
+    let q3: C = (0..3)
+        .map(|j| k.d[j] * xi[j] * xi[j] + eta[j] * eta[j] / k.d[j])
+        .sum();
+    let size: f64 = (0..3)
+        .map(|j| (k.d[j] * xi[j] * xi[j]).norm() + (eta[j] * eta[j] / k.d[j]).norm())
+        .sum();
+    assert!(q3.norm() < 1e-13 * size, "{}", q3.norm() / size);
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(64))]
+    /// (14) on both branches of √G, random states and s.
+    #[test]
+    fn closed_form_14_random(l in proptest::array::uniform6(-2.0f64..2.0),
+                             re in -3.0f64..6.0, im in -2.0f64..2.0, sg in proptest::bool::ANY) {
+        let s = C::new(re, im);
+        prop_assume!(A.iter().all(|&a| (s - a).norm() > 1e-3));
+        let h = integrals(&A, &l);
+        let sqrt_g = if sg { 1.0 } else { -1.0 } * sqrt_principal(g_poly(&A, s));
+        let (lv, _) = schottky(&A, &l, s, sqrt_g).unwrap();
+        let f = dot(&lv, &lv);
+        let closed = p_poly(&h, s) + 2.0 * h[0] * sqrt_g;
+        let scale = h[1] * (s.norm() + 4.0).powi(2);
+        prop_assert!((f - closed).norm() < 1e-13 * scale);
+    }
+
+    /// (19)–(20) for random states.
+    #[test]
+    fn relations_20_random(l in proptest::array::uniform6(-2.0f64..2.0)) {
+        if let Ok(k) = kotter_constants(&A, &l) {
+            let lp = l_p(&k, &l);
+            // relative to the size of the terms Σ |l_k^(p)|²: clustered roots make
+            // |l^(p)| large and the sums cancel
+            let size: f64 = lp.iter().flatten().map(|z| z.norm_sqr()).sum();
+            for p in 0..4 {
+                prop_assert!(dot(&lp[p], &lp[p]).norm() < 1e-11 * size);
+            }
+            for j in 0..3 {
+                let s: C = (0..4).map(|p| lp[p][j] * lp[p][j]).sum();
+                prop_assert!(s.norm() < 1e-11 * size);
+            }
+        }
+    }
+}
