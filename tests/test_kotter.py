@@ -719,3 +719,11 @@ def test_curve_field_is_the_curve_of_the_d():
     assert isinstance(k.curve, manakov.KotterCurve)
     bp = np.asarray(k.curve.branch_points)
     assert rel(bp, np.array([0, *k.d, np.prod(k.d)])) < EXACT_TOL
+
+
+def test_schottky_bad_input():
+    p = generic()
+    with pytest.raises(ValueError, match="finite"):
+        schottky(p.a, p.l0, complex(np.nan, 0.0))
+    with pytest.raises(ValueError, match="s != a_i"):
+        schottky(p.a, p.l0, p.a[0] + 0j, sqrt_g=0j)

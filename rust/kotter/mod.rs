@@ -124,8 +124,12 @@ pub fn g_poly(a: &[f64; 4], s: C) -> C {
 /// `√s_j4 √s_kl = sqrt_g` (`√s_j4` principal, see the module docs):
 /// `l_j(s) = √s_j4 m_j + √s_kl n_j`, `m_j(s) = √s_kl m_j + √s_j4 n_j`.
 ///
-/// Errors if `s = a_j` or `s = a_4` for some `j` (then `√s_kl = √G/√s_j4` is 0/0).
+/// Errors: non-finite input; `s = a_j` or `s = a_4` for some `j` (then
+/// `√s_kl = √G/√s_j4` is 0/0).
 pub fn schottky(a: &[f64; 4], l: &[f64; 6], s: C, sqrt_g: C) -> Result<([C; 3], [C; 3])> {
+    check_finite("a", a)?;
+    check_finite("l", l)?;
+    check_finite("s, sqrt_g", &[s.re, s.im, sqrt_g.re, sqrt_g.im])?;
     let (m, n) = m_n(l);
     let mut lv = [ZERO; 3];
     let mut mv = [ZERO; 3];
