@@ -727,3 +727,28 @@ def test_schottky_bad_input():
         schottky(p.a, p.l0, complex(np.nan, 0.0))
     with pytest.raises(ValueError, match="s != a_i"):
         schottky(p.a, p.l0, p.a[0] + 0j, sqrt_g=0j)
+
+
+@pytest.mark.parametrize("name", PROBLEM_NAMES)
+def test_40_corrected_closed_form(name):
+    """(40) corrected (pinned numerically, then checked on random states too):
+    eps = +-(sqrt((s2-s3)(s1-s4)) - sqrt((s1-s3)(s2-s4))) / (sqrt(d4) sqrt((s1-s2)(s3-s4)))
+    with sqrt(d4) = sqrt(d1) sqrt(d2) sqrt(d3) from (26) and principal roots; the sign goes
+    with the branch of P_0 (it is the sign of eps P_0 that (39) fixes)."""
+    p = manakov.problem(name)
+    rng = np.random.default_rng(11)
+    states = [p.l0] + [rng.normal(size=6) for _ in range(6)]
+    checked = 0
+    for l in states:
+        try:
+            k = manakov.kotter(p.a, p.b, l)
+        except ValueError:
+            continue  # an ill-conditioned random state; the four tops are all checked
+        s1, s2, s3, s4 = k.s
+        W = np.sqrt((s1 - s3) * (s2 - s4))
+        Y = np.sqrt((s2 - s3) * (s1 - s4))
+        Z = np.sqrt((s1 - s2) * (s3 - s4))
+        ratio = k.eps * np.prod(k.sqrt_d) * Z / (Y - W)
+        assert min(abs(ratio - 1), abs(ratio + 1)) < 1e-8
+        checked += 1
+    assert checked >= 4
