@@ -251,15 +251,14 @@ class KotterCurve:
             1e-8 of the size of the terms of ``R``), ``z1 == z2`` where (28)
             divides by zero, or an invalid ``eps``.
         """
-        z1a, y1a, z2a, y2a = np.broadcast_arrays(_c(z1), _c(y1), _c(z2), _c(y2))
-        shape = z1a.shape
-        e = _eps_rows(eps, shape)
-        if e is not None and eps is not None:
+        arrs = list(np.broadcast_arrays(_c(z1), _c(y1), _c(z2), _c(y2)))
+        shape = arrs[0].shape
+        if eps is not None:
             shape = np.broadcast_shapes(shape, np.shape(eps)[:-1])
-            z1a, y1a, z2a, y2a = (np.broadcast_to(a, shape) for a in (z1a, y1a, z2a, y2a))
-            e = _eps_rows(eps, shape)
-        flat = [np.ascontiguousarray(a.reshape(-1)) for a in (z1a, y1a, z2a, y2a)]
-        p, pjk = _core.curve_wurzel(self._d123(), *flat, e)
+            arrs = [np.broadcast_to(a, shape) for a in arrs]
+        e = _eps_rows(eps, shape)
+        z1f, y1f, z2f, y2f = (np.ascontiguousarray(a.reshape(-1)) for a in arrs)
+        p, pjk = _core.curve_wurzel(self._d123(), z1f, y1f, z2f, y2f, e)
         return Wurzel(P=_frozen(p.reshape(*shape, 5)), Pjk=_frozen(pjk.reshape(*shape, 5, 5)))
 
     def xi_eta(
@@ -292,15 +291,15 @@ class KotterCurve:
         -------
         xi, eta : ndarray, complex, shape (..., 3)
         """
-        arrs = np.broadcast_arrays(_c(z1), _c(y1), _c(z2), _c(y2), _c(g))
+        arrs = list(np.broadcast_arrays(_c(z1), _c(y1), _c(z2), _c(y2), _c(g)))
         shape = arrs[0].shape
         if eps is not None:
             shape = np.broadcast_shapes(shape, np.shape(eps)[:-1])
             arrs = [np.broadcast_to(a, shape) for a in arrs]
         e = _eps_rows(eps, shape)
-        flat = [np.ascontiguousarray(a.reshape(-1)) for a in arrs]
+        z1f, y1f, z2f, y2f, gf = (np.ascontiguousarray(a.reshape(-1)) for a in arrs)
         sc = None if sqrt_c is None else np.ascontiguousarray(_c(sqrt_c).reshape(-1))
-        xi, eta = _core.curve_xi_eta(self._d123(), *flat, e, sc)
+        xi, eta = _core.curve_xi_eta(self._d123(), z1f, y1f, z2f, y2f, gf, e, sc)
         return _frozen(xi.reshape(*shape, 3)), _frozen(eta.reshape(*shape, 3))
 
     def points_from_wurzel(
@@ -369,9 +368,7 @@ class KotterCurve:
         if g_ref is not None:
             gr = np.ascontiguousarray(np.broadcast_to(_c(g_ref), shape).reshape(-1))
         sc = None if sqrt_c is None else np.ascontiguousarray(_c(sqrt_c).reshape(-1))
-        pts, eps, res = _core.curve_points_from_xi_eta(
-            self._d123(), xr, er, sc, gr, float(rtol)
-        )
+        pts, eps, res = _core.curve_points_from_xi_eta(self._d123(), xr, er, sc, gr, float(rtol))
         cols = [pts[:, i].reshape(shape) for i in range(5)]
         return CurvePoints(
             z1=_scalar_or(cols[0], scalar),

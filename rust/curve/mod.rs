@@ -68,6 +68,14 @@ pub const INVERSE_RTOL: f64 = 1e-8;
 /// `d_2 d_3 = 1` only up to a few ulps.
 const REPEATED_RTOL: f64 = 8.0 * f64::EPSILON;
 
+/// `|z1 − z2|` (relative to `max(|z1|, 1)`) below which the inverse reports
+/// the double root `z1 == z2` instead of a pair: a discriminant `(z1 − z2)²`
+/// that is zero in exact arithmetic comes out ~1e-16 after rounding, i.e.
+/// `|z1 − z2|` ~1e-8, and the error of the recovered pair grows like
+/// `u/|z1 − z2|²`, reaching O(1e-4) relative at 1e-6: below that the two
+/// points are not resolved.
+const NEAR_DOUBLE_ROOT: f64 = 1e-6;
+
 /// The cyclic permutations `(j, k, l)` of `(1, 2, 3)`, in the order `j = 1, 2, 3`.
 pub const CYCLIC: [(usize, usize, usize); 3] = [(1, 2, 3), (2, 3, 1), (3, 1, 2)];
 
@@ -111,7 +119,8 @@ pub struct Wurzel {
 /// Wurzelfunktionen, as recovered by [`KotterCurve::points_from_xi_eta`].
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct WurzelPoints {
-    /// First point, the root of `U(x) = x² − (z1+z2) x + z1 z2` of larger modulus.
+    /// First point: the root of `U(x) = x² − (z1+z2) x + z1 z2` of larger
+    /// modulus in the closed form, then polished (the pair is unordered).
     pub z1: Complex64,
     /// Its `y`, `y1² = R(z1)`.
     pub y1: Complex64,
@@ -361,16 +370,21 @@ impl KotterCurve {
         let sc = self.sqrt_c_checked(sqrt_c)?;
         let ct = self.c_tilde();
         let d = &self.d;
-        let x: [Complex64; 3] = std::array::from_fn(|i| xi[i] / sc[i]);
-        let yv: [Complex64; 3] = std::array::from_fn(|i| eta[i] / sc[i]);
-
-        let g2 = (0..3).map(|i| ct[i] * yv[i] * yv[i]).sum::<Complex64>() / d[4];
+        // (36) is homogeneous in g: solve for the data scaled to max|·| = 1
+        // (so that g² neither overflows nor underflows) and scale g back.
         let scale = xi
             .iter()
             .chain(eta.iter())
             .map(|v| v.norm())
             .fold(0.0, f64::max);
-        if g2 == Complex64::new(0.0, 0.0) || scale == 0.0 {
+        let x: [Complex64; 3] = std::array::from_fn(|i| xi[i] / scale / sc[i]);
+        let yv: [Complex64; 3] = std::array::from_fn(|i| eta[i] / scale / sc[i]);
+
+        let g2 = (0..3).map(|i| ct[i] * yv[i] * yv[i]).sum::<Complex64>() / d[4];
+        if scale == 0.0
+            || g2 == Complex64::new(0.0, 0.0)
+            || !(g2.re.is_finite() && g2.im.is_finite())
+        {
             return Err(Error::InvalidArgument {
                 what: "xi, eta",
                 reason: "g^2 = sum_j c~_j (eta_j/sqrt c_j)^2 / d_4 vanishes (30a): \
@@ -396,7 +410,15 @@ impl KotterCurve {
         let target: [Complex64; 6] = [x[0], x[1], x[2], yv[0], yv[1], yv[2]];
         let yc1 = self.y(z1);
         let yc2 = self.y(z2);
-        let mut best: Option<WurzelPoints> = None;
+        let mut best = WurzelPoints {
+            z1,
+            y1: yc1,
+            z2,
+            y2: yc2,
+            g,
+            eps: [1; 5],
+            residual: f64::INFINITY,
+        };
         for s1 in [1.0, -1.0] {
             for s2 in [1.0, -1.0] {
                 let (y1, y2) = (yc1 * s1, yc2 * s2);
@@ -410,12 +432,11 @@ impl KotterCurve {
                     for (i, &(j, k, l)) in CYCLIC.iter().enumerate() {
                         let pkl = g * eps[k] * eps[l] * w.pjk[k][l];
                         let pj4 = g * eps[j] * w.pjk[j][4];
-                        resid = resid
-                            .max(((target[i] - pkl) * sc[i]).norm())
-                            .max(((target[i + 3] - pj4) * sc[i]).norm());
+                        resid = nan_max(resid, ((target[i] - pkl) * sc[i]).norm());
+                        resid = nan_max(resid, ((target[i + 3] - pj4) * sc[i]).norm());
                     }
-                    if best.as_ref().is_none_or(|b| resid < b.residual) {
-                        best = Some(WurzelPoints {
+                    if resid < best.residual {
+                        best = WurzelPoints {
                             z1,
                             y1,
                             z2,
@@ -423,16 +444,28 @@ impl KotterCurve {
                             g,
                             eps: eps.map(|v| v as i8),
                             residual: resid,
-                        });
+                        };
                     }
                 }
             }
         }
-        let Some(best) = best else {
-            return unreachable_error();
-        };
-        let b = self.refine(best, &target, &sc);
-        if b.residual <= rtol * scale {
+        let mut b = self.refine(best, &target, &sc);
+        b.g *= scale;
+        b.residual *= scale;
+        if (b.z1 - b.z2).norm() <= NEAR_DOUBLE_ROOT * b.z1.norm().max(1.0) {
+            // A discriminant that vanishes in exact arithmetic is ~1e-16 after
+            // rounding, so z1 - z2 ~ 1e-8: the data sit at z1 == z2, and no
+            // pair closer than NEAR_DOUBLE_ROOT can be resolved from them.
+            Err(Error::InvalidArgument {
+                what: "xi, eta",
+                reason: format!(
+                    "they give (nearly) z1 == z2 (|z1 - z2| = {:e} at z = {}): P_jk (28) is \
+                     singular there and the two points cannot be resolved",
+                    (b.z1 - b.z2).norm(),
+                    b.z1,
+                ),
+            })
+        } else if b.residual <= rtol * scale {
             Ok(b)
         } else {
             Err(Error::InvalidArgument {
@@ -478,7 +511,7 @@ impl KotterCurve {
         let resid_of = |f: &[Complex64; 6]| -> f64 {
             (0..6)
                 .map(|i| ((target[i] - f[i]) * sc[i % 3]).norm())
-                .fold(0.0, f64::max)
+                .fold(0.0, nan_max)
         };
         let six = |r1: &[Complex64; 5], r2: &[Complex64; 5], dz: Complex64, g: Complex64| {
             let w = wurzel_from_roots(r1, r2, dz, &[1.0; 5]);
@@ -560,11 +593,14 @@ impl KotterCurve {
     }
 }
 
-fn unreachable_error<T>() -> Result<T> {
-    Err(Error::InvalidArgument {
-        what: "xi, eta",
-        reason: "internal: no candidate evaluated".into(),
-    })
+/// `max` that propagates NaN (`f64::max` drops it), so that a NaN anywhere in
+/// a residual makes the residual NaN and the check fail.
+fn nan_max(a: f64, b: f64) -> f64 {
+    if a.is_nan() || b.is_nan() {
+        f64::NAN
+    } else {
+        a.max(b)
+    }
 }
 
 /// Checks a branch vector: entries `±1`, product `+1`.

@@ -11,16 +11,40 @@ fn c(re: f64, im: f64) -> C {
     C::new(re, im)
 }
 
+/// Single evaluations of a few (≤ 10) rounded operations on O(1) numbers
+/// (`√w`, `R(x)`, `y(x)²`): a few tens of ulps.
+const ROUNDING_TOL: f64 = 1e-13;
+
+/// Points closer than this to a cut `d_j + (−∞, 0]` may come back on the other
+/// side of it (the recovered `z` carries ~1e-15 of rounding), with `eps`
+/// compensating; 1e-9 is far above that rounding.
+const ON_CUT_DIST: f64 = 1e-9;
+
+/// A misprinted identity misses by an O(1) factor; 0.1 is far above rounding.
+const MISPRINT_MARGIN: f64 = 0.1;
+
 /// Identities are compared relative to the sum of the moduli of their terms.
 /// Each term is a product of ~20 rounded factors (relative error ~1e-15) and
 /// `P_jk` loses at most a factor `|a|/|a − b|` (≲ 1e2 for the separated
 /// points drawn here) to cancellation; 1e-11 leaves a margin of ~10.
 const IDENTITY_RTOL: f64 = 1e-11;
 
-/// The round trip `(z, y) → (ξ, η) → (z, y)` is a handful of well-conditioned
-/// rational operations and one square root for separated points; 1e-12
-/// relative to the size of the data is the claim.
-const ROUNDTRIP_RTOL: f64 = 1e-12;
+/// Backward error of the inverse map: the recovered `(z1, y1, z2, y2, g, eps)`
+/// reproduce `(ξ, η)` to this fraction of `max|(ξ, η)|`. After the
+/// Gauss–Newton polish the residual is a few rounding errors of the forward
+/// map (worst seen over 100 000 random draws: 9.4e-15).
+const BACKWARD_RTOL: f64 = 1e-13;
+
+/// Forward error of the round trip `(z, y) → (ξ, η) → (z, y)`, in units of
+/// the first-order bound `u ‖(ξ, η)‖ / σ_min(J)` ([`inverse_error_bound`]):
+/// the inverse is conditioned like the map itself, whose Jacobian is singular
+/// at `z1 = z2` and degrades for clustered branch points or far points. Over
+/// 100 000 random draws the worst ratio was 18 (29 in a run before the
+/// inverse rescaled its input; the data themselves carry more than `u` of
+/// rounding from (28)); 100 leaves a margin of 3.5 or more. In absolute terms
+/// the forward error had median 1.9e-15, 99 % 3.0e-13, 99.9 % 2.4e-12 (the
+/// `stats_forward_error` run).
+const STABILITY_FACTOR: f64 = 100.0;
 
 fn close(a: C, b: C, scale: f64, rtol: f64) -> bool {
     (a - b).norm() <= rtol * scale.max(f64::MIN_POSITIVE)
@@ -52,7 +76,7 @@ fn sqrt_principal_branch() {
     let w = c(-3.0, -4.0);
     let r = sqrt_principal(w);
     assert_eq!(r, c(1.0, -2.0));
-    assert_relative_eq!((r * r - w).norm(), 0.0, epsilon = 1e-15);
+    assert_relative_eq!((r * r - w).norm(), 0.0, epsilon = ROUNDING_TOL);
 }
 
 #[test]
@@ -67,8 +91,12 @@ fn construction_and_validation() {
     }
     let x = c(0.3, -0.7);
     let direct = x * (x - d[1]) * (x - d[2]) * (x - d[3]) * (x - d[4]);
-    assert_relative_eq!((k.r(x) - direct).norm(), 0.0, epsilon = 1e-14);
-    assert_relative_eq!((k.y(x) * k.y(x) - k.r(x)).norm(), 0.0, epsilon = 1e-13);
+    assert_relative_eq!((k.r(x) - direct).norm(), 0.0, epsilon = ROUNDING_TOL);
+    assert_relative_eq!(
+        (k.y(x) * k.y(x) - k.r(x)).norm(),
+        0.0,
+        epsilon = ROUNDING_TOL
+    );
 
     // d_j = 0 coincides with d_0.
     assert!(matches!(
@@ -158,7 +186,7 @@ fn printed_29_fails() {
     let (lhs, _) = lhs_29(&k, &w, s);
     let d = k.branch_points();
     let printed = s / ((s - d[1]) * (s - d[2]) * (s - d[3]) * (s - d[4]));
-    assert!((lhs - printed).norm() > 0.1 * printed.norm());
+    assert!((lhs - printed).norm() > MISPRINT_MARGIN * printed.norm());
     assert!(close(lhs, k.kappa() * printed, lhs.norm(), IDENTITY_RTOL));
 }
 
@@ -295,24 +323,26 @@ proptest! {
         } else {
             (back.y2, back.z2, back.y1, back.z1)
         };
-        let zs = z1.norm().max(z2.norm()).max(1.0);
-        prop_assert!(close(bz1, z1, zs, ROUNDTRIP_RTOL), "z1 {} vs {}", bz1, z1);
-        prop_assert!(close(bz2, z2, zs, ROUNDTRIP_RTOL), "z2 {} vs {}", bz2, z2);
-        let ys = y1.norm().max(y2.norm()).max(1.0);
-        prop_assert!(close(b1, y1, ys, ROUNDTRIP_RTOL), "y1 {} vs {}", b1, y1);
-        prop_assert!(close(b2, y2, ys, ROUNDTRIP_RTOL), "y2 {} vs {}", b2, y2);
-        prop_assert!(close(back.g, g, g.norm(), ROUNDTRIP_RTOL));
+        let bound = inverse_error_bound(&k, z1, y1, z2, y2, g);
+        if let Some(bd) = bound {
+            let tol = bd.map(|b| STABILITY_FACTOR * b);
+            prop_assert!((bz1 - z1).norm() <= tol[0], "z1 {} vs {} (bound {:e})", bz1, z1, bd[0]);
+            prop_assert!((bz2 - z2).norm() <= tol[0], "z2 {} vs {} (bound {:e})", bz2, z2, bd[0]);
+            prop_assert!((b1 - y1).norm() <= tol[1], "y1 {} vs {} (bound {:e})", b1, y1, bd[1]);
+            prop_assert!((b2 - y2).norm() <= tol[2], "y2 {} vs {} (bound {:e})", b2, y2, bd[2]);
+            prop_assert!((back.g - g).norm() <= tol[3], "g {} vs {}", back.g, g);
+        }
         let scale = xi.iter().chain(eta.iter()).map(|v| v.norm()).fold(0.0, f64::max);
         let (x1, e1) = k.xi_eta(back.z1, back.y1, back.z2, back.y2, back.g, Some(back.eps), None).unwrap();
         for i in 0..3 {
-            prop_assert!(close(x1[i], xi[i], scale, ROUNDTRIP_RTOL));
-            prop_assert!(close(e1[i], eta[i], scale, ROUNDTRIP_RTOL));
+            prop_assert!(close(x1[i], xi[i], scale, BACKWARD_RTOL));
+            prop_assert!(close(e1[i], eta[i], scale, BACKWARD_RTOL));
         }
         // eps is recovered modulo the flip of P_1 … P_4 that leaves every P_jk
         // unchanged — unless a point sits on a cut of the principal roots, where
         // the rounding of the recovered z decides the side and eps compensates.
         let d = k.branch_points();
-        let on_cut = |z: C| d.iter().any(|dj| (z - dj).im.abs() < 1e-9 && (z - dj).re < 0.0);
+        let on_cut = |z: C| d.iter().any(|dj| (z - dj).im.abs() < ON_CUT_DIST && (z - dj).re < 0.0);
         if !on_cut(z1) && !on_cut(z2) {
             let sgn = i8::from(eps[4] > 0) * 2 - 1;
             let norm_eps = [eps[0], eps[1] * sgn, eps[2] * sgn, eps[3] * sgn, 1];
@@ -320,15 +350,68 @@ proptest! {
         }
         // Without g_ref, the pair (−g, −y1, −y2) is just as good: same (ξ, η).
         let alt = k.points_from_xi_eta(xi, eta, None, Some(-g), INVERSE_RTOL).unwrap();
-        prop_assert!(close(alt.g, -g, g.norm(), ROUNDTRIP_RTOL));
+        if let Some(bd) = bound {
+            prop_assert!((alt.g + g).norm() <= STABILITY_FACTOR * bd[3]);
+        }
         let (x2, e2) = k.xi_eta(alt.z1, alt.y1, alt.z2, alt.y2, alt.g, Some(alt.eps), None).unwrap();
         for i in 0..3 {
-            prop_assert!(close(x2[i], xi[i], scale, ROUNDTRIP_RTOL));
-            prop_assert!(close(e2[i], eta[i], scale, ROUNDTRIP_RTOL));
+            prop_assert!(close(x2[i], xi[i], scale, BACKWARD_RTOL));
+            prop_assert!(close(e2[i], eta[i], scale, BACKWARD_RTOL));
         }
     }
 }
 
+/// First-order error bound of the inverse map at `(z1, y1, z2, y2, g)`:
+/// `u · ‖(ξ, η)‖ / σ_min(J)` with `J` the Jacobian of `(z1, z2, g) → (ξ, η)`
+/// (central differences through the public `xi_eta`, `y` continued to the
+/// nearer sheet), returned as bounds on `(|δz|, |δy1|, |δy2|, |δg|)`;
+/// `None` if the differences straddle a cut of the principal roots.
+fn inverse_error_bound(k: &KotterCurve, z1: C, y1: C, z2: C, y2: C, g: C) -> Option<[f64; 4]> {
+    let near = |y: C, yref: C| {
+        if (y - yref).norm() <= (y + yref).norm() {
+            y
+        } else {
+            -y
+        }
+    };
+    let data = |a: C, b: C, gg: C| -> Option<[C; 6]> {
+        let (ya, yb) = (near(k.y(a), y1), near(k.y(b), y2));
+        let (x, e) = k.xi_eta(a, ya, b, yb, gg, None, None).ok()?;
+        Some([x[0], x[1], x[2], e[0], e[1], e[2]])
+    };
+    let f0 = data(z1, z2, g)?;
+    let h = 1e-6 * (z1 - z2).norm().min(1.0);
+    let hc = C::new(h, 0.0);
+    let cols = [
+        (data(z1 + hc, z2, g)?, data(z1 - hc, z2, g)?),
+        (data(z1, z2 + hc, g)?, data(z1, z2 - hc, g)?),
+    ];
+    let mut jac = nalgebra::SMatrix::<C, 6, 3>::zeros();
+    for i in 0..6 {
+        for (c, (p, m)) in cols.iter().enumerate() {
+            jac[(i, c)] = (p[i] - m[i]) / (2.0 * h);
+        }
+        jac[(i, 2)] = f0[i] / g;
+    }
+    // A derivative that is O(1/h) larger than the data means a jump across a cut.
+    let fmax = f0.iter().map(|v| v.norm()).fold(0.0, f64::max);
+    if jac.iter().any(|v| v.norm() * h > 1e-2 * fmax) {
+        return None;
+    }
+    let smin = jac.singular_values().min();
+    let dz = f64::EPSILON * fmax * 6f64.sqrt() / smin;
+    let dy = |z: C, y: C| {
+        let d = k.branch_points();
+        let dlog: C = d.iter().map(|dj| 1.0 / (z - dj)).sum();
+        (y * dlog / 2.0).norm() * dz
+    };
+    Some([dz, dy(z1, y1), dy(z2, y2), dz])
+}
+
+/// Diagnostic, not a check: the worst forward and backward errors of the
+/// inverse over 100 000 random cases, binned by `|z1 − z2|` — the source of the
+/// numbers quoted at `STABILITY_FACTOR` and `BACKWARD_RTOL`. Run with
+/// `cargo test --release --lib curve::tests::stats -- --ignored --nocapture`.
 #[test]
 #[ignore]
 fn stats_forward_error() {
@@ -343,7 +426,9 @@ fn stats_forward_error() {
         cplx(-2.0, 2.0),
     );
     let mut worst = vec![0.0f64; 6];
-    for _ in 0..20000 {
+    let mut worst_ratio = 0.0f64;
+    let mut all: Vec<f64> = Vec::new();
+    for _ in 0..100_000 {
         let (d1, d2, d3, z1, z2, g) =
             proptest::strategy::ValueTree::current(&strat.new_tree(&mut runner).unwrap());
         let Ok(k) = KotterCurve::new(d1, d2, d3) else {
@@ -371,14 +456,34 @@ fn stats_forward_error() {
         let b = k
             .points_from_xi_eta(xi, eta, None, Some(g), INVERSE_RTOL)
             .unwrap();
-        let (bz1, by1) = if (b.z1 - z1).norm() < (b.z2 - z1).norm() {
-            (b.z1, b.y1)
+        let (bz1, by1, bz2, by2) = if (b.z1 - z1).norm() <= (b.z1 - z2).norm() {
+            (b.z1, b.y1, b.z2, b.y2)
         } else {
-            (b.z2, b.y2)
+            (b.z2, b.y2, b.z1, b.y1)
         };
-        let ez = (bz1 - z1).norm() / z1.norm().max(1.0);
-        let ey = (by1 - y1).norm() / y1.norm().max(1.0);
-        worst[bin] = worst[bin].max(ez.max(ey));
+        // The same measures as `inverse_round_trip`.
+        let zs = z1.norm().max(z2.norm()).max(1.0);
+        let ys = y1.norm().max(y2.norm()).max(1.0);
+        let e = [
+            (bz1 - z1).norm() / zs,
+            (bz2 - z2).norm() / zs,
+            (by1 - y1).norm() / ys,
+            (by2 - y2).norm() / ys,
+            (b.g - g).norm() / g.norm(),
+        ];
+        let m = e.iter().fold(0.0f64, |a, &b| a.max(b));
+        worst[bin] = worst[bin].max(m);
+        all.push(m);
+        if let Some(bd) = inverse_error_bound(&k, z1, y1, z2, y2, g) {
+            let ratio = [
+                (bz1 - z1).norm() / bd[0],
+                (bz2 - z2).norm() / bd[0],
+                (by1 - y1).norm() / bd[1],
+                (by2 - y2).norm() / bd[2],
+                (b.g - g).norm() / bd[3],
+            ];
+            worst_ratio = ratio.iter().fold(worst_ratio, |a, &b| a.max(b));
+        }
         let scale = xi
             .iter()
             .chain(eta.iter())
@@ -387,4 +492,15 @@ fn stats_forward_error() {
         worst[5] = worst[5].max(b.residual / scale);
     }
     println!("worst forward error by |z1-z2| bin [.1,.3,.6,1,2,inf], backward: {worst:?}");
+    println!("worst forward error / first-order bound: {worst_ratio:e}");
+    all.sort_by(f64::total_cmp);
+    let q = |p: f64| all[((all.len() - 1) as f64 * p) as usize];
+    println!(
+        "forward error over {} cases: median {:e}, 90% {:e}, 99% {:e}, 99.9% {:e}",
+        all.len(),
+        q(0.5),
+        q(0.9),
+        q(0.99),
+        q(0.999)
+    );
 }

@@ -95,6 +95,12 @@ fn curve_eval_py<'py>(
 ) -> PyResult<(Bound<'py, PyArray1<C>>, Bound<'py, PyArray1<C>>)> {
     let k = curve_of(&d)?;
     let xs = x.as_array().to_vec();
+    if let Some(index) = xs
+        .iter()
+        .position(|v| !(v.re.is_finite() && v.im.is_finite()))
+    {
+        return Err(Error::NonFinite { what: "x", index }.into());
+    }
     let (r, y): (Vec<C>, Vec<C>) = py.detach(|| xs.iter().map(|&x| (k.r(x), k.y(x))).unzip());
     Ok((
         Array1::from(r).into_pyarray(py),
