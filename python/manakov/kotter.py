@@ -167,7 +167,7 @@ def quartic(a: Any, h: Any) -> np.ndarray:
     return np.asarray(out).reshape(shape + (5,))
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)  # fields are arrays: no elementwise __eq__
 class Kotter:
     """A state in Schottky-Kötter coordinates (fields carry the paper's names).
 
