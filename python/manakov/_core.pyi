@@ -72,4 +72,5 @@ def kotter_from_points(
     y2: npt.NDArray[np.complex128],
     g: npt.NDArray[np.complex128],
     branch: npt.NDArray[np.int8],
+    zd: npt.NDArray[np.complex128] | None = None,
 ) -> npt.NDArray[np.float64]: ...

@@ -218,6 +218,15 @@ class Kotter:
     curve : KotterCurve or ndarray of KotterCurve
         The curve (8) with these ``d_j``; for a batch an object array of
         shape ``S`` (``None`` entries if ``manakov.KotterCurve`` is unavailable).
+    zd : ndarray (2, 5) complex or None
+        The offsets of the points from the branch points,
+        ``zd[i-1, j] = z_i - d_j`` (``d_0 = 0``, ``d_4 = d1 d2 d3``), to full
+        relative accuracy. A double ``z_i`` fixes ``z_i - d_j`` only to
+        ``u |z_i|`` absolutely, which near a branch point is a large relative
+        error in the roots ``sqrt(z_i - d_j)`` of (27)-(28) (on the
+        ``near_degenerate`` top a point comes within 4e-9 of ``d_1``);
+        :func:`from_kotter` uses ``zd`` when it is not ``None``. Set it to
+        ``None`` when replacing ``z1`` or ``z2``.
     """
 
     h: np.ndarray
@@ -247,6 +256,7 @@ class Kotter:
     y2: Any
     branch: np.ndarray
     curve: Any
+    zd: Any = None
 
 
 _FIELD_SHAPES = {
@@ -254,7 +264,7 @@ _FIELD_SHAPES = {
     "Delta": (3, 3), "xi": (3,), "eta": (3,), "sqrt_d": (3,), "d": (3,),
     "alpha": (3,), "beta": (3,), "gamma": (3,), "delta": (3,), "A": (3,), "B": (3,),
     "abgd38": (4,), "eps": (), "K": (), "P0": (), "g": (), "z1": (), "y1": (), "z2": (),
-    "y2": (), "branch": (5,),
+    "y2": (), "branch": (5,), "zd": (2, 5),
 }
 
 
@@ -317,8 +327,9 @@ def kotter(a: Any, b: Any, l: Any) -> Kotter:
 def from_kotter(a: Any, b: Any, k: Kotter) -> np.ndarray:
     """The state ``l`` from Kötter coordinates: the inverse of :func:`kotter`.
 
-    Uses only the curve's points, ``g`` and the branch of the ``P_j`` (with the
-    level set's constants ``d_j`` and ``alpha_j .. delta_j``):
+    Uses only the curve's points (with their offsets ``zd`` from the branch
+    points when ``k.zd`` is not ``None``), ``g`` and the branch of the ``P_j``
+    (with the level set's constants ``d_j`` and ``alpha_j .. delta_j``):
     ``xi_j = sqrt(c_j) g P_kl``, ``eta_j = sqrt(c_j) g P_j4`` (36), then (23)
     ``m_j = alpha_j xi_j + beta_j eta_j``, ``n_j = gamma_j xi_j + delta_j eta_j``.
 
@@ -329,8 +340,8 @@ def from_kotter(a: Any, b: Any, k: Kotter) -> np.ndarray:
     Raises
     ------
     ValueError
-        Points off the curve, ``z1 = z2``, a bad branch, or data that give a
-        complex state.
+        Points off the curve, offsets ``zd`` inconsistent with ``z1, z2``,
+        ``z1 = z2``, a bad branch, or data that give a complex state.
     """
     _check_a(a)
     _check_b(b)
@@ -344,8 +355,14 @@ def from_kotter(a: Any, b: Any, k: Kotter) -> np.ndarray:
         return np.ascontiguousarray(np.asarray(x, dtype=complex).reshape(-1))
 
     br = np.ascontiguousarray(np.asarray(k.branch, dtype=np.int8).reshape(-1, 5))
+    zd = None
+    if k.zd is not None:
+        zd = np.asarray(k.zd, dtype=complex)
+        if zd.shape != shape + (2, 5):
+            raise ValueError(f"k.zd must have shape {shape + (2, 5)}, got {zd.shape}")
+        zd = np.ascontiguousarray(zd.reshape(-1, 2, 5))
     out = _core.kotter_from_points(
         c2(k.alpha), c2(k.beta), c2(k.gamma), c2(k.delta), c2(k.d),
-        c1(k.z1), c1(k.y1), c1(k.z2), c1(k.y2), c1(k.g), br,
+        c1(k.z1), c1(k.y1), c1(k.z2), c1(k.y2), c1(k.g), br, zd,
     )
     return np.asarray(out).reshape(shape + (6,))

@@ -28,7 +28,7 @@
 use nalgebra::{DMatrix, DVector};
 use num_complex::Complex64;
 
-use crate::curve::{KotterCurve, WurzelPoints};
+use crate::curve::{CurvePoint, KotterCurve, WurzelPoints};
 use crate::error::{check_finite, Error, Result};
 
 type C = Complex64;
@@ -845,21 +845,34 @@ pub fn kotter_with(constants: KotterConstants, l: &[f64; 6]) -> Result<KotterSta
 /// `ξ_j = √c_j g P_kl`, `η_j = √c_j g P_j4`, `m_j = α_j ξ_j + β_j η_j`,
 /// `n_j = γ_j ξ_j + δ_j η_j`, `l = (m3, −m2, n1, m1, n2, n3)`.
 ///
-/// Errors: those of [`KotterCurve::xi_eta`] (points off the curve, `z1 = z2`,
-/// a bad branch) and of [`l_from_xi_eta`] (a complex state).
-#[allow(clippy::too_many_arguments)]
+/// `z = [z1, z2]`, `y = [y1, y2]`; `zd = Some([zd1, zd2])` gives the offsets
+/// `zd_i[j] = z_i − d_j` (as returned in [`KotterState::points`]), used for
+/// the roots `√(z_i − d_j)` of (27)–(28) — with only `z` (`zd = None`) a
+/// point within `δ` of a branch point loses `u |z| / δ` (see
+/// [`crate::curve::CurvePoint`]).
+///
+/// Errors: those of [`KotterCurve::xi_eta_points`] (points off the curve,
+/// offsets inconsistent with `z`, `z1 = z2`, a bad branch) and of
+/// [`l_from_xi_eta`] (a complex state).
 pub fn from_kotter(
     coef: &Coefficients23,
     d: [C; 3],
-    z1: C,
-    y1: C,
-    z2: C,
-    y2: C,
+    z: [C; 2],
+    y: [C; 2],
+    zd: Option<[[C; 5]; 2]>,
     g: C,
     branch: [i8; 5],
 ) -> Result<[f64; 6]> {
     let curve = KotterCurve::new(d[0], d[1], d[2])?;
-    let (xi, eta) = curve.xi_eta(z1, y1, z2, y2, g, Some(branch), None)?;
+    let pt = |i: usize| match zd {
+        Some(o) => CurvePoint {
+            z: z[i],
+            y: y[i],
+            zd: o[i],
+        },
+        None => curve.point(z[i], y[i]),
+    };
+    let (xi, eta) = curve.xi_eta_points(&pt(0), &pt(1), g, Some(branch), None)?;
     coef.state(&xi, &eta)
 }
 

@@ -131,10 +131,9 @@ fn uniformization_round_trip() {
     let back = from_kotter(
         &st.constants.coefficients23(),
         st.constants.d,
-        p.z1,
-        p.y1,
-        p.z2,
-        p.y2,
+        [p.z1, p.z2],
+        [p.y1, p.y2],
+        Some([p.zd1, p.zd2]),
         p.g,
         p.eps,
     )
@@ -214,6 +213,60 @@ proptest! {
                 let s: C = (0..4).map(|p| lp[p][j] * lp[p][j]).sum();
                 prop_assert!(s.norm() < 1e-11 * size);
             }
+        }
+    }
+}
+
+/// The `near_degenerate` top (`a_1 ≈ a_2`, so `d_1, d_2` 3.8e-5 apart) at two
+/// states of its trajectory (t = 9.25 and 9.75 of `tests/test_kotter.py`'s
+/// DOP853 run) where `z2` is within 4e-10 and 4e-9 of `d_1`: with the offsets
+/// `zd` the round trip closes to 1e-12 (through `z` alone it missed by 2e-10).
+#[test]
+fn round_trip_near_branch_point_uses_offsets() {
+    let a = [1.0, 1.000001, 2.0, 3.0];
+    let states = [
+        [
+            0.2000006371045653,
+            0.011753815424631086,
+            1.1269601730352368,
+            1.1028921558453333,
+            -0.08331349214505068,
+            -0.36947275403496677,
+        ],
+        [
+            0.20000050766187902,
+            -0.07657169519910106,
+            1.1671090490419718,
+            1.060236109278101,
+            -0.2965262832063264,
+            -0.22352761803461338,
+        ],
+    ];
+    for l in states {
+        let st = kotter(&a, &l).unwrap();
+        let p = st.points;
+        let near = st
+            .curve
+            .branch_points()
+            .iter()
+            .map(|dj| (p.z2 - dj).norm().min((p.z1 - dj).norm()))
+            .fold(f64::INFINITY, f64::min);
+        assert!(near < 1e-8, "{near}");
+        let coef = st.constants.coefficients23();
+        let d = st.constants.d;
+        let back = from_kotter(
+            &coef,
+            d,
+            [p.z1, p.z2],
+            [p.y1, p.y2],
+            Some([p.zd1, p.zd2]),
+            p.g,
+            p.eps,
+        )
+        .unwrap();
+        let size = l.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        for i in 0..6 {
+            assert!((back[i] - l[i]).abs() < 1e-12 * size, "{i}: {} vs {}", back[i], l[i]);
         }
     }
 }

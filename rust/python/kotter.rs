@@ -1,7 +1,7 @@
 //! Bindings for `crate::kotter`.
 
 use numpy::ndarray::{Array1, Array2, Array3};
-use numpy::{Complex64, IntoPyArray, PyReadonlyArray1, PyReadonlyArray2};
+use numpy::{Complex64, IntoPyArray, PyReadonlyArray1, PyReadonlyArray2, PyReadonlyArray3};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
@@ -222,6 +222,16 @@ fn kotter_batch_py<'py>(
     dict.set_item("y1", c1(&|st| st.points.y1).into_pyarray(py))?;
     dict.set_item("z2", c1(&|st| st.points.z2).into_pyarray(py))?;
     dict.set_item("y2", c1(&|st| st.points.y2).into_pyarray(py))?;
+    let zd: Vec<C> = res
+        .iter()
+        .flat_map(|st| [st.points.zd1, st.points.zd2].concat())
+        .collect();
+    dict.set_item(
+        "zd",
+        Array3::from_shape_vec((n, 2, 5), zd)
+            .map_err(|e| shape_err_msg(e.to_string()))?
+            .into_pyarray(py),
+    )?;
     let br: Vec<i8> = res.iter().flat_map(|st| st.points.eps).collect();
     dict.set_item(
         "branch",
@@ -233,7 +243,7 @@ fn kotter_batch_py<'py>(
 }
 
 /// The inverse map: states (n, 6) from the coefficients of (23), d (26), the points, g and the branch.
-#[pyfunction(name = "kotter_from_points")]
+#[pyfunction(name = "kotter_from_points", signature = (alpha, beta, gamma, delta, d, z1, y1, z2, y2, g, branch, zd=None))]
 #[allow(clippy::too_many_arguments)]
 fn kotter_from_points_py<'py>(
     py: Python<'py>,
@@ -248,6 +258,7 @@ fn kotter_from_points_py<'py>(
     y2: PyReadonlyArray1<'py, C>,
     g: PyReadonlyArray1<'py, C>,
     branch: PyReadonlyArray2<'py, i8>,
+    zd: Option<PyReadonlyArray3<'py, C>>,
 ) -> PyResult<Bound<'py, PyAny>> {
     let n = z1.as_array().len();
     let al = read_crows::<3>("alpha", &alpha, n)?;
@@ -270,6 +281,20 @@ fn kotter_from_points_py<'py>(
             .map(|r| std::array::from_fn(|i| r[i]))
             .collect::<Vec<[i8; 5]>>()
     };
+    let zd: Option<Vec<[[C; 5]; 2]>> = match zd {
+        None => None,
+        Some(z) => {
+            let z = z.as_array();
+            if z.shape() != [n, 2, 5] {
+                return Err(shape_err("zd", &format!("({n}, 2, 5)"), z.shape()));
+            }
+            Some(
+                (0..n)
+                    .map(|i| std::array::from_fn(|p| std::array::from_fn(|j| z[[i, p, j]])))
+                    .collect(),
+            )
+        }
+    };
     let res: Result<Vec<[f64; 6]>, Error> = py.detach(|| {
         (0..n)
             .map(|i| {
@@ -279,7 +304,15 @@ fn kotter_from_points_py<'py>(
                     gamma: ga[i],
                     delta: de[i],
                 };
-                kotter::from_kotter(&coef, dv[i], z1[i], y1[i], z2[i], y2[i], g[i], br[i])
+                kotter::from_kotter(
+                    &coef,
+                    dv[i],
+                    [z1[i], z2[i]],
+                    [y1[i], y2[i]],
+                    zd.as_ref().map(|v| v[i]),
+                    g[i],
+                    br[i],
+                )
             })
             .collect()
     });
