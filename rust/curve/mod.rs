@@ -618,19 +618,24 @@ impl KotterCurve {
     /// Gauss–Newton polish of `(z1, z2, g)` for [`KotterCurve::points_from_xi_eta`].
     ///
     /// The closed form goes through `Σ c̃_j X_j²`, whose terms cancel heavily
-    /// when the `P_kl` are nearly equal (points far out or close together);
-    /// that costs up to ~1e3 over the conditioning of the map itself. A
-    /// least-squares Newton step on the six equations `X = g P_kl`,
-    /// `Y = g P_j4` recovers the intrinsic accuracy.
+    /// when the `P_kl` are nearly equal (points far out or close together) or
+    /// when two branch points nearly coincide (`c̃_j ~ 1/(d_j − d_k)`); that
+    /// costs up to ~1e3 over the conditioning of the map itself, and more for
+    /// clustered branch points. Least-squares Newton steps on the six
+    /// equations `X = g P_kl`, `Y = g P_j4` recover the intrinsic accuracy.
     ///
-    /// Each point is parametrised by its offset `t_i = z_i − d_b` from its
-    /// nearest branch point `d_b`, and all offsets are `t_i + (d_b − d_j)`:
-    /// the unknowns are then resolved to a few ulps of `t_i` rather than of
-    /// `z_i`, which matters for points near branch points ([`CurvePoint`]).
-    /// The roots are continued holomorphically,
-    /// `r_j(z + δ) = r_j(z) √(1 + δ/(z − d_j))`, so a step never crosses a cut
-    /// of the principal roots; the final branch is expressed again as `eps`
-    /// relative to the canonical roots.
+    /// Each point is parametrised by the local uniformizing parameter at its
+    /// nearest branch point `d_b`: `w = r_b(z) = √(z − d_b)` (with its
+    /// branch), `z = d_b + w²`. In `w` the map is holomorphic and regular
+    /// through the branch point, whereas in `z` it has a square-root
+    /// singularity there: a closed-form `z` whose error is comparable to its
+    /// distance from `d_b` (a point 5e-11 from `d_1` when `d_1, d_2` are 3e-5
+    /// apart) is outside the basin of Newton's method in `z`, not in `w`.
+    /// The offsets are then `zd_j = w² + (d_b − d_j)`, accurate to a few ulps
+    /// ([`CurvePoint`]). The other roots are continued holomorphically,
+    /// `r_j(z + δ) = r_j(z) √(1 + δ/(z − d_j))`, so a step never crosses a
+    /// cut of the principal roots; the final branch is expressed again as
+    /// `eps` relative to the canonical roots.
     fn refine(
         &self,
         start: WurzelPoints,
@@ -638,18 +643,26 @@ impl KotterCurve {
         sc: &[Complex64; 3],
     ) -> WurzelPoints {
         let d = self.d;
+        let zero = Complex64::new(0.0, 0.0);
         let nearest = |zd: &[Complex64; 5]| -> usize {
             (0..5).fold(0, |b, j| if zd[j].norm() < zd[b].norm() { j } else { b })
         };
         let (b1, b2) = (nearest(&start.zd1), nearest(&start.zd2));
-        // d_b − d_j: exactly 0 at j = b, so zd_b = t exactly.
+        // d_b − d_j: exactly 0 at j = b, so zd_b = w² exactly.
         let dd1: [Complex64; 5] = std::array::from_fn(|j| d[b1] - d[j]);
         let dd2: [Complex64; 5] = std::array::from_fn(|j| d[b2] - d[j]);
-        let off = |t: Complex64, dd: &[Complex64; 5]| -> [Complex64; 5] {
-            std::array::from_fn(|j| t + dd[j])
+        // The scale on which the map varies in w: the square root of the
+        // distance from d_b to the next branch point.
+        let wscale = |dd: &[Complex64; 5]| -> f64 {
+            dd.iter()
+                .filter(|v| v.norm() > 0.0)
+                .map(|v| v.norm())
+                .fold(f64::INFINITY, f64::min)
+                .sqrt()
         };
+        let (ws1, ws2) = (wscale(&dd1), wscale(&dd2));
         let d12 = d[b1] - d[b2];
-        let dz_of = |t1: Complex64, t2: Complex64| d12 + (t1 - t2);
+        let dz_of = |w1: Complex64, w2: Complex64| d12 + (w1 * w1 - w2 * w2);
         let eps_f = start.eps.map(f64::from);
         // The branch of the start, folded into the roots of the first point:
         // P_j = (eps_j r_j(z1)) r_j(z2).
@@ -658,77 +671,104 @@ impl KotterCurve {
             r1[j] *= eps_f[j];
         }
         let mut r2 = self.roots_from_offsets(&start.zd2, start.y2);
-        let (mut t1, mut t2, mut g) = (start.zd1[b1], start.zd2[b2], start.g);
+        let mut g = start.g;
         let resid_of = |f: &[Complex64; 6]| -> f64 {
             (0..6)
                 .map(|i| ((target[i] - f[i]) * sc[i % 3]).norm())
                 .fold(0.0, nan_max)
         };
-        let six = |r1: &[Complex64; 5], r2: &[Complex64; 5], dz: Complex64, g: Complex64| {
+        let six = |r1: &[Complex64; 5], r2: &[Complex64; 5], g: Complex64| {
+            let dz = dz_of(r1[b1], r2[b2]);
             let w = wurzel_from_roots(r1, r2, dz, &[1.0; 5]);
-            let mut f = [Complex64::new(0.0, 0.0); 6];
+            let mut f = [zero; 6];
             for (i, &(j, k, l)) in CYCLIC.iter().enumerate() {
                 f[i] = g * w.pjk[k][l];
                 f[i + 3] = g * w.pjk[j][4];
             }
             f
         };
-        let cont = |r: &[Complex64; 5], zd: &[Complex64; 5], dz: Complex64| -> [Complex64; 5] {
-            std::array::from_fn(|j| r[j] * sqrt_principal(1.0 + dz / zd[j]))
+        // Move the point's parameter w = r[b] to w + dw: r_b = w + dw, the other
+        // roots continued along t = w² → (w + dw)².
+        let moved = |r: &[Complex64; 5], b: usize, dd: &[Complex64; 5], dw: Complex64| {
+            let w = r[b];
+            let dt = (2.0 * w + dw) * dw;
+            let t = w * w;
+            std::array::from_fn(|j| {
+                if j == b {
+                    w + dw
+                } else {
+                    r[j] * sqrt_principal(1.0 + dt / (t + dd[j]))
+                }
+            })
         };
-        let mut f = six(&r1, &r2, dz_of(t1, t2), g);
+        let mut f = six(&r1, &r2, g);
         let mut resid = resid_of(&f);
-        for _ in 0..3 {
-            let (zd1, zd2) = (off(t1, &dd1), off(t2, &dd2));
-            // Continuation needs the points off the branch points and apart.
-            let rho = (0..5)
-                .map(|j| zd1[j].norm().min(zd2[j].norm()))
-                .fold(dz_of(t1, t2).norm(), f64::min);
-            if rho.is_nan() || rho <= 0.0 || g == Complex64::new(0.0, 0.0) {
+        for _ in 0..8 {
+            if g == zero || dz_of(r1[b1], r2[b2]) == zero {
                 break;
             }
-            let h = 1e-6 * rho;
+            let (h1, h2) = (1e-7 * ws1, 1e-7 * ws2);
             let mut jac = nalgebra::SMatrix::<Complex64, 6, 3>::zeros();
-            let hc = Complex64::new(h, 0.0);
-            let fp1 = six(&cont(&r1, &zd1, hc), &r2, dz_of(t1 + hc, t2), g);
-            let fm1 = six(&cont(&r1, &zd1, -hc), &r2, dz_of(t1 - hc, t2), g);
-            let fp2 = six(&r1, &cont(&r2, &zd2, hc), dz_of(t1, t2 + hc), g);
-            let fm2 = six(&r1, &cont(&r2, &zd2, -hc), dz_of(t1, t2 - hc), g);
+            let c = |x: f64| Complex64::new(x, 0.0);
+            let fp1 = six(&moved(&r1, b1, &dd1, c(h1)), &r2, g);
+            let fm1 = six(&moved(&r1, b1, &dd1, c(-h1)), &r2, g);
+            let fp2 = six(&r1, &moved(&r2, b2, &dd2, c(h2)), g);
+            let fm2 = six(&r1, &moved(&r2, b2, &dd2, c(-h2)), g);
             let mut rhs = nalgebra::SVector::<Complex64, 6>::zeros();
             for i in 0..6 {
                 let w = sc[i % 3];
-                jac[(i, 0)] = w * (fp1[i] - fm1[i]) / (2.0 * h);
-                jac[(i, 1)] = w * (fp2[i] - fm2[i]) / (2.0 * h);
+                jac[(i, 0)] = w * (fp1[i] - fm1[i]) / (2.0 * h1);
+                jac[(i, 1)] = w * (fp2[i] - fm2[i]) / (2.0 * h2);
                 jac[(i, 2)] = w * f[i] / g;
                 rhs[i] = w * (target[i] - f[i]);
             }
             let Ok(step) = jac.svd(true, true).solve(&rhs, 1e-14) else {
                 break;
             };
-            let (nt1, nt2, ng) = (t1 + step[0], t2 + step[1], g + step[2]);
-            let (nr1, nr2) = (cont(&r1, &zd1, step[0]), cont(&r2, &zd2, step[1]));
-            let nf = six(&nr1, &nr2, dz_of(nt1, nt2), ng);
+            let nr1 = moved(&r1, b1, &dd1, step[0]);
+            let nr2 = moved(&r2, b2, &dd2, step[1]);
+            let ng = g + step[2];
+            let nf = six(&nr1, &nr2, ng);
             let nres = resid_of(&nf);
             if nres.is_nan() || nres >= resid {
                 break;
             }
-            (t1, t2, g, r1, r2, f, resid) = (nt1, nt2, ng, nr1, nr2, nf, nres);
+            (g, r1, r2, f, resid) = (ng, nr1, nr2, nf, nres);
         }
         if resid >= start.residual {
             return start;
         }
-        let (zd1, zd2) = (off(t1, &dd1), off(t2, &dd2));
-        let (z1, z2) = (d[b1] + t1, d[b2] + t2);
+        let (w1, w2) = (r1[b1], r2[b2]);
+        let zd1: [Complex64; 5] = std::array::from_fn(|j| w1 * w1 + dd1[j]);
+        let zd2: [Complex64; 5] = std::array::from_fn(|j| w2 * w2 + dd2[j]);
+        let (z1, z2) = (d[b1] + w1 * w1, d[b2] + w2 * w2);
         // Express the continued roots as (y_i, eps) relative to the canonical roots.
         // Π_j eps_j = +1, so the product of the branch-folded roots is y1.
         let y1: Complex64 = r1.iter().product();
         let y2: Complex64 = r2.iter().product();
         let c1 = self.roots_from_offsets(&zd1, y1);
         let c2 = self.roots_from_offsets(&zd2, y2);
-        let mut eps = [1i8; 5];
-        for j in 0..5 {
-            let ratio = (r1[j] * r2[j]) / (c1[j] * c2[j]);
-            eps[j] = if ratio.re >= 0.0 { 1 } else { -1 };
+        // The sign of each continued root relative to the canonical one (a
+        // root at a branch point is 0 on both: its sign is immaterial).
+        let sign = |r: Complex64, c: Complex64| -> i8 {
+            if c == zero || (r / c).re >= 0.0 {
+                1
+            } else {
+                -1
+            }
+        };
+        let mut eps: [i8; 5] = std::array::from_fn(|j| sign(r1[j], c1[j]) * sign(r2[j], c2[j]));
+        if eps.iter().map(|&e| i32::from(e)).product::<i32>() < 0 {
+            // Only possible with a root exactly 0: flip the sign of the P_j
+            // nearest zero, the one the data determine least.
+            let j = (0..5).fold(0, |m, j| {
+                if (c1[j] * c2[j]).norm() < (c1[m] * c2[m]).norm() {
+                    j
+                } else {
+                    m
+                }
+            });
+            eps[j] = -eps[j];
         }
         if eps[4] < 0 {
             eps = eps.map(|e| -e);

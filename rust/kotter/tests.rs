@@ -266,7 +266,12 @@ fn round_trip_near_branch_point_uses_offsets() {
         .unwrap();
         let size = l.iter().fold(0.0f64, |m, v| m.max(v.abs()));
         for i in 0..6 {
-            assert!((back[i] - l[i]).abs() < 1e-12 * size, "{i}: {} vs {}", back[i], l[i]);
+            assert!(
+                (back[i] - l[i]).abs() < 1e-12 * size,
+                "{i}: {} vs {}",
+                back[i],
+                l[i]
+            );
         }
     }
 }
