@@ -54,6 +54,13 @@ def kotter_schottky(
     s: npt.NDArray[np.complex128],
     sqrt_g: npt.NDArray[np.complex128],
 ) -> tuple[npt.NDArray[np.complex128], npt.NDArray[np.complex128]]: ...
+def kotter_lax_m(
+    a: npt.NDArray[np.float64],
+    b: npt.NDArray[np.float64],
+    l: npt.NDArray[np.float64],
+    s: npt.NDArray[np.complex128],
+    sqrt_g: npt.NDArray[np.complex128],
+) -> npt.NDArray[np.complex128]: ...
 def kotter_quartic(
     a: npt.NDArray[np.float64], h: npt.NDArray[np.float64]
 ) -> npt.NDArray[np.float64]: ...

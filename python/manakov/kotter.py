@@ -132,20 +132,64 @@ def _skew3(v: np.ndarray) -> np.ndarray:
     return out - np.swapaxes(out, -1, -2)
 
 
-def lax_pair(a: Any, l: Any, s: Any, *, sqrt_g: Any = None) -> tuple[np.ndarray, np.ndarray]:
-    """The antisymmetric 3x3 matrices ``L(s)``, ``M(s)`` of (17) built from (12), (16).
+def lax_pair(
+    a: Any, b: Any, l: Any, s: Any, *, sqrt_g: Any = None
+) -> tuple[np.ndarray, np.ndarray]:
+    """The Lax pair ``L(s)``, ``M_b(s)`` of (15)-(17) for the top ``(a, b)``, corrected.
 
-    ``L = [[0, l3, -l2], [-l3, 0, l1], [l2, -l1, 0]]`` and the same for ``M``
-    from ``m(s)``. ``dL/dt = [L, M]`` (15) holds along the flow of the top with
-    ``c_ij = a_i + a_j`` (``b_i = a_i^2``); for a general ``b`` it does not
-    (see docs/errata-kotter.md).
+    ``L = [[0, l3, -l2], [-l3, 0, l1], [l2, -l1, 0]]`` from Schottky's ``l(s)`` (12),
+    and ``M_b`` the same antisymmetric matrix built from
+
+    ``m_b(s) = -tau [p2 m(s) + p3 (e2 m(s) + m^[w3](s)) / (e1 - s)]``,
+
+    so that ``dL/dt = [L, M_b]`` (15) along the flow (1)-(2) on either branch of
+    ``sqrt(G)``. Here ``b_i = p0 + p1 a_i + p2 a_i^2 + p3 a_i^3`` is the cubic
+    interpolant of ``b`` over ``a`` (``p3`` the third divided difference),
+    ``m(s)`` is the vector (16), ``m^[X](s)`` the same built from an
+    antisymmetric ``X`` instead of ``l`` (``m^[X]_j = sqrt(s_kl) X_kl +
+    sqrt(s_j4) X_j4``), ``(w3)_ij = (a_i^2 + a_i a_j + a_j^2) l_ij`` the angular
+    velocity of the top with ``b = a^3``, ``e1 = sum a_i``,
+    ``e2 = sum_{i<j} a_i a_j``, and
+    ``tau = sqrt(s_14) sqrt(s_24) sqrt(s_34) sqrt(G) / ((s - a4) G(s)) = +-1``.
+    The printed ``M(s)`` (16)-(17), which does not involve ``b``, is the case
+    ``b = a^2`` (``p2 = 1, p3 = 0``) on the branch ``tau = -1``; for a general
+    ``b`` it does not give the flow (see docs/errata-kotter.md).
+
+    Parameters
+    ----------
+    a, b : array_like, shape (4,)
+        Manakov parameters (2), ``a`` distinct.
+    l : array_like, shape (..., 6)
+    s : complex array_like, broadcastable with ``l``'s leading axes
+    sqrt_g : complex array_like, optional, keyword-only
+        The branch of ``sqrt(G(s))`` (default principal); must square to ``G(s)``.
 
     Returns
     -------
     (ndarray, ndarray), each of shape (..., 3, 3), complex
+
+    Raises
+    ------
+    ValueError
+        Bad shapes or non-finite input, repeated ``a``, ``s = a_j``,
+        ``sqrt_g**2 != G(s)``, or ``s = e1`` when ``p3 != 0`` (a pole of ``M_b``).
     """
-    lv, mv = schottky(a, l, s, sqrt_g=sqrt_g)
-    return _skew3(lv), _skew3(mv)
+    a = _check_a(a)
+    b = _check_b(b)
+    l = np.asarray(l, dtype=float)
+    if l.ndim == 0 or l.shape[-1] != 6:
+        raise ValueError(f"l must have shape (..., 6), got {l.shape}")
+    s = np.asarray(s, dtype=complex)
+    if sqrt_g is None:
+        sqrt_g = np.sqrt(np.prod(s[..., None] - a, axis=-1))
+    sqrt_g = np.asarray(sqrt_g, dtype=complex)
+    lv, _ = schottky(a, l, s, sqrt_g=sqrt_g)
+    shape = lv.shape[:-1]
+    lb = np.ascontiguousarray(np.broadcast_to(l, shape + (6,)).reshape(-1, 6))
+    sb = np.ascontiguousarray(np.broadcast_to(s, shape).reshape(-1))
+    gb = np.ascontiguousarray(np.broadcast_to(sqrt_g, shape).reshape(-1))
+    mb = np.asarray(_core.kotter_lax_m(a, b, lb, sb, gb)).reshape(shape + (3,))
+    return _skew3(lv), _skew3(mb)
 
 
 def quartic(a: Any, h: Any) -> np.ndarray:

@@ -275,3 +275,71 @@ fn round_trip_near_branch_point_uses_offsets() {
         }
     }
 }
+
+/// Frahm's equations (1) with (2), written here independently: `l̇ = [l, ω]`,
+/// `ω_ij = c_ij l_ij`, state order `(l12, l13, l14, l23, l24, l34)`.
+fn frahm_rhs(a: &[f64; 4], b: &[f64; 4], l: &[f64; 6]) -> [f64; 6] {
+    const P: [(usize, usize); 6] = [(0, 1), (0, 2), (0, 3), (1, 2), (1, 3), (2, 3)];
+    let mut lm = [[0.0; 4]; 4];
+    let mut w = [[0.0; 4]; 4];
+    for (q, &(i, j)) in P.iter().enumerate() {
+        let c = (b[i] - b[j]) / (a[i] - a[j]);
+        lm[i][j] = l[q];
+        lm[j][i] = -l[q];
+        w[i][j] = c * l[q];
+        w[j][i] = -c * l[q];
+    }
+    std::array::from_fn(|q| {
+        let (i, j) = P[q];
+        (0..4)
+            .map(|k| lm[i][k] * w[k][j] - w[i][k] * lm[k][j])
+            .sum()
+    })
+}
+
+proptest! {
+    /// The cubic interpolant reproduces b at the four a_i.
+    #[test]
+    fn cubic_interpolant_reproduces_b(
+        a in proptest::array::uniform4(-3.0f64..3.0),
+        b in proptest::array::uniform4(-2.0f64..2.0),
+    ) {
+        prop_assume!((0..4).all(|i| ((i + 1)..4).all(|j| (a[i] - a[j]).abs() > 0.2)));
+        let p = cubic_interpolant(&a, &b).unwrap();
+        for i in 0..4 {
+            let v = p[0] + a[i] * (p[1] + a[i] * (p[2] + a[i] * p[3]));
+            prop_assert!((v - b[i]).abs() < 1e-12 * (1.0 + p.iter().map(|x| x.abs()).sum::<f64>()));
+        }
+    }
+
+    /// (15) corrected: l̇(s) = m_b(s) × l(s) (i.e. L̇ = [L, M_b] with the hat map of (17))
+    /// for random a, b, l, s on both branches of √G.
+    #[test]
+    fn lax_pair_general_b(
+        a in proptest::array::uniform4(-3.0f64..3.0),
+        b in proptest::array::uniform4(-2.0f64..2.0),
+        l in proptest::array::uniform6(-2.0f64..2.0),
+        sre in -3.0f64..3.0, sim in 0.1f64..2.0, flip in proptest::bool::ANY,
+    ) {
+        prop_assume!((0..4).all(|i| ((i + 1)..4).all(|j| (a[i] - a[j]).abs() > 0.2)));
+        let s = C::new(sre, sim);
+        let sg = sqrt_principal(g_poly(&a, s)) * if flip { -1.0 } else { 1.0 };
+        let (lv, mv) = schottky(&a, &l, s, sg).unwrap();
+        let (ldv, _) = schottky(&a, &frahm_rhs(&a, &b, &l), s, sg).unwrap();
+        let mb = lax_m(&a, &b, &l, s, sg).unwrap();
+        let cross = [
+            mb[1] * lv[2] - mb[2] * lv[1],
+            mb[2] * lv[0] - mb[0] * lv[2],
+            mb[0] * lv[1] - mb[1] * lv[0],
+        ];
+        let cmax = (0..4)
+            .flat_map(|i| (0..4).filter(move |&j| j != i).map(move |j| (i, j)))
+            .map(|(i, j)| ((b[i] - b[j]) / (a[i] - a[j])).abs())
+            .fold(0.0, f64::max);
+        let n = |v: &[C; 3]| v.iter().map(|x| x.norm()).fold(0.0, f64::max);
+        let scale = n(&ldv).max(n(&lv) * n(&mb)).max(n(&lv) * n(&mv) * cmax).max(f64::MIN_POSITIVE);
+        for j in 0..3 {
+            prop_assert!((ldv[j] - cross[j]).norm() < 1e-12 * scale);
+        }
+    }
+}

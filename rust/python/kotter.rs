@@ -123,6 +123,39 @@ fn kotter_schottky_py<'py>(
     ))
 }
 
+/// The vectors m_b(s) of the Lax matrix M_b(s) (15)-(17) for the top (a, b), states (n, 6).
+#[pyfunction(name = "kotter_lax_m")]
+fn kotter_lax_m_py<'py>(
+    py: Python<'py>,
+    a: PyReadonlyArray1<'py, f64>,
+    b: PyReadonlyArray1<'py, f64>,
+    l: PyReadonlyArray2<'py, f64>,
+    s: PyReadonlyArray1<'py, C>,
+    sqrt_g: PyReadonlyArray1<'py, C>,
+) -> PyResult<Bound<'py, PyAny>> {
+    let a = read_a(&a)?;
+    let b = {
+        let b = b.as_array();
+        if b.len() != 4 {
+            return Err(shape_err("b", "(4,)", b.shape()));
+        }
+        [b[0], b[1], b[2], b[3]]
+    };
+    let rows = read_rows::<6>("l", &l)?;
+    let n = rows.len();
+    let s = read_c1("s", &s, n)?;
+    let sg = read_c1("sqrt_g", &sqrt_g, n)?;
+    let res: Result<Vec<[C; 3]>, Error> = py.detach(|| {
+        rows.iter()
+            .zip(s.iter().zip(sg.iter()))
+            .map(|(r, (&si, &gi))| kotter::lax_m(&a, &b, r, si, gi))
+            .collect()
+    });
+    let out: Vec<C> = res?.into_iter().flatten().collect();
+    let arr = Array2::from_shape_vec((n, 3), out).map_err(|e| shape_err_msg(e.to_string()))?;
+    Ok(arr.into_pyarray(py).into_any())
+}
+
 /// Coefficients of F(s) (18), monic, highest power first, for integrals h of shape (n, 4).
 #[pyfunction(name = "kotter_quartic")]
 fn kotter_quartic_py<'py>(
@@ -326,6 +359,7 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(kotter_integrals_py, m)?)?;
     m.add_function(wrap_pyfunction!(kotter_schottky_py, m)?)?;
     m.add_function(wrap_pyfunction!(kotter_quartic_py, m)?)?;
+    m.add_function(wrap_pyfunction!(kotter_lax_m_py, m)?)?;
     m.add_function(wrap_pyfunction!(kotter_batch_py, m)?)?;
     m.add_function(wrap_pyfunction!(kotter_from_points_py, m)?)?;
     Ok(())
