@@ -250,7 +250,10 @@ class Kotter:
         The constants ``(alpha, beta, gamma, delta)`` of (38):
         ``A_j = alpha + beta d_j + gamma/d_j``, ``B_j = delta (d_j + 1/d_j)``.
     eps, K : complex
-        (39) corrected: ``H0 = K g^2 (1 - eps P_0)^2``.
+        (39) corrected: ``H0 = K g^2 (1 - eps P_0)^2`` with
+        ``K = kappa sum_j c~_j d_j beta_j delta_j`` and
+        ``2 K eps = kappa sum_j c~_j (alpha_j delta_j + beta_j gamma_j)``,
+        ``kappa = prod_{m=1}^3 (d_m - d4)``, ``c~_j`` of (33).
     P0 : complex
         ``P_0 = sqrt(z1 z2)`` (27) in the curve's branch.
     g : complex

@@ -60,11 +60,11 @@ pub const REPEATED_ROOT_RTOL: f64 = 1e-7;
 pub const ROOT_STAGNATION: f64 = 1e-8;
 
 /// Residual (relative to the size of the data) above which the structural
-/// fits of (37)–(39) are reported as failing: the nine equations for six
-/// unknowns are consistent to rounding (a few 1e-13 on the reference tops,
-/// up to ~1e-7 when two `d_j` nearly coincide, which amplifies rounding in
-/// `α_j … δ_j` by `1/|d_j − d_k|`); 1e-6 still rejects an inconsistent
-/// system, whose residual is O(1).
+/// fits of (37)–(38) and the perfect square of the corrected (39) are
+/// reported as failing: they hold to rounding (a few 1e-13 on the reference
+/// tops, up to ~1e-7 when two `d_j` nearly coincide, which amplifies rounding
+/// in `α_j … δ_j` by `1/|d_j − d_k|`); 1e-6 still rejects an inconsistent
+/// structure, whose residual is O(1).
 pub const STRUCTURE_RTOL: f64 = 1e-6;
 
 /// The principal square root of the curve module (`−π/2 < arg √w ≤ π/2`,
@@ -473,9 +473,11 @@ pub struct KotterConstants {
     pub b_coef: [C; 3],
     /// `(α, β, γ, δ)` of (38) (the paper's unnamed constants; not the `α_j` of (24)).
     pub abgd38: [C; 4],
-    /// `ε` of (39)–(40), corrected: `H0 = K g² (1 − ε P_0)²` with [`KotterConstants::k`].
+    /// `ε` of (39)–(40), corrected: `H0 = K g² (1 − ε P_0)²` with [`KotterConstants::k`];
+    /// `ε = Σ_j c̃_j (α_j δ_j + β_j γ_j) / (2 Σ_j c̃_j d_j β_j δ_j)`.
     pub eps: C,
-    /// `K` of the corrected (39) (printed as `1/(4 ε d_4)`).
+    /// `K` of the corrected (39) (printed as `1/(4 ε d_4)`):
+    /// `K = κ Σ_j c̃_j d_j β_j δ_j`, `κ = Π_{m=1}^{3} (d_m − d_4)`, `c̃_j` of (33).
     pub k: C,
 }
 
@@ -719,8 +721,10 @@ fn lstsq(rows: &[Vec<C>], rhs: &[C]) -> Result<(Vec<C>, f64)> {
 /// paper's (38) then reads `A_j = α + β d_j + γ/d_j`, `B_j = δ (d_j + 1/d_j)`.
 /// The corrected (39): on the quadrics, by (30a), (30b), (31b),
 /// `H0 ≡ K/d4 Σ η_j²/(d_j − d4) + 2Kε Σ ξ_jη_j/(d_j − d4) + Kε² Σ d_j ξ_j²/(d_j − d4)`
-/// `= K g² (1 − ε P_0)²`; `(K, ε)` and the multipliers are found from the nine
-/// coefficient equations (six unknowns), whose consistency is checked.
+/// `= K g² (1 − ε P_0)²` with, in closed form (`κ = Π_m (d_m − d4)`,
+/// `c̃_j` of (33)),
+/// `K = κ Σ_j c̃_j d_j β_j δ_j`, `2Kε = κ Σ_j c̃_j (α_j δ_j + β_j γ_j)`,
+/// `Kε² = (κ/d4) Σ_j c̃_j α_j γ_j`; the perfect square `(Kε)² = K · Kε²` is checked.
 fn h0_structure(
     alpha: &[C; 3],
     beta: &[C; 3],
@@ -751,24 +755,44 @@ fn h0_structure(
     let (x, _) = lstsq(&rows, &a_coef)?;
     let abgd38 = [x[0], x[1], x[2], delta38];
 
-    // (39): unknowns X = (K ε², 2 K ε, K, λ', μ', ν').
-    let mut rows = Vec::with_capacity(9);
-    let mut rhs = Vec::with_capacity(9);
-    for j in 0..3 {
-        let w = ONE / (d[j] - d4);
-        rows.push(vec![d[j] * w, ZERO, ZERO, ONE, ZERO, d[j]]);
-        rhs.push(ac[j]);
-        rows.push(vec![ZERO, w, ZERO, ZERO, ONE, ZERO]);
-        rhs.push(bc[j]);
-        rows.push(vec![ZERO, ZERO, w / d4, ONE, ZERO, ONE / d[j]]);
-        rhs.push(cc[j]);
-    }
-    let (x, r3) = lstsq(&rows, &rhs)?;
-    // ε from 2Kε and K; that the K ε² column then agrees (the perfect square
-    // of (39)) is a property checked in the tests and, per state, through
-    // the corrected (41) in `kotter_with`.
-    let k = x[2];
-    let eps = x[1] / (2.0 * k);
+    // (39) corrected, in closed form. On the quadrics H0 ≡ K g² − 2Kε g²P_0 +
+    // Kε² g²P_0², with g² = Σ η_j²/((d_j − d4) d4) (30a), g²P_0 = −Σ ξ_jη_j/(d_j − d4)
+    // (31b), g²P_0² = Σ d_j ξ_j²/(d_j − d4) (30b), up to λQ1 + μQ2 + νQ3 of (11).
+    // Matching the coefficients of η_j², ξ_jη_j, ξ_j² and multiplying by (d_j − d4)
+    // (and d_j) gives polynomials of degree ≤ 2 in d_j whose value at x = d4 —
+    // the Lagrange interpolant through d1, d2, d3, L_j(d4) = c̃_j (d4 − d_k)(d4 − d_l)
+    // — isolates the K terms, since the multiplier terms vanish at x = d4:
+    // K = κ Σ c̃_j d_j c_j, 2Kε = κ Σ c̃_j b_j, Kε² d4 = κ Σ c̃_j a_j, with
+    // κ = Π (d_m − d4) (docs/kotter.md §7).
+    let ct: [C; 3] = std::array::from_fn(|j| {
+        let (k2, l2) = ((j + 1) % 3, (j + 2) % 3);
+        ONE / ((d[j] - d[k2]) * (d[j] - d[l2]))
+    });
+    let kappa = (d[0] - d4) * (d[1] - d4) * (d[2] - d4);
+    let k: C = kappa * (0..3).map(|j| ct[j] * d[j] * cc[j]).sum::<C>();
+    // 2Kε: (d_j − d4) b_j is of degree 1 in d_j, so two nodes suffice and the
+    // symmetric three-node form κ Σ c̃_j b_j equals the slope
+    // (b_j − b_k)/(w_j − w_k), w_j = 1/(d_j − d4), through any pair. The pair with
+    // the most separated w avoids the cancellation of the three-node form when
+    // two d_j nearly coincide (c̃_j ~ 1/(d_1 − d_2): 1e12 on near_degenerate states).
+    let w: [C; 3] = std::array::from_fn(|j| ONE / (d[j] - d4));
+    let (pj, pk) = [(0, 1), (0, 2), (1, 2)]
+        .into_iter()
+        .fold((0, 1), |best, (j, kk)| {
+            if (w[j] - w[kk]).norm() > (w[best.0] - w[best.1]).norm() {
+                (j, kk)
+            } else {
+                best
+            }
+        });
+    let k_eps: C = 0.5 * (bc[pj] - bc[pk]) / (w[pj] - w[pk]);
+    let eps = k_eps / k;
+    // The perfect square of (39), (Kε)² = K · Kε², with Kε² d4 = κ Σ c̃_j a_j;
+    // relative to the size of the terms (the sum cancels when two d_j are close).
+    let terms_e2: f64 = (0..3).map(|j| (ct[j] * ac[j]).norm()).sum();
+    let k_eps2: C = kappa / d4 * (0..3).map(|j| ct[j] * ac[j]).sum::<C>();
+    let r3 = (k_eps * k_eps - k * k_eps2).norm()
+        / ((k_eps * k_eps).norm() + (k * kappa / d4).norm() * terms_e2);
     let worst = r1.max(r2).max(r3);
     if worst.is_nan() || worst > STRUCTURE_RTOL {
         return Err(Error::InvalidArgument {
@@ -850,9 +874,9 @@ pub const UNIFORM_RTOL: f64 = 1e-6;
 
 /// Relative agreement required between `g` from (30a) (the curve's inverse
 /// map) and the corrected (41). The sign choice needs only `|Δg| ≪ |g|`; the
-/// accuracy of `K`, `ε` (a least-squares fit of (37)–(39)) degrades with the
-/// conditioning of the `d_j` (clustered roots of F give ~1e-8), so 1e-6 flags
-/// a wrong structure, not rounding.
+/// accuracy of the closed forms for `K`, `ε` (sums with `c̃_j ~ 1/(d_j − d_k)`)
+/// degrades with the conditioning of the `d_j` (clustered roots of F give
+/// ~1e-8), so 1e-6 flags a wrong structure, not rounding.
 pub const G41_RTOL: f64 = 1e-6;
 
 /// A state in Kötter's coordinates: the constants of its level set, the

@@ -343,3 +343,47 @@ proptest! {
         }
     }
 }
+
+/// The corrected (39) with the closed-form `K = κ Σ c̃_j d_j β_j δ_j`,
+/// `2Kε = κ Σ c̃_j (α_j δ_j + β_j γ_j)` is an identity on the whole quadric
+/// variety: at complex point pairs of the curve with complex `g`,
+/// `Σ_j m_j n_j` of (23) applied to (36) equals `K g² (1 − ε P_0)²`.
+#[test]
+fn h0_39_closed_form_on_point_pairs() {
+    let st = kotter(&A, &L0).unwrap();
+    let k = &st.constants;
+    let d = k.d;
+    let d4 = d[0] * d[1] * d[2];
+    let kappa = (d[0] - d4) * (d[1] - d4) * (d[2] - d4);
+    let ct = st.curve.c_tilde();
+    let k_closed: C = kappa
+        * (0..3)
+            .map(|j| ct[j] * d[j] * k.beta[j] * k.delta[j])
+            .sum::<C>();
+    let ke_closed: C = 0.5
+        * kappa
+        * (0..3)
+            .map(|j| ct[j] * (k.alpha[j] * k.delta[j] + k.beta[j] * k.gamma[j]))
+            .sum::<C>();
+    assert!((k.k - k_closed).norm() < 1e-12 * k_closed.norm());
+    assert!((k.k * k.eps - ke_closed).norm() < 1e-12 * ke_closed.norm());
+    for (z1, z2, g) in [
+        (C::new(0.4, 1.3), C::new(-2.1, 0.7), C::new(0.9, -0.3)),
+        (C::new(3.3, -0.2), C::new(0.1, -1.9), C::new(-0.4, 1.2)),
+        (C::new(-5.0, 2.5), C::new(7.0, 1.0), C::new(2.0, 0.5)),
+    ] {
+        let (y1, y2) = (st.curve.y(z1), -st.curve.y(z2));
+        let (xi, eta) = st.curve.xi_eta(z1, y1, z2, y2, g, None, None).unwrap();
+        let p0 = st.curve.wurzel(z1, y1, z2, y2, None).unwrap().p[0];
+        let mut h0 = ZERO;
+        let mut size = 0.0;
+        for j in 0..3 {
+            let mj = k.alpha[j] * xi[j] + k.beta[j] * eta[j];
+            let nj = k.gamma[j] * xi[j] + k.delta[j] * eta[j];
+            h0 += mj * nj;
+            size += (mj * nj).norm();
+        }
+        let rhs = k.k * g * g * (ONE - k.eps * p0) * (ONE - k.eps * p0);
+        assert!((h0 - rhs).norm() < 1e-11 * size, "{h0} vs {rhs}");
+    }
+}
