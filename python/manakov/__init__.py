@@ -8,6 +8,7 @@ Equation numbers in docstrings are the paper's.
 from ._core import ConvergenceError, __version__
 from .curve import CurvePoints, KotterCurve, Wurzel
 from .problems import Problem, benchmark_setup, problem, problem_names
+from .reduction import Kotter, from_kotter, kotter
 from .theta import (
     CHARACTERISTICS,
     PAPER_CHARACTERISTICS,
@@ -37,7 +38,10 @@ __all__ = [
     "ConvergenceError",
     "CurvePoints",
     "FrahmTop",
+    "from_kotter",
     "from_matrix",
+    "kotter",
+    "Kotter",
     "KotterCurve",
     "ManakovTop",
     "METHODS",

@@ -17,6 +17,12 @@ __all__ = [
     "hamiltonian",
     "integrate",
     "integrate_many",
+    "kotter_batch",
+    "kotter_from_points",
+    "kotter_integrals",
+    "kotter_lax_m",
+    "kotter_quartic",
+    "kotter_schottky",
     "manakov_c",
     "manakov_integral_labels",
     "manakov_integrals",
@@ -119,3 +125,42 @@ def theta_jet(
 def theta_plan_info(
     tau: npt.NDArray[np.complex128], tol: float, order: int
 ) -> tuple[float, float, float, float]: ...
+
+# --- kotter (rust/python/kotter.rs) ---
+
+def kotter_integrals(
+    a: npt.NDArray[np.float64], l: npt.NDArray[np.float64]
+) -> npt.NDArray[np.float64]: ...
+def kotter_schottky(
+    a: npt.NDArray[np.float64],
+    l: npt.NDArray[np.float64],
+    s: npt.NDArray[np.complex128],
+    sqrt_g: npt.NDArray[np.complex128],
+) -> tuple[npt.NDArray[np.complex128], npt.NDArray[np.complex128]]: ...
+def kotter_lax_m(
+    a: npt.NDArray[np.float64],
+    b: npt.NDArray[np.float64],
+    l: npt.NDArray[np.float64],
+    s: npt.NDArray[np.complex128],
+    sqrt_g: npt.NDArray[np.complex128],
+) -> npt.NDArray[np.complex128]: ...
+def kotter_quartic(
+    a: npt.NDArray[np.float64], h: npt.NDArray[np.float64]
+) -> npt.NDArray[np.float64]: ...
+def kotter_batch(
+    a: npt.NDArray[np.float64], l: npt.NDArray[np.float64]
+) -> dict[str, npt.NDArray[np.generic]]: ...
+def kotter_from_points(
+    alpha: npt.NDArray[np.complex128],
+    beta: npt.NDArray[np.complex128],
+    gamma: npt.NDArray[np.complex128],
+    delta: npt.NDArray[np.complex128],
+    d: npt.NDArray[np.complex128],
+    z1: npt.NDArray[np.complex128],
+    y1: npt.NDArray[np.complex128],
+    z2: npt.NDArray[np.complex128],
+    y2: npt.NDArray[np.complex128],
+    g: npt.NDArray[np.complex128],
+    branch: npt.NDArray[np.int8],
+    zd: npt.NDArray[np.complex128] | None = None,
+) -> npt.NDArray[np.float64]: ...

@@ -571,6 +571,42 @@ class ManakovTop(FrahmTop):
         vals = _core.manakov_integrals(self._a, flat)
         return vals.reshape(lead + (vals.shape[1],))
 
+    def kotter(self, l: Any) -> Any:
+        """Schottky–Kötter coordinates of the state(s) ``l`` (n = 4 only).
+
+        Shorthand for :func:`manakov.kotter` ``(self.a, self.b, l)``: the roots of
+        F (18), Kötter's vectors ξ, η (21), the curve constants d (26), and the two
+        points of the curve (8) with g, such that ξ_j = √c_j g P_kl, η_j = √c_j g P_j4
+        (36), (41). See ``docs/kotter.md``.
+
+        Returns
+        -------
+        manakov.Kotter
+        """
+        from .reduction import kotter
+
+        self._require_so4("kotter")
+        return kotter(self._a, self._b, l)
+
+    def from_kotter(self, k: Any) -> np.ndarray:
+        """Map Schottky–Kötter coordinates back to the state l (n = 4 only).
+
+        Shorthand for :func:`manakov.from_kotter` ``(self.a, self.b, k)``: rebuilds
+        ξ, η from the curve points and g by (36) and inverts (23).
+
+        Returns
+        -------
+        ndarray, shape (..., 6)
+        """
+        from .reduction import from_kotter
+
+        self._require_so4("from_kotter")
+        return from_kotter(self._a, self._b, k)
+
+    def _require_so4(self, what: str) -> None:
+        if self.n != 4:
+            raise ValueError(f"{what} is defined for so(4) only (n = 4), this top has n = {self.n}")
+
     def __repr__(self) -> str:
         return f"ManakovTop(a={self._a.tolist()}, b={self._b.tolist()})"
 

@@ -63,6 +63,12 @@ pub const ON_CURVE_RTOL: f64 = 1e-8;
 /// computed elsewhere while rejecting data off Kötter's quadrics (11).
 pub const INVERSE_RTOL: f64 = 1e-8;
 
+/// Offsets `zd_j` given with a point must agree with `z − d_j` to
+/// `OFFSET_RTOL · (|z| + max_m |d_m|)`: the accurate offsets
+/// `t + (d_b − d_j)` and the rounded `z − d_j` differ by a few roundings of
+/// numbers of that size; anything larger is an inconsistent point.
+pub const OFFSET_RTOL: f64 = 16.0 * f64::EPSILON;
+
 /// Two branch points closer than this (relative to their size) are treated as
 /// coinciding: `d_4 = d_1 d_2 d_3` is a rounded product, so `d_4 = d_1` when
 /// `d_2 d_3 = 1` only up to a few ulps.
@@ -134,6 +140,34 @@ pub struct WurzelPoints {
     pub eps: [i8; 5],
     /// Largest deviation `|(ξ, η) − (ξ, η)(z1, y1, z2, y2, g, eps)|`.
     pub residual: f64,
+    /// `zd1[j] = z1 − d_j`, `j = 0..4`, to full relative accuracy (see
+    /// [`CurvePoint`]): a point close to a branch point is not resolved by
+    /// `z1` alone.
+    pub zd1: [Complex64; 5],
+    /// `zd2[j] = z2 − d_j`.
+    pub zd2: [Complex64; 5],
+}
+
+/// A point `(z, y)` of the curve together with its offsets
+/// `zd[j] = z − d_j` from the branch points, `j = 0..4`.
+///
+/// Why the offsets: a double-precision `z` fixes `z − d_j` only to an
+/// absolute `u |z|` (u the unit roundoff), i.e. to a relative `u |z| / |z − d_j|`,
+/// and the roots `√(z − d_j)` of (27)–(28) inherit it. A point 4e-9 from a
+/// branch point (as on the `near_degenerate` top, whose `d_1, d_2` are 3.8e-5
+/// apart and trap the point between them) loses eight digits in `√(z − d_j)`.
+/// Carried separately (computed as `t + (d_b − d_j)` from the offset `t`
+/// to the nearest branch point `d_b`), the offsets are accurate to a few ulps
+/// relative. [`KotterCurve::point`] fills them in plainly from `z`;
+/// [`KotterCurve::points_from_xi_eta`] returns accurate ones.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct CurvePoint {
+    /// The abscissa.
+    pub z: Complex64,
+    /// Its `y`, `y² = R(z)` (the sheet).
+    pub y: Complex64,
+    /// `zd[j] = z − d_j`, `j = 0..4`.
+    pub zd: [Complex64; 5],
 }
 
 fn check_finite_c(what: &'static str, x: &[Complex64]) -> Result<()> {
@@ -231,12 +265,128 @@ impl KotterCurve {
     /// `r_j(z)² = z − d_j`, `Π_j r_j(z) = y` (see the module docs). The point
     /// is not checked; see [`KotterCurve::check_point`].
     pub fn roots(&self, z: Complex64, y: Complex64) -> [Complex64; 5] {
-        let mut r = self.d.map(|dj| sqrt_principal(z - dj));
+        self.roots_from_offsets(&self.offsets(z), y)
+    }
+
+    /// The offsets `z − d_j`, `j = 0..4`, computed plainly from `z`.
+    pub fn offsets(&self, z: Complex64) -> [Complex64; 5] {
+        self.d.map(|dj| z - dj)
+    }
+
+    /// The point `(z, y)` with the plain offsets [`KotterCurve::offsets`]
+    /// (not checked; see [`KotterCurve::check_curve_point`]).
+    pub fn point(&self, z: Complex64, y: Complex64) -> CurvePoint {
+        CurvePoint {
+            z,
+            y,
+            zd: self.offsets(z),
+        }
+    }
+
+    /// The canonical roots `r_j = sqrt_principal(zd_j)` (`j = 0..3`) and
+    /// `r_4 = ±sqrt_principal(zd_4)` with `Π_j r_j = y`, from the offsets
+    /// `zd_j = z − d_j` (see [`KotterCurve::roots`]).
+    pub fn roots_from_offsets(&self, zd: &[Complex64; 5], y: Complex64) -> [Complex64; 5] {
+        let mut r = zd.map(sqrt_principal);
         let prod = r[0] * r[1] * r[2] * r[3] * r[4];
         if (prod.conj() * y).re < 0.0 {
             r[4] = -r[4];
         }
         r
+    }
+
+    /// Checks a point given with offsets: finite, `zd_j` consistent with
+    /// `z − d_j` (to [`OFFSET_RTOL`]) and on the curve, `y² = Π_j zd_j` (to
+    /// [`ON_CURVE_RTOL`], as [`KotterCurve::check_point`]).
+    pub fn check_curve_point(&self, what: &'static str, p: &CurvePoint) -> Result<()> {
+        check_finite_c(what, &[p.z, p.y])?;
+        check_finite_c(what, &p.zd)?;
+        let dmax = self.d.iter().map(|v| v.norm()).fold(0.0, f64::max);
+        for j in 0..5 {
+            let err = (p.zd[j] - (p.z - self.d[j])).norm();
+            if err.is_nan() || err > OFFSET_RTOL * (p.z.norm() + dmax) {
+                return Err(Error::InvalidArgument {
+                    what,
+                    reason: format!(
+                        "the offset zd[{j}] = {} is not z - d_{j} = {} (|difference| = {err:e}): \
+                         offsets inconsistent with z",
+                        p.zd[j],
+                        p.z - self.d[j]
+                    ),
+                });
+            }
+        }
+        let scale: f64 = self.d.iter().map(|dj| p.z.norm() + dj.norm()).product();
+        let r: Complex64 = p.zd.iter().product();
+        let resid = (p.y * p.y - r).norm();
+        if resid.is_nan() || resid > ON_CURVE_RTOL * scale {
+            return Err(Error::InvalidArgument {
+                what,
+                reason: format!(
+                    "the point ({}, {}) is not on the curve y^2 = R(x): \
+                     |y^2 - R(z)| = {resid:e} > {ON_CURVE_RTOL:e} * {scale:e}",
+                    p.z, p.y
+                ),
+            });
+        }
+        Ok(())
+    }
+
+    /// [`KotterCurve::wurzel`] for points given with their offsets
+    /// ([`CurvePoint`]): the roots `√(z_i − d_j)` are taken from the offsets,
+    /// so points close to branch points keep full accuracy.
+    ///
+    /// Errors: as [`KotterCurve::wurzel`], and offsets inconsistent with `z`.
+    pub fn wurzel_points(
+        &self,
+        p1: &CurvePoint,
+        p2: &CurvePoint,
+        eps: Option<[i8; 5]>,
+    ) -> Result<Wurzel> {
+        self.check_curve_point("point (z1, y1, zd1)", p1)?;
+        self.check_curve_point("point (z2, y2, zd2)", p2)?;
+        self.wurzel_unchecked(p1, p2, eps)
+    }
+
+    fn wurzel_unchecked(
+        &self,
+        p1: &CurvePoint,
+        p2: &CurvePoint,
+        eps: Option<[i8; 5]>,
+    ) -> Result<Wurzel> {
+        let (z1, z2) = (p1.z, p2.z);
+        if z1 == z2 {
+            return Err(Error::InvalidArgument {
+                what: "points (z1, z2)",
+                reason: format!(
+                    "z1 == z2 == {z1}: P_jk (28) divides by z1 - z2 and is undefined \
+                     (a pole, or a 0/0 when y1 == y2)"
+                ),
+            });
+        }
+        let eps = match eps {
+            None => [1.0; 5],
+            Some(e) => check_eps(e)?,
+        };
+        let r1 = self.roots_from_offsets(&p1.zd, p1.y);
+        let r2 = self.roots_from_offsets(&p2.zd, p2.y);
+        Ok(wurzel_from_roots(&r1, &r2, z1 - z2, &eps))
+    }
+
+    /// [`KotterCurve::xi_eta`] for points given with their offsets
+    /// ([`CurvePoint`], [`KotterCurve::wurzel_points`]).
+    pub fn xi_eta_points(
+        &self,
+        p1: &CurvePoint,
+        p2: &CurvePoint,
+        g: Complex64,
+        eps: Option<[i8; 5]>,
+        sqrt_c: Option<[Complex64; 3]>,
+    ) -> Result<([Complex64; 3], [Complex64; 3])> {
+        check_finite_c("g", &[g])?;
+        let sc = self.sqrt_c_checked(sqrt_c)?;
+        let w = self.wurzel_points(p1, p2, eps)?;
+        Ok(xi_eta_of(&w, &sc, g))
     }
 
     /// The Wurzelfunktionen (27)–(28) of the points `(z1, y1)`, `(z2, y2)` in
@@ -257,22 +407,7 @@ impl KotterCurve {
     ) -> Result<Wurzel> {
         self.check_point("point (z1, y1)", z1, y1)?;
         self.check_point("point (z2, y2)", z2, y2)?;
-        if z1 == z2 {
-            return Err(Error::InvalidArgument {
-                what: "points (z1, z2)",
-                reason: format!(
-                    "z1 == z2 == {z1}: P_jk (28) divides by z1 - z2 and is undefined \
-                     (a pole, or a 0/0 when y1 == y2)"
-                ),
-            });
-        }
-        let eps = match eps {
-            None => [1.0; 5],
-            Some(e) => check_eps(e)?,
-        };
-        let r1 = self.roots(z1, y1);
-        let r2 = self.roots(z2, y2);
-        Ok(wurzel_from_roots(&r1, &r2, z1 - z2, &eps))
+        self.wurzel_unchecked(&self.point(z1, y1), &self.point(z2, y2), eps)
     }
 
     /// Kötter's vectors (36): `ξ_j = √c_j g P_kl`, `η_j = √c_j g P_j4`,
@@ -292,13 +427,7 @@ impl KotterCurve {
         check_finite_c("g", &[g])?;
         let sc = self.sqrt_c_checked(sqrt_c)?;
         let w = self.wurzel(z1, y1, z2, y2, eps)?;
-        let mut xi = [Complex64::new(0.0, 0.0); 3];
-        let mut eta = xi;
-        for (i, &(j, k, l)) in CYCLIC.iter().enumerate() {
-            xi[i] = sc[i] * g * w.pjk[k][l];
-            eta[i] = sc[i] * g * w.pjk[j][4];
-        }
-        Ok((xi, eta))
+        Ok(xi_eta_of(&w, &sc, g))
     }
 
     fn sqrt_c_checked(&self, sqrt_c: Option<[Complex64; 3]>) -> Result<[Complex64; 3]> {
@@ -418,6 +547,8 @@ impl KotterCurve {
             g,
             eps: [1; 5],
             residual: f64::INFINITY,
+            zd1: self.offsets(z1),
+            zd2: self.offsets(z2),
         };
         for s1 in [1.0, -1.0] {
             for s2 in [1.0, -1.0] {
@@ -444,6 +575,8 @@ impl KotterCurve {
                             g,
                             eps: eps.map(|v| v as i8),
                             residual: resid,
+                            zd1: self.offsets(z1),
+                            zd2: self.offsets(z2),
                         };
                     }
                 }
@@ -485,13 +618,24 @@ impl KotterCurve {
     /// Gauss–Newton polish of `(z1, z2, g)` for [`KotterCurve::points_from_xi_eta`].
     ///
     /// The closed form goes through `Σ c̃_j X_j²`, whose terms cancel heavily
-    /// when the `P_kl` are nearly equal (points far out or close together);
-    /// that costs up to ~1e3 over the conditioning of the map itself. A
-    /// least-squares Newton step on the six equations `X = g P_kl`,
-    /// `Y = g P_j4` recovers the intrinsic accuracy. The roots `r_j(z_i)` are
-    /// continued holomorphically, `r_j(z + δ) = r_j(z) √(1 + δ/(z − d_j))`,
-    /// so the step never crosses a cut of the principal roots; the final
-    /// branch is expressed again as `eps` relative to the canonical roots.
+    /// when the `P_kl` are nearly equal (points far out or close together) or
+    /// when two branch points nearly coincide (`c̃_j ~ 1/(d_j − d_k)`); that
+    /// costs up to ~1e3 over the conditioning of the map itself, and more for
+    /// clustered branch points. Least-squares Newton steps on the six
+    /// equations `X = g P_kl`, `Y = g P_j4` recover the intrinsic accuracy.
+    ///
+    /// Each point is parametrised by the local uniformizing parameter at its
+    /// nearest branch point `d_b`: `w = r_b(z) = √(z − d_b)` (with its
+    /// branch), `z = d_b + w²`. In `w` the map is holomorphic and regular
+    /// through the branch point, whereas in `z` it has a square-root
+    /// singularity there: a closed-form `z` whose error is comparable to its
+    /// distance from `d_b` (a point 5e-11 from `d_1` when `d_1, d_2` are 3e-5
+    /// apart) is outside the basin of Newton's method in `z`, not in `w`.
+    /// The offsets are then `zd_j = w² + (d_b − d_j)`, accurate to a few ulps
+    /// ([`CurvePoint`]). The other roots are continued holomorphically,
+    /// `r_j(z + δ) = r_j(z) √(1 + δ/(z − d_j))`, so a step never crosses a
+    /// cut of the principal roots; the final branch is expressed again as
+    /// `eps` relative to the canonical roots.
     fn refine(
         &self,
         start: WurzelPoints,
@@ -499,83 +643,132 @@ impl KotterCurve {
         sc: &[Complex64; 3],
     ) -> WurzelPoints {
         let d = self.d;
+        let zero = Complex64::new(0.0, 0.0);
+        let nearest = |zd: &[Complex64; 5]| -> usize {
+            (0..5).fold(0, |b, j| if zd[j].norm() < zd[b].norm() { j } else { b })
+        };
+        let (b1, b2) = (nearest(&start.zd1), nearest(&start.zd2));
+        // d_b − d_j: exactly 0 at j = b, so zd_b = w² exactly.
+        let dd1: [Complex64; 5] = std::array::from_fn(|j| d[b1] - d[j]);
+        let dd2: [Complex64; 5] = std::array::from_fn(|j| d[b2] - d[j]);
+        // The scale on which the map varies in w: the square root of the
+        // distance from d_b to the next branch point.
+        let wscale = |dd: &[Complex64; 5]| -> f64 {
+            dd.iter()
+                .filter(|v| v.norm() > 0.0)
+                .map(|v| v.norm())
+                .fold(f64::INFINITY, f64::min)
+                .sqrt()
+        };
+        let (ws1, ws2) = (wscale(&dd1), wscale(&dd2));
+        let d12 = d[b1] - d[b2];
+        let dz_of = |w1: Complex64, w2: Complex64| d12 + (w1 * w1 - w2 * w2);
         let eps_f = start.eps.map(f64::from);
         // The branch of the start, folded into the roots of the first point:
         // P_j = (eps_j r_j(z1)) r_j(z2).
-        let mut r1 = self.roots(start.z1, start.y1);
+        let mut r1 = self.roots_from_offsets(&start.zd1, start.y1);
         for j in 0..5 {
             r1[j] *= eps_f[j];
         }
-        let mut r2 = self.roots(start.z2, start.y2);
-        let (mut z1, mut z2, mut g) = (start.z1, start.z2, start.g);
+        let mut r2 = self.roots_from_offsets(&start.zd2, start.y2);
+        let mut g = start.g;
         let resid_of = |f: &[Complex64; 6]| -> f64 {
             (0..6)
                 .map(|i| ((target[i] - f[i]) * sc[i % 3]).norm())
                 .fold(0.0, nan_max)
         };
-        let six = |r1: &[Complex64; 5], r2: &[Complex64; 5], dz: Complex64, g: Complex64| {
+        let six = |r1: &[Complex64; 5], r2: &[Complex64; 5], g: Complex64| {
+            let dz = dz_of(r1[b1], r2[b2]);
             let w = wurzel_from_roots(r1, r2, dz, &[1.0; 5]);
-            let mut f = [Complex64::new(0.0, 0.0); 6];
+            let mut f = [zero; 6];
             for (i, &(j, k, l)) in CYCLIC.iter().enumerate() {
                 f[i] = g * w.pjk[k][l];
                 f[i + 3] = g * w.pjk[j][4];
             }
             f
         };
-        let cont = |r: &[Complex64; 5], z: Complex64, dz: Complex64| -> [Complex64; 5] {
-            std::array::from_fn(|j| r[j] * sqrt_principal(1.0 + dz / (z - d[j])))
+        // Move the point's parameter w = r[b] to w + dw: r_b = w + dw, the other
+        // roots continued along t = w² → (w + dw)².
+        let moved = |r: &[Complex64; 5], b: usize, dd: &[Complex64; 5], dw: Complex64| {
+            let w = r[b];
+            let dt = (2.0 * w + dw) * dw;
+            let t = w * w;
+            std::array::from_fn(|j| {
+                if j == b {
+                    w + dw
+                } else {
+                    r[j] * sqrt_principal(1.0 + dt / (t + dd[j]))
+                }
+            })
         };
-        let mut f = six(&r1, &r2, z1 - z2, g);
+        let mut f = six(&r1, &r2, g);
         let mut resid = resid_of(&f);
-        for _ in 0..3 {
-            // Continuation needs the points off the branch points and apart.
-            let rho = d
-                .iter()
-                .map(|dj| (z1 - dj).norm().min((z2 - dj).norm()))
-                .fold((z1 - z2).norm(), f64::min);
-            if rho.is_nan() || rho <= 0.0 || g == Complex64::new(0.0, 0.0) {
+        for _ in 0..8 {
+            if g == zero || dz_of(r1[b1], r2[b2]) == zero {
                 break;
             }
-            let h = 1e-6 * rho;
+            let (h1, h2) = (1e-7 * ws1, 1e-7 * ws2);
             let mut jac = nalgebra::SMatrix::<Complex64, 6, 3>::zeros();
-            let hc = Complex64::new(h, 0.0);
-            let fp1 = six(&cont(&r1, z1, hc), &r2, z1 + hc - z2, g);
-            let fm1 = six(&cont(&r1, z1, -hc), &r2, z1 - hc - z2, g);
-            let fp2 = six(&r1, &cont(&r2, z2, hc), z1 - z2 - hc, g);
-            let fm2 = six(&r1, &cont(&r2, z2, -hc), z1 - z2 + hc, g);
+            let c = |x: f64| Complex64::new(x, 0.0);
+            let fp1 = six(&moved(&r1, b1, &dd1, c(h1)), &r2, g);
+            let fm1 = six(&moved(&r1, b1, &dd1, c(-h1)), &r2, g);
+            let fp2 = six(&r1, &moved(&r2, b2, &dd2, c(h2)), g);
+            let fm2 = six(&r1, &moved(&r2, b2, &dd2, c(-h2)), g);
             let mut rhs = nalgebra::SVector::<Complex64, 6>::zeros();
             for i in 0..6 {
                 let w = sc[i % 3];
-                jac[(i, 0)] = w * (fp1[i] - fm1[i]) / (2.0 * h);
-                jac[(i, 1)] = w * (fp2[i] - fm2[i]) / (2.0 * h);
+                jac[(i, 0)] = w * (fp1[i] - fm1[i]) / (2.0 * h1);
+                jac[(i, 1)] = w * (fp2[i] - fm2[i]) / (2.0 * h2);
                 jac[(i, 2)] = w * f[i] / g;
                 rhs[i] = w * (target[i] - f[i]);
             }
             let Ok(step) = jac.svd(true, true).solve(&rhs, 1e-14) else {
                 break;
             };
-            let (nz1, nz2, ng) = (z1 + step[0], z2 + step[1], g + step[2]);
-            let (nr1, nr2) = (cont(&r1, z1, step[0]), cont(&r2, z2, step[1]));
-            let nf = six(&nr1, &nr2, nz1 - nz2, ng);
+            let nr1 = moved(&r1, b1, &dd1, step[0]);
+            let nr2 = moved(&r2, b2, &dd2, step[1]);
+            let ng = g + step[2];
+            let nf = six(&nr1, &nr2, ng);
             let nres = resid_of(&nf);
             if nres.is_nan() || nres >= resid {
                 break;
             }
-            (z1, z2, g, r1, r2, f, resid) = (nz1, nz2, ng, nr1, nr2, nf, nres);
+            (g, r1, r2, f, resid) = (ng, nr1, nr2, nf, nres);
         }
         if resid >= start.residual {
             return start;
         }
+        let (w1, w2) = (r1[b1], r2[b2]);
+        let zd1: [Complex64; 5] = std::array::from_fn(|j| w1 * w1 + dd1[j]);
+        let zd2: [Complex64; 5] = std::array::from_fn(|j| w2 * w2 + dd2[j]);
+        let (z1, z2) = (d[b1] + w1 * w1, d[b2] + w2 * w2);
         // Express the continued roots as (y_i, eps) relative to the canonical roots.
         // Π_j eps_j = +1, so the product of the branch-folded roots is y1.
         let y1: Complex64 = r1.iter().product();
         let y2: Complex64 = r2.iter().product();
-        let c1 = self.roots(z1, y1);
-        let c2 = self.roots(z2, y2);
-        let mut eps = [1i8; 5];
-        for j in 0..5 {
-            let ratio = (r1[j] * r2[j]) / (c1[j] * c2[j]);
-            eps[j] = if ratio.re >= 0.0 { 1 } else { -1 };
+        let c1 = self.roots_from_offsets(&zd1, y1);
+        let c2 = self.roots_from_offsets(&zd2, y2);
+        // The sign of each continued root relative to the canonical one (a
+        // root at a branch point is 0 on both: its sign is immaterial).
+        let sign = |r: Complex64, c: Complex64| -> i8 {
+            if c == zero || (r / c).re >= 0.0 {
+                1
+            } else {
+                -1
+            }
+        };
+        let mut eps: [i8; 5] = std::array::from_fn(|j| sign(r1[j], c1[j]) * sign(r2[j], c2[j]));
+        if eps.iter().map(|&e| i32::from(e)).product::<i32>() < 0 {
+            // Only possible with a root exactly 0: flip the sign of the P_j
+            // nearest zero, the one the data determine least.
+            let j = (0..5).fold(0, |m, j| {
+                if (c1[j] * c2[j]).norm() < (c1[m] * c2[m]).norm() {
+                    j
+                } else {
+                    m
+                }
+            });
+            eps[j] = -eps[j];
         }
         if eps[4] < 0 {
             eps = eps.map(|e| -e);
@@ -589,8 +782,21 @@ impl KotterCurve {
             g,
             eps,
             residual: resid,
+            zd1,
+            zd2,
         }
     }
+}
+
+/// (36) from the Wurzelfunktionen: `ξ_j = √c_j g P_kl`, `η_j = √c_j g P_j4`.
+fn xi_eta_of(w: &Wurzel, sc: &[Complex64; 3], g: Complex64) -> ([Complex64; 3], [Complex64; 3]) {
+    let mut xi = [Complex64::new(0.0, 0.0); 3];
+    let mut eta = xi;
+    for (i, &(j, k, l)) in CYCLIC.iter().enumerate() {
+        xi[i] = sc[i] * g * w.pjk[k][l];
+        eta[i] = sc[i] * g * w.pjk[j][4];
+    }
+    (xi, eta)
 }
 
 /// `max` that propagates NaN (`f64::max` drops it), so that a NaN anywhere in

@@ -39,10 +39,11 @@ const BACKWARD_RTOL: f64 = 1e-13;
 /// the first-order bound `u ‖(ξ, η)‖ / σ_min(J)` ([`inverse_error_bound`]):
 /// the inverse is conditioned like the map itself, whose Jacobian is singular
 /// at `z1 = z2` and degrades for clustered branch points or far points. Over
-/// 100 000 random draws the worst ratio was 18 (29 in a run before the
+/// 100 000 random draws the worst ratio was 9.1 with the polish in the
+/// uniformizing parameter `w` (18 with the polish in `z`, 29 before the
 /// inverse rescaled its input; the data themselves carry more than `u` of
-/// rounding from (28)); 100 leaves a margin of 3.5 or more. In absolute terms
-/// the forward error had median 1.9e-15, 99 % 3.0e-13, 99.9 % 2.4e-12 (the
+/// rounding from (28)); 100 leaves a margin of 5 or more. In absolute terms
+/// the forward error had median 1.9e-15, 99 % 3.0e-13, 99.9 % 2.8e-12 (the
 /// `stats_forward_error` run).
 const STABILITY_FACTOR: f64 = 100.0;
 
@@ -503,4 +504,73 @@ fn stats_forward_error() {
         q(0.99),
         q(0.999)
     );
+}
+
+/// A point 1e-11 from the branch point `d_1` (offsets exact by construction):
+/// the inverse map returns offsets `zd` that resolve it — the offset to `d_1`
+/// comes back to 1e-8 relative (a double `z` alone fixes it only to
+/// `u |z| / 1e-11` ≈ 2e-5) — and (36) at the recovered points, evaluated from
+/// the offsets, reproduces `(ξ, η)` to [`BACKWARD_RTOL`].
+#[test]
+fn inverse_resolves_points_near_branch_points() {
+    let curve = KotterCurve::new(c(0.0, 1.678), c(0.0, 1.67796), c(0.0, -21.56)).unwrap();
+    let d = curve.branch_points();
+    let t = c(0.0, -1e-11);
+    let p2 = CurvePoint {
+        z: d[1] + t,
+        y: C::new(0.0, 0.0),
+        zd: std::array::from_fn(|j| t + (d[1] - d[j])),
+    };
+    let y2: C = p2.zd.map(sqrt_principal).iter().product();
+    let p2 = CurvePoint { y: y2, ..p2 };
+    let z1 = c(0.3, -8.3);
+    let p1 = curve.point(z1, curve.y(z1));
+    let g = c(0.7, 0.2);
+    let (xi, eta) = curve.xi_eta_points(&p1, &p2, g, None, None).unwrap();
+    let w = curve
+        .points_from_xi_eta(xi, eta, None, Some(g), INVERSE_RTOL)
+        .unwrap();
+    // the pair is unordered: the recovered point near d_1 is the one with the small offset
+    let zd_near = if w.zd1[1].norm() < w.zd2[1].norm() {
+        w.zd1[1]
+    } else {
+        w.zd2[1]
+    };
+    assert!((zd_near - t).norm() <= 1e-8 * t.norm(), "{zd_near} vs {t}");
+    let q1 = CurvePoint {
+        z: w.z1,
+        y: w.y1,
+        zd: w.zd1,
+    };
+    let q2 = CurvePoint {
+        z: w.z2,
+        y: w.y2,
+        zd: w.zd2,
+    };
+    let (xi2, eta2) = curve
+        .xi_eta_points(&q1, &q2, w.g, Some(w.eps), None)
+        .unwrap();
+    let scale = xi
+        .iter()
+        .chain(eta.iter())
+        .map(|v| v.norm())
+        .fold(0.0, f64::max);
+    for j in 0..3 {
+        assert!(close(xi2[j], xi[j], scale, BACKWARD_RTOL));
+        assert!(close(eta2[j], eta[j], scale, BACKWARD_RTOL));
+    }
+}
+
+/// Offsets inconsistent with `z` are rejected.
+#[test]
+fn inconsistent_offsets_rejected() {
+    let curve = KotterCurve::new(c(1.0, 0.2), c(-0.5, 0.1), c(2.0, -0.3)).unwrap();
+    let z1 = c(0.4, 0.9);
+    let z2 = c(-1.1, 0.3);
+    let p1 = curve.point(z1, curve.y(z1));
+    let mut p2 = curve.point(z2, curve.y(z2));
+    assert!(curve.wurzel_points(&p1, &p2, None).is_ok());
+    p2.zd[3] += c(1e-6, 0.0);
+    let err = curve.wurzel_points(&p1, &p2, None).unwrap_err();
+    assert!(format!("{err}").contains("offset"));
 }

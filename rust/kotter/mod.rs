@@ -1,1 +1,1050 @@
-//! Schottky's l(s), f(s) (12)–(17) and Kötter's reduction (18)–(26), (37)–(41).
+//! Schottky's `l(s)`, `f(s)` (12)–(17) and Kötter's reduction (18)–(26),
+//! (37)–(41): from a state `l` of the top to the vectors `ξ, η`, the constants
+//! `d_j` of Kötter's quadrics (11) and of the curve (8), and back.
+//!
+//! # Notation and conventions (all of them; see `docs/kotter.md`)
+//!
+//! * State `l = (l12, l13, l14, l23, l24, l34)`; `m_j = l_kl`, `n_j = l_j4` (13)
+//!   with `(j, k, l)` cyclic in `(1, 2, 3)`: `m = (l23, l31, l12)`,
+//!   `n = (l14, l24, l34)`.
+//! * Integrals: `h0 = l12 l34 + l23 l14 + l31 l24` (6), `h1 = Σ l_jk²`, and
+//!   **`h2 = Σ_{j<k} (a_l + a_m) l_jk²`, `h3 = Σ_{j<k} a_l a_m l_jk²`** with
+//!   `{l, m}` the complement of `{j, k}` — the forms for which the closed form
+//!   (14) holds (erratum to (7)/(14), `docs/errata-kotter.md`).
+//! * `√s_j4` is the principal root of `s_j4 = (s − a_j)(s − a_4)`, and
+//!   `√s_kl := √G / √s_j4` for a chosen branch `√G` of `G(s) = Π (s − a_j)`,
+//!   so that `√s_j4 √s_kl = √G` for every `j` (the cross term of (14)).
+//! * At a root `s_p` of `F` (18), the branch of `√G` is
+//!   `σ_p = −(h1 s_p² − h2 s_p + h3)/(2 h0)`, the one on which `f(s_p) = 0`.
+//! * `√F'(s_p)` principal. Order of the roots: `s1` the non-real root of
+//!   largest imaginary part, `s2` the root nearest `conj(s1)`, `s3` the
+//!   remaining root of larger imaginary part (then larger real part), `s4`
+//!   the last; when all four are real, descending order. With this order
+//!   `l^(2) = conj(l^(1))` for real `l` whenever `s2 = conj(s1)`.
+//! * `Δ_j^(p)` (25) is the 2×2 determinant
+//!   `(√s_j4^(q) √s_kl^(r) − √s_j4^(r) √s_kl^(q)) / (√F'(s_q) √F'(s_r))`
+//!   (erratum: printed with one root over the whole difference).
+
+use nalgebra::{DMatrix, DVector};
+use num_complex::Complex64;
+
+use crate::curve::{CurvePoint, KotterCurve, WurzelPoints};
+use crate::error::{check_finite, Error, Result};
+
+type C = Complex64;
+
+const ZERO: C = C::new(0.0, 0.0);
+const ONE: C = C::new(1.0, 0.0);
+const I: C = C::new(0.0, 1.0);
+
+/// `(j, k, l)` cyclic permutations of `(1, 2, 3)`, 0-based, in the order `j = 1, 2, 3`.
+pub const CYCLIC: [(usize, usize, usize); 3] = [(0, 1, 2), (1, 2, 0), (2, 0, 1)];
+
+/// `|h1² − 4 h0²| ≤ DEGENERATE_RTOL · h1²` is treated as `h1² = 4 h0²`: the
+/// denominator of (18) vanishes. `h1² − 4h0² = |m − n|² |m + n|² ≥ 0` is a
+/// difference of rounded squares, accurate to a few ulps of `h1²`; 1e-12
+/// leaves room for that and for states given to ~12 digits.
+pub const DEGENERATE_RTOL: f64 = 1e-12;
+
+/// Roots of `F` closer than `REPEATED_ROOT_RTOL` times their scale are
+/// treated as repeated: then `F'(s_p) → 0` and `l^(p)` (19) is undefined. A
+/// double root is located only to `√ε ≈ 1.5e-8` relative, so two roots
+/// within 1e-7 are indistinguishable from a double root.
+pub const REPEATED_ROOT_RTOL: f64 = 1e-7;
+
+/// Roots within a relative distance `δ` of each other are determined only to
+/// about `u/δ` (u the unit roundoff), and the Aberth iteration then jitters
+/// at that level instead of reaching 1e-15. Steps still larger than 1e-8
+/// after 500 sweeps mean no convergence (roots closer than ~1e-8 are
+/// reported as repeated anyway).
+pub const ROOT_STAGNATION: f64 = 1e-8;
+
+/// Residual (relative to the size of the data) above which the structural
+/// fits of (37)–(38) and the perfect square of the corrected (39) are
+/// reported as failing: they hold to rounding (a few 1e-13 on the reference
+/// tops, up to ~1e-7 when two `d_j` nearly coincide, which amplifies rounding
+/// in `α_j … δ_j` by `1/|d_j − d_k|`); 1e-6 still rejects an inconsistent
+/// structure, whose residual is O(1).
+pub const STRUCTURE_RTOL: f64 = 1e-6;
+
+/// The principal square root of the curve module (`−π/2 < arg √w ≤ π/2`,
+/// `√(−x) = +i√x` whatever the sign of a zero imaginary part), so that both
+/// modules cut `(−∞, 0)` on the same side.
+pub use crate::curve::sqrt_principal;
+
+fn check_a(a: &[f64; 4]) -> Result<()> {
+    check_finite("a", a)?;
+    for i in 0..4 {
+        for j in (i + 1)..4 {
+            if a[i] == a[j] {
+                return Err(Error::RepeatedA { i, j, value: a[i] });
+            }
+        }
+    }
+    Ok(())
+}
+
+/// `(m, n)` of (13): `m_j = l_kl`, `n_j = l_j4`, from `l = (l12, l13, l14, l23, l24, l34)`.
+pub fn m_n(l: &[f64; 6]) -> ([f64; 3], [f64; 3]) {
+    ([l[3], -l[1], l[0]], [l[2], l[4], l[5]])
+}
+
+/// Inverse of [`m_n`]: `l = (m3, −m2, n1, m1, n2, n3)`.
+pub fn l_from_m_n(m: &[f64; 3], n: &[f64; 3]) -> [f64; 6] {
+    [m[2], -m[1], n[0], m[0], n[1], n[2]]
+}
+
+/// The integrals `(h0, h1, h2, h3)`: `H0` (6), `H1` (7), and `H2`, `H3` in the
+/// form consistent with (14): `H2 = Σ_{j<k} (a_l + a_m) l_jk²`,
+/// `H3 = Σ_{j<k} a_l a_m l_jk²`, `{l, m}` the complement of `{j, k}`.
+pub fn integrals(a: &[f64; 4], l: &[f64; 6]) -> [f64; 4] {
+    let (m, n) = m_n(l);
+    let h0 = m[0] * n[0] + m[1] * n[1] + m[2] * n[2];
+    let mut h = [h0, 0.0, 0.0, 0.0];
+    for (j, &(_, k, ll)) in CYCLIC.iter().enumerate() {
+        // m_j = l_kl has complement {j, 4}; n_j = l_j4 has complement {k, l}.
+        h[1] += m[j] * m[j] + n[j] * n[j];
+        h[2] += (a[j] + a[3]) * m[j] * m[j] + (a[k] + a[ll]) * n[j] * n[j];
+        h[3] += a[j] * a[3] * m[j] * m[j] + a[k] * a[ll] * n[j] * n[j];
+    }
+    h
+}
+
+/// `s_jk = (s − a_j)(s − a_k)` (13), 0-based indices.
+fn s_pair(s: C, a: &[f64; 4], j: usize, k: usize) -> C {
+    (s - a[j]) * (s - a[k])
+}
+
+/// `G(s) = Π_{j=1}^{4} (s − a_j)` (14).
+pub fn g_poly(a: &[f64; 4], s: C) -> C {
+    a.iter().fold(ONE, |acc, &aj| acc * (s - aj))
+}
+
+/// Schottky's vector (12) and the vector `m(s)` of (16) on the branch
+/// `√s_j4 √s_kl = sqrt_g` (`√s_j4` principal, see the module docs):
+/// `l_j(s) = √s_j4 m_j + √s_kl n_j`, `m_j(s) = √s_kl m_j + √s_j4 n_j`.
+///
+/// Errors: non-finite input; `s = a_j` or `s = a_4` for some `j` (then
+/// `√s_kl = √G/√s_j4` is 0/0).
+pub fn schottky(a: &[f64; 4], l: &[f64; 6], s: C, sqrt_g: C) -> Result<([C; 3], [C; 3])> {
+    check_finite("a", a)?;
+    check_finite("l", l)?;
+    check_finite("s, sqrt_g", &[s.re, s.im, sqrt_g.re, sqrt_g.im])?;
+    let (m, n) = m_n(l);
+    let mut lv = [ZERO; 3];
+    let mut mv = [ZERO; 3];
+    for (j, _) in CYCLIC.iter().enumerate() {
+        let r = sqrt_principal(s_pair(s, a, j, 3));
+        if r == ZERO {
+            return Err(Error::InvalidArgument {
+                what: "s",
+                reason: format!(
+                    "s = {s} is a root of s_j4 (j = {}): l(s) (12) is taken at s != a_i",
+                    j + 1
+                ),
+            });
+        }
+        let q = sqrt_g / r;
+        lv[j] = r * m[j] + q * n[j];
+        mv[j] = q * m[j] + r * n[j];
+    }
+    Ok((lv, mv))
+}
+
+/// The cubic interpolant of `b` over `a`: `(p0, p1, p2, p3)` with
+/// `b_i = p0 + p1 a_i + p2 a_i² + p3 a_i³`, `i = 1 … 4` (always possible for
+/// four distinct `a_i`; `p3` is the third divided difference of `b` over
+/// `a`). By (2), `c_ij = p1 + p2 (a_i + a_j) + p3 (a_i² + a_i a_j + a_j²)`.
+///
+/// Errors: non-finite or repeated `a`, non-finite `b`.
+pub fn cubic_interpolant(a: &[f64; 4], b: &[f64; 4]) -> Result<[f64; 4]> {
+    check_a(a)?;
+    check_finite("b", b)?;
+    // Newton's divided differences: b(x) = b0 + f01 (x − a0) + f012 (x − a0)(x − a1)
+    // + f0123 (x − a0)(x − a1)(x − a2).
+    let f01 = (b[1] - b[0]) / (a[1] - a[0]);
+    let f12 = (b[2] - b[1]) / (a[2] - a[1]);
+    let f23 = (b[3] - b[2]) / (a[3] - a[2]);
+    let f012 = (f12 - f01) / (a[2] - a[0]);
+    let f123 = (f23 - f12) / (a[3] - a[1]);
+    let f0123 = (f123 - f012) / (a[3] - a[0]);
+    let p3 = f0123;
+    let p2 = f012 - f0123 * (a[0] + a[1] + a[2]);
+    let p1 = f01 - f012 * (a[0] + a[1]) + f0123 * (a[0] * a[1] + a[0] * a[2] + a[1] * a[2]);
+    let p0 = b[0] - f01 * a[0] + f012 * a[0] * a[1] - f0123 * a[0] * a[1] * a[2];
+    Ok([p0, p1, p2, p3])
+}
+
+/// `|sqrt_g² − G(s)| ≤ SQRT_G_RTOL · |G(s)|` is required of the branch passed
+/// to [`lax_m`]: a rounded square root is good to a few ulps; the sign `τ`
+/// (below) is meaningless for a number that is not a root of `G`.
+pub const SQRT_G_RTOL: f64 = 1e-8;
+
+/// The branch sign `τ = √s_14 √s_24 √s_34 √G / ((s − a_4) G(s)) = ±1`
+/// (`√s_j4` principal, `√G = sqrt_g`); its square is 1 because
+/// `s_14 s_24 s_34 = (s − a_4)² G(s)`.
+///
+/// Errors: `sqrt_g` not a square root of `G(s)` (to [`SQRT_G_RTOL`]),
+/// `G(s) = 0`.
+pub fn branch_sign(a: &[f64; 4], s: C, sqrt_g: C) -> Result<f64> {
+    let g = g_poly(a, s);
+    let miss = (sqrt_g * sqrt_g - g).norm();
+    if g == ZERO || miss.is_nan() || miss > SQRT_G_RTOL * g.norm() {
+        return Err(Error::InvalidArgument {
+            what: "sqrt_g",
+            reason: format!(
+                "sqrt_g = {sqrt_g} is not a square root of G(s) = {g} at s = {s} (or G(s) = 0)"
+            ),
+        });
+    }
+    let r: C = (0..3).map(|j| sqrt_principal(s_pair(s, a, j, 3))).product();
+    let tau = r * sqrt_g / ((s - a[3]) * g);
+    Ok(if tau.re >= 0.0 { 1.0 } else { -1.0 })
+}
+
+/// The vector `m_b(s)` of the Lax matrix `M_b(s)` (17) for the top with
+/// parameters `(a, b)`, so that `L̇(s) = [L(s), M_b(s)]` (15) along the flow
+/// (1)–(2), on the branch `√s_j4 √s_kl = sqrt_g` (`√s_j4` principal):
+///
+/// `m_b(s) = −τ [p2 m(s) + p3 (e2 m(s) + m^[ω3](s)) / (e1 − s)]`
+///
+/// with `(p0, …, p3)` the cubic interpolant of `b` over `a`
+/// ([`cubic_interpolant`]), `m(s)` the vector (16) (`m^[l]`), `m^[X](s)` the
+/// same built from an antisymmetric `X` instead of `l`
+/// (`m^[X]_j = √s_kl X_kl + √s_j4 X_j4`), `(ω3)_ij = (a_i² + a_i a_j + a_j²) l_ij`
+/// (the angular velocity of the top with `b = a³`), `e1 = Σ a_i`,
+/// `e2 = Σ_{i<j} a_i a_j`, and `τ = ±1` the branch sign ([`branch_sign`]).
+/// The printed (16)–(17) is the case `b = a²` on the branch `τ = −1`
+/// (erratum, `docs/errata-kotter.md`; derivation in `docs/kotter.md` §2).
+///
+/// Errors: those of [`schottky`] and [`branch_sign`]; `s = e1` when
+/// `p3 ≠ 0` (a pole of `M_b`).
+pub fn lax_m(a: &[f64; 4], b: &[f64; 4], l: &[f64; 6], s: C, sqrt_g: C) -> Result<[C; 3]> {
+    let p = cubic_interpolant(a, b)?;
+    let (_, m) = schottky(a, l, s, sqrt_g)?;
+    let tau = branch_sign(a, s, sqrt_g)?;
+    let mut mb: [C; 3] = m.map(|v| v * p[2]);
+    if p[3] != 0.0 {
+        let e1: f64 = a.iter().sum();
+        let e2 = a[0] * (a[1] + a[2] + a[3]) + a[1] * (a[2] + a[3]) + a[2] * a[3];
+        let den = e1 - s;
+        if den == ZERO {
+            return Err(Error::InvalidArgument {
+                what: "s",
+                reason: format!(
+                    "s = {s} equals e1 = a1 + a2 + a3 + a4, a pole of M_b(s) (b is not \
+                     quadratic in a: p3 = {})",
+                    p[3]
+                ),
+            });
+        }
+        // ω3 in the state order (l12, l13, l14, l23, l24, l34)
+        const PAIRS: [(usize, usize); 6] = [(0, 1), (0, 2), (0, 3), (1, 2), (1, 3), (2, 3)];
+        let w3: [f64; 6] = std::array::from_fn(|q| {
+            let (i, j) = PAIRS[q];
+            (a[i] * a[i] + a[i] * a[j] + a[j] * a[j]) * l[q]
+        });
+        let (_, m3) = schottky(a, &w3, s, sqrt_g)?;
+        for j in 0..3 {
+            mb[j] += p[3] * (e2 * m[j] + m3[j]) / den;
+        }
+    }
+    Ok(mb.map(|v| -tau * v))
+}
+
+/// The polynomial part `h1 s² − h2 s + h3` of (14).
+pub fn p_poly(h: &[f64; 4], s: C) -> C {
+    (s * h[1] - h[2]) * s + h[3]
+}
+
+/// Coefficients of `F(s)` (18), monic, highest power first:
+/// `F = [(h1 s² − h2 s + h3)² − 4 h0² G(s)] / (h1² − 4 h0²)`.
+///
+/// Errors: `h1² = 4 h0²` (to [`DEGENERATE_RTOL`]), i.e. `m = ±n`: (18) is not
+/// defined (and `f(s)` has fewer than four zeros).
+pub fn quartic_f(a: &[f64; 4], h: &[f64; 4]) -> Result<[f64; 5]> {
+    let [h0, h1, h2, h3] = *h;
+    let den = h1 * h1 - 4.0 * h0 * h0;
+    if den.abs() <= DEGENERATE_RTOL * h1 * h1 || h1 == 0.0 {
+        return Err(Error::InvalidArgument {
+            what: "state l",
+            reason: format!(
+                "h1^2 - 4 h0^2 = {den:e} vanishes (h1 = {h1}, h0 = {h0}; the state is \
+                 self-dual or anti-self-dual, m = +-n): F(s) (18) is not defined"
+            ),
+        });
+    }
+    // G(s) = s^4 - e1 s^3 + e2 s^2 - e3 s + e4
+    let mut g = [1.0, 0.0, 0.0, 0.0, 0.0];
+    for &aj in a {
+        for i in (1..5).rev() {
+            g[i] -= aj * g[i - 1];
+        }
+    }
+    let p2 = [
+        h1 * h1,
+        -2.0 * h1 * h2,
+        h2 * h2 + 2.0 * h1 * h3,
+        -2.0 * h2 * h3,
+        h3 * h3,
+    ];
+    let mut f = [0.0; 5];
+    for i in 0..5 {
+        f[i] = (p2[i] - 4.0 * h0 * h0 * g[i]) / den;
+    }
+    Ok(f)
+}
+
+fn horner(c: &[f64; 5], s: C) -> (C, C) {
+    let mut p = C::new(c[0], 0.0);
+    let mut dp = ZERO;
+    for &ci in &c[1..] {
+        dp = dp * s + p;
+        p = p * s + ci;
+    }
+    (p, dp)
+}
+
+/// The four roots of the monic quartic `F` (18), by the Aberth–Ehrlich
+/// iteration followed by Newton polishing, in the documented order (module
+/// docs).
+///
+/// Errors: two roots closer than [`REPEATED_ROOT_RTOL`] (repeated roots of
+/// F, where (19) divides by `F'(s_p) = 0`); no convergence.
+pub fn quartic_roots(f: &[f64; 5]) -> Result<[C; 4]> {
+    check_finite("F coefficients", f)?;
+    // Cauchy bound for the initial circle.
+    let rad = 1.0 + f[1..].iter().fold(0.0f64, |m, c| m.max(c.abs()));
+    let mut z: [C; 4] = std::array::from_fn(|k| {
+        C::from_polar(rad * 0.5, 0.4 + std::f64::consts::FRAC_PI_2 * k as f64)
+    });
+    let mut converged = false;
+    let mut last = f64::INFINITY;
+    for _ in 0..500 {
+        let mut maxstep = 0.0f64;
+        for k in 0..4 {
+            let (p, dp) = horner(f, z[k]);
+            if p == ZERO {
+                continue;
+            }
+            let ratio = p / dp;
+            let mut sum = ZERO;
+            for j in 0..4 {
+                if j != k {
+                    sum += ONE / (z[k] - z[j]);
+                }
+            }
+            let w = ratio / (ONE - ratio * sum);
+            z[k] -= w;
+            maxstep = maxstep.max(w.norm() / (1.0 + z[k].norm()));
+        }
+        last = maxstep;
+        if maxstep < 1e-15 {
+            converged = true;
+            break;
+        }
+    }
+    for zk in z.iter_mut() {
+        for _ in 0..2 {
+            let (p, dp) = horner(f, *zk);
+            if dp != ZERO {
+                *zk -= p / dp;
+            }
+        }
+    }
+    let scale = z.iter().fold(1.0f64, |m, v| m.max(v.norm()));
+    // A cluster is reported as a repeated root even when the iteration has not
+    // met its tolerance: Aberth converges only linearly to a multiple root.
+    for i in 0..4 {
+        for j in (i + 1)..4 {
+            if (z[i] - z[j]).norm() <= REPEATED_ROOT_RTOL * scale {
+                return Err(Error::InvalidArgument {
+                    what: "state l",
+                    reason: format!(
+                        "F(s) (18) has a repeated root s = {} (|s_{} - s_{}| = {:e}): l^(p) (19) \
+                         divides by sqrt(F'(s_p)) = 0",
+                        z[i],
+                        i + 1,
+                        j + 1,
+                        (z[i] - z[j]).norm()
+                    ),
+                });
+            }
+        }
+    }
+    if !converged && last > ROOT_STAGNATION {
+        return Err(Error::NoConvergence {
+            what: "roots of F(s) (18)",
+            tol: ROOT_STAGNATION,
+            reached: last,
+            iterations: 500,
+        });
+    }
+    Ok(order_roots(z, scale))
+}
+
+fn order_roots(z: [C; 4], scale: f64) -> [C; 4] {
+    // F has real coefficients: a root whose imaginary part is at rounding
+    // level is real (made exactly real, so that the order below does not
+    // depend on the sign of rounding noise), and the partner of a non-real
+    // root is its exact conjugate. Genuinely complex roots this close to the
+    // axis would form a pair closer than REPEATED_ROOT_RTOL (already rejected).
+    let snap = |x: C| {
+        if x.im.abs() <= 1e-12 * scale {
+            C::new(x.re, 0.0)
+        } else {
+            x
+        }
+    };
+    let mut r: Vec<C> = z.iter().map(|&x| snap(x)).collect();
+    let by_im_re = |x: &C, y: &C| {
+        x.im.partial_cmp(&y.im)
+            .unwrap_or(std::cmp::Ordering::Equal)
+            .then(x.re.partial_cmp(&y.re).unwrap_or(std::cmp::Ordering::Equal))
+    };
+    if r.iter().any(|x| x.im != 0.0) {
+        let i1 = (0..4)
+            .filter(|&i| r[i].im != 0.0)
+            .max_by(|&i, &j| by_im_re(&r[i], &r[j]))
+            .unwrap_or(0);
+        let s1 = r.remove(i1);
+        let i2 = (0..3)
+            .min_by(|&i, &j| {
+                (r[i] - s1.conj())
+                    .norm()
+                    .partial_cmp(&(r[j] - s1.conj()).norm())
+                    .unwrap_or(std::cmp::Ordering::Equal)
+            })
+            .unwrap_or(0);
+        r.remove(i2);
+        let (s3, mut s4) = if by_im_re(&r[0], &r[1]) == std::cmp::Ordering::Less {
+            (r[1], r[0])
+        } else {
+            (r[0], r[1])
+        };
+        if s3.im != 0.0 {
+            // the second conjugate pair: s4 = conj(s3) exactly
+            s4 = s3.conj();
+        }
+        [s1, s1.conj(), s3, s4]
+    } else {
+        r.sort_by(|x, y| y.re.partial_cmp(&x.re).unwrap_or(std::cmp::Ordering::Equal));
+        [r[0], r[1], r[2], r[3]]
+    }
+}
+
+/// The constants of Kötter's reduction for one level set `(a, h)`.
+///
+/// Everything here depends only on `a` and the integrals `h`, hence is
+/// constant along a trajectory; `ξ, η` ([`xi_eta`]) carry the time dependence.
+#[derive(Debug, Clone, PartialEq)]
+pub struct KotterConstants {
+    /// `(h0, h1, h2, h3)` ([`integrals`]).
+    pub h: [f64; 4],
+    /// Roots `s_1 … s_4` of `F` (18), in the documented order.
+    pub s: [C; 4],
+    /// `σ_p`, the branch of `√G(s_p)` on which `f(s_p) = 0`.
+    pub sigma: [C; 4],
+    /// `√F'(s_p)`, principal.
+    pub sqrt_fprime: [C; 4],
+    /// `u[p][j] = √s_j4(s_p) / √F'(s_p)` (coefficient of `m_j` in `l_j^(p)` (19)).
+    pub u: [[C; 3]; 4],
+    /// `v[p][j] = √s_kl(s_p) / √F'(s_p)` (coefficient of `n_j`).
+    pub v: [[C; 3]; 4],
+    /// `delta_det[p][j] = Δ_j^(p)` (25) (corrected: a 2×2 determinant), `p = 1, 2, 3`.
+    pub delta_det: [[C; 3]; 3],
+    /// `√d_j = (Δ_j^(1) − i Δ_j^(2)) / Δ_j^(3)` (26).
+    pub sqrt_d: [C; 3],
+    /// `d_j` (26), the constants of Kötter's quadrics (11) and of the curve (8).
+    pub d: [C; 3],
+    /// `α_j, β_j, γ_j, δ_j` of (23) in corrected form (24):
+    /// `m_j = α_j ξ_j + β_j η_j`, `n_j = γ_j ξ_j + δ_j η_j`.
+    pub alpha: [C; 3],
+    /// See [`KotterConstants::alpha`].
+    pub beta: [C; 3],
+    /// See [`KotterConstants::alpha`].
+    pub gamma: [C; 3],
+    /// See [`KotterConstants::alpha`].
+    pub delta: [C; 3],
+    /// `A_j` of (37)–(38): on Kötter's quadrics
+    /// `H0 = Σ_j A_j (ξ_j² − η_j²) + B_j ξ_j η_j`.
+    pub a_coef: [C; 3],
+    /// `B_j` of (37)–(38).
+    pub b_coef: [C; 3],
+    /// `(α, β, γ, δ)` of (38) (the paper's unnamed constants; not the `α_j` of (24)).
+    pub abgd38: [C; 4],
+    /// `ε` of (39)–(40), corrected: `H0 = K g² (1 − ε P_0)²` with [`KotterConstants::k`];
+    /// `ε = Σ_j c̃_j (α_j δ_j + β_j γ_j) / (2 Σ_j c̃_j d_j β_j δ_j)`.
+    pub eps: C,
+    /// `K` of the corrected (39) (printed as `1/(4 ε d_4)`):
+    /// `K = κ Σ_j c̃_j d_j β_j δ_j`, `κ = Π_{m=1}^{3} (d_m − d_4)`, `c̃_j` of (33).
+    pub k: C,
+}
+
+/// Kötter's constants for the level set of the state `l` of the top with
+/// parameters `a` (only `a` and the integrals of `l` enter).
+///
+/// Errors: non-finite or repeated `a`; non-finite `l`; `h0 = 0` or
+/// `h1² = 4h0²` (F (18) not defined or with double roots); repeated roots of
+/// `F`; a root `s_p` at some `a_j` (then `√s_kl` is 0/0); `Δ_j^(3) = 0`
+/// (the pair `s1, s2` does not determine `m_j, n_j`); `d_j` zero or infinite.
+pub fn kotter_constants(a: &[f64; 4], l: &[f64; 6]) -> Result<KotterConstants> {
+    check_a(a)?;
+    check_finite("l", l)?;
+    let h = integrals(a, l);
+    let (m, n) = m_n(l);
+    // P(a_i) = h1 a_i^2 - h2 a_i + h3 from the state itself: the sum of the
+    // non-vanishing terms s_j4 m_j^2 + s_kl n_j^2 at s = a_i, without the
+    // cancellation of the form in h (it is small exactly when a root of F is
+    // near a_i, which is when it is needed to full relative accuracy).
+    let p_at_a: [f64; 4] = std::array::from_fn(|i| {
+        let x = a[i];
+        CYCLIC
+            .iter()
+            .enumerate()
+            .map(|(j, &(_, k, ll))| {
+                (x - a[j]) * (x - a[3]) * m[j] * m[j] + (x - a[k]) * (x - a[ll]) * n[j] * n[j]
+            })
+            .sum()
+    });
+    constants_impl(a, &h, &p_at_a)
+}
+
+/// [`kotter_constants`] from the integrals `h = (h0, h1, h2, h3)` directly.
+///
+/// A root `s_p` close to some `a_i` is then known only to an absolute
+/// accuracy of a few ulps of the coefficients, so `s_p − a_i` (and with it
+/// `√s_j4`, `l^(p)`) loses relative accuracy; [`kotter_constants`] avoids this.
+pub fn constants_from_h(a: &[f64; 4], h: &[f64; 4]) -> Result<KotterConstants> {
+    check_finite("h", h)?;
+    let p_at_a: [f64; 4] = std::array::from_fn(|i| (h[1] * a[i] - h[2]) * a[i] + h[3]);
+    constants_impl(a, h, &p_at_a)
+}
+
+/// The offsets `s_p − a_i` to full relative accuracy, and `P(s_p)`.
+///
+/// When `s_p` is nearer to `a_i` than a tenth of the distance from `a_i` to the
+/// other `a`'s, `t = s_p − a_i` is re-solved by Newton's method on
+/// `(P(a_i) + P'(a_i) t + h1 t²)² − 4 h0² t Π_{m≠i}(a_i − a_m + t) = 0`
+/// (the numerator of (18) at `s = a_i + t`, using `G(a_i) = 0`), whose terms
+/// are all of the size of `t`; the other offsets are `(a_i − a_m) + t`.
+fn root_offsets(a: &[f64; 4], h: &[f64; 4], p_at_a: &[f64; 4], sp: C) -> ([C; 4], C) {
+    let mut best = 0;
+    for i in 1..4 {
+        if (sp - a[i]).norm() < (sp - a[best]).norm() {
+            best = i;
+        }
+    }
+    let ai = a[best];
+    let gap = (0..4)
+        .filter(|&m| m != best)
+        .map(|m| (a[m] - ai).abs())
+        .fold(f64::INFINITY, f64::min);
+    let plain = |s: C| -> ([C; 4], C) { (std::array::from_fn(|m| s - a[m]), p_poly(h, s)) };
+    if (sp - ai).norm() >= 0.1 * gap {
+        return plain(sp);
+    }
+    let [h0, h1, h2, _] = *h;
+    let pa = p_at_a[best];
+    let dpa = 2.0 * h1 * ai - h2;
+    let mut t = sp - ai;
+    for _ in 0..4 {
+        let pt = pa + (h1 * t + dpa) * t;
+        let dpt = dpa + 2.0 * h1 * t;
+        let mut prod = ONE;
+        let mut dprod = ZERO;
+        for m in (0..4).filter(|&m| m != best) {
+            let f = ai - a[m] + t;
+            dprod = dprod * f + prod;
+            prod *= f;
+        }
+        let val = pt * pt - 4.0 * h0 * h0 * t * prod;
+        let der = 2.0 * pt * dpt - 4.0 * h0 * h0 * (prod + t * dprod);
+        if der == ZERO {
+            break;
+        }
+        let step = val / der;
+        t -= step;
+        if step.norm() <= f64::EPSILON * t.norm() {
+            break;
+        }
+    }
+    let diffs = std::array::from_fn(|m| if m == best { t } else { (ai - a[m]) + t });
+    (diffs, pa + (h1 * t + dpa) * t)
+}
+
+fn constants_impl(a: &[f64; 4], h: &[f64; 4], p_at_a: &[f64; 4]) -> Result<KotterConstants> {
+    check_a(a)?;
+    let f = quartic_f(a, h)?;
+    if h[0] == 0.0 || h[0].abs() <= DEGENERATE_RTOL * h[1] {
+        return Err(Error::InvalidArgument {
+            what: "state l",
+            reason: format!(
+                "h0 = {} vanishes: F(s) (18) = (h1 s^2 - h2 s + h3)^2 / h1^2 has double roots and \
+                 the branch sigma = -(h1 s^2 - h2 s + h3)/(2 h0) is undefined",
+                h[0]
+            ),
+        });
+    }
+    let s = quartic_roots(&f)?;
+    let scale_a = a.iter().fold(1.0f64, |m, v| m.max(v.abs()));
+    let mut sigma = [ZERO; 4];
+    let mut sqrt_fp = [ZERO; 4];
+    let mut u = [[ZERO; 3]; 4];
+    let mut v = [[ZERO; 3]; 4];
+    for p in 0..4 {
+        // (conjugate roots give exactly conjugate offsets: the arithmetic is symmetric)
+        let (diff, p_sp) = root_offsets(a, h, p_at_a, s[p]);
+        sigma[p] = -p_sp / (2.0 * h[0]);
+        sqrt_fp[p] = sqrt_principal(horner(&f, s[p]).1);
+        for (j, &aj) in a.iter().enumerate() {
+            // the offsets are accurate to a few ulps relative (root_offsets):
+            // only a root indistinguishable from a_j in double precision is 0/0
+            if diff[j].norm() <= 4.0 * f64::EPSILON * scale_a {
+                return Err(Error::InvalidArgument {
+                    what: "state l",
+                    reason: format!(
+                        "the root s_{} = {} of F (18) coincides with a_{} = {aj}: sqrt(s_kl) = \
+                         sqrt(G)/sqrt(s_j4) is 0/0 there",
+                        p + 1,
+                        s[p],
+                        j + 1
+                    ),
+                });
+            }
+        }
+        for j in 0..3 {
+            let r = sqrt_principal(diff[j] * diff[3]);
+            u[p][j] = r / sqrt_fp[p];
+            v[p][j] = sigma[p] / r / sqrt_fp[p];
+        }
+    }
+    let mut dd = [[ZERO; 3]; 3];
+    for (p, q, r) in [(0, 1, 2), (1, 2, 0), (2, 0, 1)] {
+        for j in 0..3 {
+            dd[p][j] = u[q][j] * v[r][j] - u[r][j] * v[q][j];
+        }
+    }
+    let mut sqrt_d = [ZERO; 3];
+    let mut d = [ZERO; 3];
+    let mut alpha = [ZERO; 3];
+    let mut beta = [ZERO; 3];
+    let mut gamma = [ZERO; 3];
+    let mut delta = [ZERO; 3];
+    for j in 0..3 {
+        let d3 = dd[2][j];
+        let size = (u[0][j].norm() + v[0][j].norm()) * (u[1][j].norm() + v[1][j].norm());
+        if d3.norm() <= 1e-12 * size {
+            return Err(Error::InvalidArgument {
+                what: "state l",
+                reason: format!(
+                    "Delta_{}^(3) (25) vanishes: l_j^(1), l_j^(2) do not determine m_j, n_j",
+                    j + 1
+                ),
+            });
+        }
+        sqrt_d[j] = (dd[0][j] - I * dd[1][j]) / d3;
+        d[j] = sqrt_d[j] * sqrt_d[j];
+        let (u1, v1, u2, v2) = (u[0][j], v[0][j], u[1][j], v[1][j]);
+        alpha[j] = (v2 + I * v1) / (2.0 * d3);
+        beta[j] = (v2 - I * v1) / (2.0 * d3);
+        gamma[j] = -(u2 + I * u1) / (2.0 * d3);
+        delta[j] = -(u2 - I * u1) / (2.0 * d3);
+        if d[j].norm() == 0.0 || !d[j].norm().is_finite() {
+            return Err(Error::InvalidArgument {
+                what: "state l",
+                reason: format!("d_{} = {} (26) is zero or infinite", j + 1, d[j]),
+            });
+        }
+    }
+    let (a_coef, b_coef, abgd38, eps, k) = h0_structure(&alpha, &beta, &gamma, &delta, &d)?;
+    Ok(KotterConstants {
+        h: *h,
+        s,
+        sigma,
+        sqrt_fprime: sqrt_fp,
+        u,
+        v,
+        delta_det: dd,
+        sqrt_d,
+        d,
+        alpha,
+        beta,
+        gamma,
+        delta,
+        a_coef,
+        b_coef,
+        abgd38,
+        eps,
+        k,
+    })
+}
+
+type H0Structure = ([C; 3], [C; 3], [C; 4], C, C);
+
+/// Least-squares solve of a small complex system, returning the solution and
+/// the residual relative to `|rhs|`.
+fn lstsq(rows: &[Vec<C>], rhs: &[C]) -> Result<(Vec<C>, f64)> {
+    let nr = rows.len();
+    let nc = rows.first().map_or(0, |r| r.len());
+    // Columns are equilibrated first: the unknowns (K ε², 2Kε, K, ...) differ
+    // by many orders of magnitude, and an unscaled SVD cut-off would discard
+    // the small ones.
+    let colnorm: Vec<f64> = (0..nc)
+        .map(|j| {
+            let n = rows.iter().map(|r| r[j].norm_sqr()).sum::<f64>().sqrt();
+            if n > 0.0 {
+                n
+            } else {
+                1.0
+            }
+        })
+        .collect();
+    let m = DMatrix::from_fn(nr, nc, |i, j| rows[i][j] / colnorm[j]);
+    let b = DVector::from_row_slice(rhs);
+    let svd = m.clone().svd(true, true);
+    let y = svd.solve(&b, 1e-14).map_err(|e| Error::InvalidArgument {
+        what: "Koetter constants",
+        reason: format!("least-squares solve failed: {e}"),
+    })?;
+    let res = (&m * &y - &b).norm() / b.norm().max(f64::MIN_POSITIVE);
+    Ok(((0..nc).map(|j| y[j] / colnorm[j]).collect(), res))
+}
+
+/// (37)–(39): `H0 = Σ_j m_j n_j` as a quadratic form in `ξ, η`, reduced modulo
+/// Kötter's quadrics (11).
+///
+/// `H0 = Σ_j a_j ξ_j² + b_j ξ_j η_j + c_j η_j²` with `a_j = α_j γ_j`,
+/// `b_j = α_j δ_j + β_j γ_j`, `c_j = β_j δ_j` (from (23)). Adding
+/// `λ Q1 + μ Q2 + ν Q3` of (11) gives the form (37) when
+/// `a_j + λ + ν d_j = −(c_j + λ + ν/d_j) =: A_j` and `B_j = b_j + μ`; the
+/// paper's (38) then reads `A_j = α + β d_j + γ/d_j`, `B_j = δ (d_j + 1/d_j)`.
+/// The corrected (39): on the quadrics, by (30a), (30b), (31b),
+/// `H0 ≡ K/d4 Σ η_j²/(d_j − d4) + 2Kε Σ ξ_jη_j/(d_j − d4) + Kε² Σ d_j ξ_j²/(d_j − d4)`
+/// `= K g² (1 − ε P_0)²` with, in closed form (`κ = Π_m (d_m − d4)`,
+/// `c̃_j` of (33)),
+/// `K = κ Σ_j c̃_j d_j β_j δ_j`, `2Kε = κ Σ_j c̃_j (α_j δ_j + β_j γ_j)`,
+/// `Kε² = (κ/d4) Σ_j c̃_j α_j γ_j`; the perfect square `(Kε)² = K · Kε²` is checked.
+fn h0_structure(
+    alpha: &[C; 3],
+    beta: &[C; 3],
+    gamma: &[C; 3],
+    delta: &[C; 3],
+    d: &[C; 3],
+) -> Result<H0Structure> {
+    let d4 = d[0] * d[1] * d[2];
+    let ac: [C; 3] = std::array::from_fn(|j| alpha[j] * gamma[j]);
+    let bc: [C; 3] = std::array::from_fn(|j| alpha[j] * delta[j] + beta[j] * gamma[j]);
+    let cc: [C; 3] = std::array::from_fn(|j| beta[j] * delta[j]);
+
+    // (37): unknowns (λ, ν) from a_j + c_j + 2λ + ν (d_j + 1/d_j) = 0; μ and δ38 from
+    // b_j + μ = δ38 (d_j + 1/d_j).
+    let rows: Vec<Vec<C>> = (0..3)
+        .map(|j| vec![C::new(2.0, 0.0), d[j] + ONE / d[j]])
+        .collect();
+    let rhs: Vec<C> = (0..3).map(|j| -(ac[j] + cc[j])).collect();
+    let (x, r1) = lstsq(&rows, &rhs)?;
+    let (lam, nu) = (x[0], x[1]);
+    let a_coef: [C; 3] = std::array::from_fn(|j| ac[j] + lam + nu * d[j]);
+    let rows: Vec<Vec<C>> = (0..3).map(|j| vec![-ONE, d[j] + ONE / d[j]]).collect();
+    let (x, r2) = lstsq(&rows, &bc)?;
+    let (mu, delta38) = (x[0], x[1]);
+    let b_coef: [C; 3] = std::array::from_fn(|j| bc[j] + mu);
+    // A_j = α + β d_j + γ / d_j: three equations, three unknowns.
+    let rows: Vec<Vec<C>> = (0..3).map(|j| vec![ONE, d[j], ONE / d[j]]).collect();
+    let (x, _) = lstsq(&rows, &a_coef)?;
+    let abgd38 = [x[0], x[1], x[2], delta38];
+
+    // (39) corrected, in closed form. On the quadrics H0 ≡ K g² − 2Kε g²P_0 +
+    // Kε² g²P_0², with g² = Σ η_j²/((d_j − d4) d4) (30a), g²P_0 = −Σ ξ_jη_j/(d_j − d4)
+    // (31b), g²P_0² = Σ d_j ξ_j²/(d_j − d4) (30b), up to λQ1 + μQ2 + νQ3 of (11).
+    // Matching the coefficients of η_j², ξ_jη_j, ξ_j² and multiplying by (d_j − d4)
+    // (and d_j) gives polynomials of degree ≤ 2 in d_j whose value at x = d4 —
+    // the Lagrange interpolant through d1, d2, d3, L_j(d4) = c̃_j (d4 − d_k)(d4 − d_l)
+    // — isolates the K terms, since the multiplier terms vanish at x = d4:
+    // K = κ Σ c̃_j d_j c_j, 2Kε = κ Σ c̃_j b_j, Kε² d4 = κ Σ c̃_j a_j, with
+    // κ = Π (d_m − d4) (docs/kotter.md §7).
+    let ct: [C; 3] = std::array::from_fn(|j| {
+        let (k2, l2) = ((j + 1) % 3, (j + 2) % 3);
+        ONE / ((d[j] - d[k2]) * (d[j] - d[l2]))
+    });
+    let kappa = (d[0] - d4) * (d[1] - d4) * (d[2] - d4);
+    let k: C = kappa * (0..3).map(|j| ct[j] * d[j] * cc[j]).sum::<C>();
+    // 2Kε: (d_j − d4) b_j is of degree 1 in d_j, so two nodes suffice and the
+    // symmetric three-node form κ Σ c̃_j b_j equals the slope
+    // (b_j − b_k)/(w_j − w_k), w_j = 1/(d_j − d4), through any pair. The pair with
+    // the most separated w avoids the cancellation of the three-node form when
+    // two d_j nearly coincide (c̃_j ~ 1/(d_1 − d_2): 1e12 on near_degenerate states).
+    let w: [C; 3] = std::array::from_fn(|j| ONE / (d[j] - d4));
+    let (pj, pk) = [(0, 1), (0, 2), (1, 2)]
+        .into_iter()
+        .fold((0, 1), |best, (j, kk)| {
+            if (w[j] - w[kk]).norm() > (w[best.0] - w[best.1]).norm() {
+                (j, kk)
+            } else {
+                best
+            }
+        });
+    let k_eps: C = 0.5 * (bc[pj] - bc[pk]) / (w[pj] - w[pk]);
+    let eps = k_eps / k;
+    // The perfect square of (39), (Kε)² = K · Kε², with Kε² d4 = κ Σ c̃_j a_j;
+    // relative to the size of the terms (the sum cancels when two d_j are close).
+    let terms_e2: f64 = (0..3).map(|j| (ct[j] * ac[j]).norm()).sum();
+    let k_eps2: C = kappa / d4 * (0..3).map(|j| ct[j] * ac[j]).sum::<C>();
+    let r3 = (k_eps * k_eps - k * k_eps2).norm()
+        / ((k_eps * k_eps).norm() + (k * kappa / d4).norm() * terms_e2);
+    let worst = r1.max(r2).max(r3);
+    if worst.is_nan() || worst > STRUCTURE_RTOL {
+        return Err(Error::InvalidArgument {
+            what: "Koetter constants",
+            reason: format!(
+                "H0 does not reduce to the form (37)/(39) on Koetter's quadrics: relative \
+                 residual {worst:e} > {STRUCTURE_RTOL:e}"
+            ),
+        });
+    }
+    Ok((a_coef, b_coef, abgd38, eps, k))
+}
+
+/// `l^(p) = l(s_p)/√F'(s_p)` (19) for `p = 1 … 4`, on the documented branches.
+pub fn l_p(k: &KotterConstants, l: &[f64; 6]) -> [[C; 3]; 4] {
+    let (m, n) = m_n(l);
+    std::array::from_fn(|p| std::array::from_fn(|j| k.u[p][j] * m[j] + k.v[p][j] * n[j]))
+}
+
+/// Kötter's vectors (21): `ξ = l^(1) + i l^(2)`, `η = l^(1) − i l^(2)`.
+pub fn xi_eta(k: &KotterConstants, l: &[f64; 6]) -> ([C; 3], [C; 3]) {
+    let lp = l_p(k, l);
+    let xi = std::array::from_fn(|j| lp[0][j] + I * lp[1][j]);
+    let eta = std::array::from_fn(|j| lp[0][j] - I * lp[1][j]);
+    (xi, eta)
+}
+
+/// Relative size of the imaginary part above which [`l_from_xi_eta`] refuses
+/// to return a real state: a round trip leaves ~1e-15 on well-conditioned
+/// curves and up to ~1e-8 near coinciding branch points; data that do not
+/// come from a real state leave an O(1) imaginary part.
+pub const REAL_RTOL: f64 = 1e-6;
+
+/// The state from `ξ, η` by (23): `m_j = α_j ξ_j + β_j η_j`,
+/// `n_j = γ_j ξ_j + δ_j η_j`, `l = (m3, −m2, n1, m1, n2, n3)`.
+///
+/// Errors: non-finite input; an imaginary part larger than [`REAL_RTOL`]
+/// times the size of `l` (the data do not describe a real state).
+pub fn l_from_xi_eta(k: &KotterConstants, xi: &[C; 3], eta: &[C; 3]) -> Result<[f64; 6]> {
+    real_state(&k.coefficients23(), xi, eta)
+}
+
+fn real_state(k: &Coefficients23, xi: &[C; 3], eta: &[C; 3]) -> Result<[f64; 6]> {
+    let mut m = [0.0; 3];
+    let mut n = [0.0; 3];
+    let mut im: f64 = 0.0;
+    let mut size: f64 = 0.0;
+    for j in 0..3 {
+        let mj = k.alpha[j] * xi[j] + k.beta[j] * eta[j];
+        let nj = k.gamma[j] * xi[j] + k.delta[j] * eta[j];
+        if !(mj.re.is_finite() && mj.im.is_finite() && nj.re.is_finite() && nj.im.is_finite()) {
+            return Err(Error::NonFinite {
+                what: "m_j, n_j from (xi, eta)",
+                index: j,
+            });
+        }
+        im = im.max(mj.im.abs()).max(nj.im.abs());
+        size = size.max(mj.norm()).max(nj.norm());
+        m[j] = mj.re;
+        n[j] = nj.re;
+    }
+    if im > REAL_RTOL * size {
+        return Err(Error::InvalidArgument {
+            what: "xi, eta",
+            reason: format!(
+                "they give a complex state: max |Im m_j, Im n_j| = {im:e} > {REAL_RTOL:e} * {size:e}"
+            ),
+        });
+    }
+    Ok(l_from_m_n(&m, &n))
+}
+
+/// Tolerance passed to the inverse map of the curve module
+/// ([`KotterCurve::points_from_xi_eta`]): exact data reproduce `(ξ, η)` to
+/// ~1e-14 relative on well-conditioned curves, to ~1e-7 when two branch
+/// points nearly coincide (points trapped between them); data off the
+/// quadrics miss by O(1), so 1e-6 separates the two.
+pub const UNIFORM_RTOL: f64 = 1e-6;
+
+/// Relative agreement required between `g` from (30a) (the curve's inverse
+/// map) and the corrected (41). The sign choice needs only `|Δg| ≪ |g|`; the
+/// accuracy of the closed forms for `K`, `ε` (sums with `c̃_j ~ 1/(d_j − d_k)`)
+/// degrades with the conditioning of the `d_j` (clustered roots of F give
+/// ~1e-8), so 1e-6 flags a wrong structure, not rounding.
+pub const G41_RTOL: f64 = 1e-6;
+
+/// A state in Kötter's coordinates: the constants of its level set, the
+/// vectors `l^(p)`, `ξ, η`, the curve (8) and the point pair with `g` (36), (41).
+#[derive(Debug, Clone, PartialEq)]
+pub struct KotterState {
+    /// Constants of the level set.
+    pub constants: KotterConstants,
+    /// `l^(p)` (19), `p = 1 … 4`.
+    pub l_p: [[C; 3]; 4],
+    /// `ξ` (21).
+    pub xi: [C; 3],
+    /// `η` (21).
+    pub eta: [C; 3],
+    /// The curve (8) with the `d_j` of (26).
+    pub curve: KotterCurve,
+    /// `P_0 = √(z1 z2)` in the curve's branch, from (31b): `P_0 = −Σ_j c̃_j P_j4 P_kl`.
+    pub p0: C,
+    /// The points, `g` and the branch of the `P_j` (see [`crate::curve`]),
+    /// with `ξ_j = √c_j g P_kl`, `η_j = √c_j g P_j4` (36); the sign of `g` is
+    /// fixed by the corrected (41): `g (1 − ε P_0) = √(h0/K)` (principal root).
+    pub points: WurzelPoints,
+}
+
+/// From a state `l` of the top with parameters `a` to Kötter's coordinates
+/// and the points of the curve (the algebraic uniformization (36), (41)).
+///
+/// `g` (36) is fixed up to sign by (30a), `g² = Σ_j c̃_j (η_j/√c_j)² / d4`;
+/// the corrected (39) reads `h0 = K g² (1 − ε P_0)²`, so the corrected (41)
+/// is `g = √(h0/K) / (1 − ε P_0)`, which fixes the sign (and is checked).
+///
+/// Errors: those of [`kotter_constants`], of [`KotterCurve::new`] (coinciding
+/// branch points `d_j`: the genus drops) and of the inverse map of the curve
+/// module (`z1 = z2`, data off the quadrics); and `1 − ε P_0 = 0` (then (41)
+/// puts `g` at infinity: `ξ, η` are not finite multiples of the `P_jk`).
+pub fn kotter(a: &[f64; 4], l: &[f64; 6]) -> Result<KotterState> {
+    let constants = kotter_constants(a, l)?;
+    kotter_with(constants, l)
+}
+
+/// [`kotter`] for a state whose level-set constants are already known
+/// (e.g. along a trajectory). The constants must belong to `l`'s level set.
+pub fn kotter_with(constants: KotterConstants, l: &[f64; 6]) -> Result<KotterState> {
+    check_finite("l", l)?;
+    let lp = l_p(&constants, l);
+    let (xi, eta) = xi_eta(&constants, l);
+    let [d1, d2, d3] = constants.d;
+    let curve = KotterCurve::new(d1, d2, d3)?;
+    let ct = curve.c_tilde();
+    let sc = curve.c().map(sqrt_principal);
+    let d4 = curve.branch_points()[4];
+    let x: [C; 3] = std::array::from_fn(|j| xi[j] / sc[j]);
+    let y: [C; 3] = std::array::from_fn(|j| eta[j] / sc[j]);
+    let g2: C = (0..3).map(|j| ct[j] * y[j] * y[j]).sum::<C>() / d4;
+    let g2p0: C = -(0..3).map(|j| ct[j] * x[j] * y[j]).sum::<C>();
+    let p0 = g2p0 / g2;
+    let one_m = ONE - constants.eps * p0;
+    let size = 1.0 + (constants.eps * p0).norm();
+    if one_m.norm().is_nan() || one_m.norm() <= 1e-12 * size {
+        return Err(Error::InvalidArgument {
+            what: "state l",
+            reason: format!("1 - eps P_0 = {one_m} vanishes: g (41) is infinite at this state"),
+        });
+    }
+    let g41 = sqrt_principal(C::new(constants.h[0], 0.0) / constants.k) / one_m;
+    let points = curve.points_from_xi_eta(xi, eta, None, Some(g41), UNIFORM_RTOL)?;
+    let mis = (points.g - g41).norm();
+    if mis.is_nan() || mis > G41_RTOL * g41.norm() {
+        return Err(Error::InvalidArgument {
+            what: "state l",
+            reason: format!(
+                "the corrected (41) g = sqrt(h0/K)/(1 - eps P0) = {g41} disagrees with g = {} \
+                 from (30a) (|difference| = {mis:e})",
+                points.g
+            ),
+        });
+    }
+    Ok(KotterState {
+        constants,
+        l_p: lp,
+        xi,
+        eta,
+        curve,
+        p0,
+        points,
+    })
+}
+
+/// The inverse of [`kotter`]: the state `l` from the curve's points, `g`
+/// and the branch of the `P_j` by (36) and (23):
+/// `ξ_j = √c_j g P_kl`, `η_j = √c_j g P_j4`, `m_j = α_j ξ_j + β_j η_j`,
+/// `n_j = γ_j ξ_j + δ_j η_j`, `l = (m3, −m2, n1, m1, n2, n3)`.
+///
+/// `z = [z1, z2]`, `y = [y1, y2]`; `zd = Some([zd1, zd2])` gives the offsets
+/// `zd_i[j] = z_i − d_j` (as returned in [`KotterState::points`]), used for
+/// the roots `√(z_i − d_j)` of (27)–(28) — with only `z` (`zd = None`) a
+/// point within `δ` of a branch point loses `u |z| / δ` (see
+/// [`crate::curve::CurvePoint`]).
+///
+/// Errors: those of [`KotterCurve::xi_eta_points`] (points off the curve,
+/// offsets inconsistent with `z`, `z1 = z2`, a bad branch) and of
+/// [`l_from_xi_eta`] (a complex state).
+pub fn from_kotter(
+    coef: &Coefficients23,
+    d: [C; 3],
+    z: [C; 2],
+    y: [C; 2],
+    zd: Option<[[C; 5]; 2]>,
+    g: C,
+    branch: [i8; 5],
+) -> Result<[f64; 6]> {
+    let curve = KotterCurve::new(d[0], d[1], d[2])?;
+    let pt = |i: usize| match zd {
+        Some(o) => CurvePoint {
+            z: z[i],
+            y: y[i],
+            zd: o[i],
+        },
+        None => curve.point(z[i], y[i]),
+    };
+    let (xi, eta) = curve.xi_eta_points(&pt(0), &pt(1), g, Some(branch), None)?;
+    coef.state(&xi, &eta)
+}
+
+/// The coefficients `α_j, β_j, γ_j, δ_j` of (23), the linear map `(ξ, η) → (m, n)`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Coefficients23 {
+    /// `α_j`.
+    pub alpha: [C; 3],
+    /// `β_j`.
+    pub beta: [C; 3],
+    /// `γ_j`.
+    pub gamma: [C; 3],
+    /// `δ_j`.
+    pub delta: [C; 3],
+}
+
+impl Coefficients23 {
+    /// The state of (23); see [`l_from_xi_eta`].
+    pub fn state(&self, xi: &[C; 3], eta: &[C; 3]) -> Result<[f64; 6]> {
+        for (what, v) in [
+            ("alpha", &self.alpha),
+            ("beta", &self.beta),
+            ("gamma", &self.gamma),
+            ("delta", &self.delta),
+        ] {
+            if let Some(index) = v
+                .iter()
+                .position(|z| !(z.re.is_finite() && z.im.is_finite()))
+            {
+                return Err(Error::NonFinite { what, index });
+            }
+        }
+        real_state(self, xi, eta)
+    }
+}
+
+impl KotterConstants {
+    /// The coefficients of (23).
+    pub fn coefficients23(&self) -> Coefficients23 {
+        Coefficients23 {
+            alpha: self.alpha,
+            beta: self.beta,
+            gamma: self.gamma,
+            delta: self.delta,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests;

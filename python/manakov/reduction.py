@@ -1,0 +1,447 @@
+# ruff: noqa: E741  (l is the paper's name for the state)
+"""Schottky's l(s) and Kötter's reduction: from a state l to the curve (8) and back.
+
+The chain, with the paper's equation numbers (details and every convention in
+``docs/kotter.md``; corrected formulas in ``docs/errata-kotter.md``):
+
+* Schottky's vector (12) ``l_j(s) = sqrt(s_j4) m_j + sqrt(s_kl) n_j`` with
+  ``m_j = l_kl``, ``n_j = l_j4`` (13), and its square (14)
+  ``f(s) = h1 s^2 - h2 s + h3 + 2 h0 sqrt(G(s))`` (with the complementary-pair
+  ``h2``, ``h3``);
+* the quartic ``F(s)`` (18), its roots ``s_p`` and the isotropic vectors
+  ``l^(p) = l(s_p)/sqrt(F'(s_p))`` (19)-(20);
+* Kötter's ``xi = l^(1) + i l^(2)``, ``eta = l^(1) - i l^(2)`` (21), the linear
+  map (23)-(24) back to ``(m, n)``, the constants ``d_j`` (25)-(26) of the
+  quadrics (11);
+* ``H0`` on the quadrics (37)-(39), ``eps`` and ``g`` (40)-(41) (corrected);
+* the points ``(z1, y1), (z2, y2)`` of the curve ``y^2 = prod_{j=0}^4 (x - d_j)``
+  (8) with ``xi_j = sqrt(c_j) g P_kl``, ``eta_j = sqrt(c_j) g P_j4`` (36).
+
+The state is ordered ``l = (l12, l13, l14, l23, l24, l34)``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from . import _core
+
+__all__ = [
+    "Kotter",
+    "from_kotter",
+    "integrals",
+    "kotter",
+    "lax_pair",
+    "quartic",
+    "schottky",
+]
+
+
+def _check_a(a: Any) -> np.ndarray:
+    a = np.array(a, dtype=float)
+    if a.shape != (4,):
+        raise ValueError(f"a must have shape (4,), got {a.shape}")
+    if not np.all(np.isfinite(a)):
+        raise ValueError("a must be finite")
+    return a
+
+
+def _check_b(b: Any) -> np.ndarray:
+    b = np.array(b, dtype=float)
+    if b.shape != (4,):
+        raise ValueError(f"b must have shape (4,), got {b.shape}")
+    if not np.all(np.isfinite(b)):
+        raise ValueError("b must be finite")
+    return b
+
+
+def _states(l: Any) -> tuple[np.ndarray, tuple[int, ...]]:
+    l = np.array(l, dtype=float)
+    if l.ndim == 0 or l.shape[-1] != 6:
+        raise ValueError(f"l must have shape (..., 6), got {l.shape}")
+    shape = l.shape[:-1]
+    return np.ascontiguousarray(l.reshape(-1, 6)), shape
+
+
+def integrals(a: Any, l: Any) -> np.ndarray:
+    """The integrals ``(h0, h1, h2, h3)`` in the form consistent with (14).
+
+    ``h0 = l12 l34 + l23 l14 + l31 l24`` (6), ``h1 = sum l_jk^2`` (7), and
+    ``h2 = sum_{j<k} (a_l + a_m) l_jk^2``, ``h3 = sum_{j<k} a_l a_m l_jk^2``
+    with ``{l, m}`` the complement of ``{j, k}`` (the pairs printed in (7),
+    ``a_j + a_k`` and ``a_j a_k``, do not give (14); see docs/errata-kotter.md).
+
+    Parameters
+    ----------
+    a : array_like, shape (4,)
+        Manakov parameters ``a_i`` (2).
+    l : array_like, shape (..., 6)
+        States ``(l12, l13, l14, l23, l24, l34)``.
+
+    Returns
+    -------
+    ndarray, shape (..., 4)
+    """
+    a = _check_a(a)
+    flat, shape = _states(l)
+    return np.asarray(_core.kotter_integrals(a, flat)).reshape(shape + (4,))
+
+
+def schottky(a: Any, l: Any, s: Any, *, sqrt_g: Any = None) -> tuple[np.ndarray, np.ndarray]:
+    """Schottky's vectors ``l(s)`` (12) and ``m(s)`` (16).
+
+    ``l_j(s) = sqrt(s_j4) m_j + sqrt(s_kl) n_j``, ``m_j(s) = sqrt(s_kl) m_j + sqrt(s_j4) n_j``,
+    ``s_jk = (s - a_j)(s - a_k)``, ``(j, k, l)`` cyclic. Branch: ``sqrt(s_j4)``
+    principal and ``sqrt(s_kl) = sqrt_g / sqrt(s_j4)``, so that
+    ``sqrt(s_j4) sqrt(s_kl) = sqrt(G(s))`` for every ``j`` (needed for the
+    cross term ``2 h0 sqrt(G)`` of (14)).
+
+    Parameters
+    ----------
+    a : array_like, shape (4,)
+    l : array_like, shape (..., 6)
+    s : complex array_like, broadcastable with ``l``'s leading axes
+    sqrt_g : complex array_like, optional, keyword-only
+        The branch of ``sqrt(G(s))``, ``G(s) = prod_j (s - a_j)``; default the
+        principal root of ``G(s)``.
+
+    Returns
+    -------
+    (ndarray, ndarray), each of shape (..., 3), complex
+    """
+    a = _check_a(a)
+    l = np.asarray(l, dtype=float)
+    s = np.asarray(s, dtype=complex)
+    if sqrt_g is None:
+        sqrt_g = np.sqrt(np.prod(s[..., None] - a, axis=-1))
+    sqrt_g = np.asarray(sqrt_g, dtype=complex)
+    shape = np.broadcast_shapes(l.shape[:-1], s.shape, sqrt_g.shape)
+    lb = np.ascontiguousarray(np.broadcast_to(l, shape + (6,)).reshape(-1, 6))
+    sb = np.ascontiguousarray(np.broadcast_to(s, shape).reshape(-1))
+    gb = np.ascontiguousarray(np.broadcast_to(sqrt_g, shape).reshape(-1))
+    lv, mv = _core.kotter_schottky(a, lb, sb, gb)
+    return np.asarray(lv).reshape(shape + (3,)), np.asarray(mv).reshape(shape + (3,))
+
+
+def _skew3(v: np.ndarray) -> np.ndarray:
+    out = np.zeros(v.shape[:-1] + (3, 3), dtype=v.dtype)
+    out[..., 0, 1], out[..., 0, 2], out[..., 1, 2] = v[..., 2], -v[..., 1], v[..., 0]
+    return out - np.swapaxes(out, -1, -2)
+
+
+def lax_pair(
+    a: Any, b: Any, l: Any, s: Any, *, sqrt_g: Any = None
+) -> tuple[np.ndarray, np.ndarray]:
+    """The Lax pair ``L(s)``, ``M_b(s)`` of (15)-(17) for the top ``(a, b)``, corrected.
+
+    ``L = [[0, l3, -l2], [-l3, 0, l1], [l2, -l1, 0]]`` from Schottky's ``l(s)`` (12),
+    and ``M_b`` the same antisymmetric matrix built from
+
+    ``m_b(s) = -tau [p2 m(s) + p3 (e2 m(s) + m^[w3](s)) / (e1 - s)]``,
+
+    so that ``dL/dt = [L, M_b]`` (15) along the flow (1)-(2) on either branch of
+    ``sqrt(G)``. Here ``b_i = p0 + p1 a_i + p2 a_i^2 + p3 a_i^3`` is the cubic
+    interpolant of ``b`` over ``a`` (``p3`` the third divided difference),
+    ``m(s)`` is the vector (16), ``m^[X](s)`` the same built from an
+    antisymmetric ``X`` instead of ``l`` (``m^[X]_j = sqrt(s_kl) X_kl +
+    sqrt(s_j4) X_j4``), ``(w3)_ij = (a_i^2 + a_i a_j + a_j^2) l_ij`` the angular
+    velocity of the top with ``b = a^3``, ``e1 = sum a_i``,
+    ``e2 = sum_{i<j} a_i a_j``, and
+    ``tau = sqrt(s_14) sqrt(s_24) sqrt(s_34) sqrt(G) / ((s - a4) G(s)) = +-1``.
+    The printed ``M(s)`` (16)-(17), which does not involve ``b``, is the case
+    ``b = a^2`` (``p2 = 1, p3 = 0``) on the branch ``tau = -1``; for a general
+    ``b`` it does not give the flow (see docs/errata-kotter.md).
+
+    Parameters
+    ----------
+    a, b : array_like, shape (4,)
+        Manakov parameters (2), ``a`` distinct.
+    l : array_like, shape (..., 6)
+    s : complex array_like, broadcastable with ``l``'s leading axes
+    sqrt_g : complex array_like, optional, keyword-only
+        The branch of ``sqrt(G(s))`` (default principal); must square to ``G(s)``.
+
+    Returns
+    -------
+    (ndarray, ndarray), each of shape (..., 3, 3), complex
+
+    Raises
+    ------
+    ValueError
+        Bad shapes or non-finite input, repeated ``a``, ``s = a_j``,
+        ``sqrt_g**2 != G(s)``, or ``s = e1`` when ``p3 != 0`` (a pole of ``M_b``).
+    """
+    a = _check_a(a)
+    b = _check_b(b)
+    l = np.asarray(l, dtype=float)
+    if l.ndim == 0 or l.shape[-1] != 6:
+        raise ValueError(f"l must have shape (..., 6), got {l.shape}")
+    s = np.asarray(s, dtype=complex)
+    if sqrt_g is None:
+        sqrt_g = np.sqrt(np.prod(s[..., None] - a, axis=-1))
+    sqrt_g = np.asarray(sqrt_g, dtype=complex)
+    lv, _ = schottky(a, l, s, sqrt_g=sqrt_g)
+    shape = lv.shape[:-1]
+    lb = np.ascontiguousarray(np.broadcast_to(l, shape + (6,)).reshape(-1, 6))
+    sb = np.ascontiguousarray(np.broadcast_to(s, shape).reshape(-1))
+    gb = np.ascontiguousarray(np.broadcast_to(sqrt_g, shape).reshape(-1))
+    mb = np.asarray(_core.kotter_lax_m(a, b, lb, sb, gb)).reshape(shape + (3,))
+    return _skew3(lv), _skew3(mb)
+
+
+def quartic(a: Any, h: Any) -> np.ndarray:
+    """Coefficients of ``F(s)`` (18), monic, highest power first.
+
+    ``F(s) = [(h1 s^2 - h2 s + h3)^2 - 4 h0^2 G(s)] / (h1^2 - 4 h0^2)``.
+
+    Raises
+    ------
+    ValueError
+        If ``h1^2 = 4 h0^2`` (a self-dual or anti-self-dual state): (18) is not defined.
+    """
+    a = _check_a(a)
+    h = np.array(h, dtype=float)
+    if h.ndim == 0 or h.shape[-1] != 4:
+        raise ValueError(f"h must have shape (..., 4), got {h.shape}")
+    shape = h.shape[:-1]
+    out = _core.kotter_quartic(a, np.ascontiguousarray(h.reshape(-1, 4)))
+    return np.asarray(out).reshape(shape + (5,))
+
+
+@dataclass(frozen=True, eq=False)  # fields are arrays: no elementwise __eq__
+class Kotter:
+    """A state in Schottky-Kötter coordinates (fields carry the paper's names).
+
+    For one state every field has the shape given below; for a batch of states
+    with leading shape ``S`` every field gains the leading axes ``S`` (scalars
+    become arrays of shape ``S``).
+
+    Attributes
+    ----------
+    h : ndarray (4,)
+        ``(h0, h1, h2, h3)`` (6)-(7), complementary-pair ``h2``, ``h3``.
+    s : ndarray (4,) complex
+        Roots ``s_1 .. s_4`` of ``F`` (18): ``s1`` the non-real root of largest
+        imaginary part, ``s2`` the root nearest ``conj(s1)``, ``s3`` the
+        remaining one of larger imaginary part (then real part), ``s4`` the
+        last; all real: descending.
+    sigma : ndarray (4,) complex
+        The branch of ``sqrt(G(s_p))`` with ``f(s_p) = 0``:
+        ``sigma_p = -(h1 s_p^2 - h2 s_p + h3)/(2 h0)``.
+    sqrt_fprime : ndarray (4,) complex
+        ``sqrt(F'(s_p))``, principal.
+    l_p : ndarray (4, 3) complex
+        ``l^(p) = l(s_p)/sqrt(F'(s_p))`` (19); ``l_p[p-1]`` is ``l^(p)``.
+    Delta : ndarray (3, 3) complex
+        ``Delta[p-1, j-1] = Delta_j^(p)`` (25), corrected (a determinant).
+    xi, eta : ndarray (3,) complex
+        Kötter's vectors (21).
+    sqrt_d, d : ndarray (3,) complex
+        ``sqrt(d_j)`` and ``d_j`` (26).
+    alpha, beta, gamma, delta : ndarray (3,) complex
+        (23): ``m_j = alpha_j xi_j + beta_j eta_j``,
+        ``n_j = gamma_j xi_j + delta_j eta_j`` ((24) corrected).
+    A, B : ndarray (3,) complex
+        (37): on the quadrics (11), ``H0 = sum_j A_j (xi_j^2 - eta_j^2) + B_j xi_j eta_j``.
+    abgd38 : ndarray (4,) complex
+        The constants ``(alpha, beta, gamma, delta)`` of (38):
+        ``A_j = alpha + beta d_j + gamma/d_j``, ``B_j = delta (d_j + 1/d_j)``.
+    eps, K : complex
+        (39) corrected: ``H0 = K g^2 (1 - eps P_0)^2`` with
+        ``K = kappa sum_j c~_j d_j beta_j delta_j`` and
+        ``2 K eps = kappa sum_j c~_j (alpha_j delta_j + beta_j gamma_j)``,
+        ``kappa = prod_{m=1}^3 (d_m - d4)``, ``c~_j`` of (33).
+    P0 : complex
+        ``P_0 = sqrt(z1 z2)`` (27) in the curve's branch.
+    g : complex
+        The factor of (36); (41) corrected: ``g = sqrt(h0/K) / (1 - eps P_0)``.
+    z1, y1, z2, y2 : complex
+        The two points of the curve (8), ``y_i^2 = R(z_i)``.
+    branch : ndarray (5,) int8
+        The signs of the Wurzelfunktionen ``P_0 .. P_4`` (see ``docs/curve.md``).
+    curve : KotterCurve or ndarray of KotterCurve
+        The curve (8) with these ``d_j``; for a batch an object array of
+        shape ``S`` (``None`` entries if ``manakov.KotterCurve`` is unavailable).
+    zd : ndarray (2, 5) complex or None
+        The offsets of the points from the branch points,
+        ``zd[i-1, j] = z_i - d_j`` (``d_0 = 0``, ``d_4 = d1 d2 d3``), to full
+        relative accuracy. A double ``z_i`` fixes ``z_i - d_j`` only to
+        ``u |z_i|`` absolutely, which near a branch point is a large relative
+        error in the roots ``sqrt(z_i - d_j)`` of (27)-(28) (on the
+        ``near_degenerate`` top a point comes within 4e-9 of ``d_1``);
+        :func:`from_kotter` uses ``zd`` when it is not ``None``. Set it to
+        ``None`` when replacing ``z1`` or ``z2``.
+    """
+
+    h: np.ndarray
+    s: np.ndarray
+    sigma: np.ndarray
+    sqrt_fprime: np.ndarray
+    l_p: np.ndarray
+    Delta: np.ndarray
+    xi: np.ndarray
+    eta: np.ndarray
+    sqrt_d: np.ndarray
+    d: np.ndarray
+    alpha: np.ndarray
+    beta: np.ndarray
+    gamma: np.ndarray
+    delta: np.ndarray
+    A: np.ndarray
+    B: np.ndarray
+    abgd38: np.ndarray
+    eps: Any
+    K: Any
+    P0: Any
+    g: Any
+    z1: Any
+    y1: Any
+    z2: Any
+    y2: Any
+    branch: np.ndarray
+    curve: Any
+    zd: Any = None
+
+
+_FIELD_SHAPES = {
+    "h": (4,),
+    "s": (4,),
+    "sigma": (4,),
+    "sqrt_fprime": (4,),
+    "l_p": (4, 3),
+    "Delta": (3, 3),
+    "xi": (3,),
+    "eta": (3,),
+    "sqrt_d": (3,),
+    "d": (3,),
+    "alpha": (3,),
+    "beta": (3,),
+    "gamma": (3,),
+    "delta": (3,),
+    "A": (3,),
+    "B": (3,),
+    "abgd38": (4,),
+    "eps": (),
+    "K": (),
+    "P0": (),
+    "g": (),
+    "z1": (),
+    "y1": (),
+    "z2": (),
+    "y2": (),
+    "branch": (5,),
+    "zd": (2, 5),
+}
+
+
+def _make_curve(d: np.ndarray) -> Any:
+    try:
+        from .curve import KotterCurve  # type: ignore[attr-defined]
+    except ImportError:  # the curve module is merged separately
+        return None
+    return KotterCurve(complex(d[0]), complex(d[1]), complex(d[2]))
+
+
+def kotter(a: Any, b: Any, l: Any) -> Kotter:
+    """Schottky-Kötter coordinates of states ``l`` of the top ``(a, b)``.
+
+    Computes (12)-(26), (37)-(41) and the points of the curve (36) for each
+    state; see :class:`Kotter` for the fields and ``docs/kotter.md`` for every
+    convention. Only ``a`` and the state enter: ``b`` (checked) fixes the
+    time evolution, not the reduction.
+
+    Parameters
+    ----------
+    a, b : array_like, shape (4,)
+        Manakov parameters (2), ``a`` distinct.
+    l : array_like, shape (..., 6)
+        States ``(l12, l13, l14, l23, l24, l34)``.
+
+    Returns
+    -------
+    Kotter
+
+    Raises
+    ------
+    ValueError
+        Non-finite input; repeated ``a_i``; ``h0 = 0`` or ``h1^2 = 4 h0^2``
+        (``F`` (18) undefined or with double roots); repeated roots of ``F``;
+        a root of ``F`` at some ``a_j``; coinciding branch points ``d_j`` of
+        the curve (its genus drops); ``z1 = z2``; ``1 - eps P_0 = 0``.
+    """
+    a = _check_a(a)
+    _check_b(b)
+    flat, shape = _states(l)
+    raw = _core.kotter_batch(a, flat)
+    fields: dict[str, Any] = {}
+    for name, fshape in _FIELD_SHAPES.items():
+        arr = np.asarray(raw[name]).reshape(shape + fshape)
+        if arr.ndim == 0:
+            arr = arr[()]
+        fields[name] = arr
+    d_all = np.asarray(raw["d"])
+    curves = [_make_curve(dd) for dd in d_all]
+    if shape == ():
+        fields["curve"] = curves[0]
+    else:
+        carr = np.empty(len(curves), dtype=object)
+        carr[:] = curves
+        fields["curve"] = carr.reshape(shape)
+    return Kotter(**fields)
+
+
+def from_kotter(a: Any, b: Any, k: Kotter) -> np.ndarray:
+    """The state ``l`` from Kötter coordinates: the inverse of :func:`kotter`.
+
+    Uses only the curve's points (with their offsets ``zd`` from the branch
+    points when ``k.zd`` is not ``None``), ``g`` and the branch of the ``P_j``
+    (with the level set's constants ``d_j`` and ``alpha_j .. delta_j``):
+    ``xi_j = sqrt(c_j) g P_kl``, ``eta_j = sqrt(c_j) g P_j4`` (36), then (23)
+    ``m_j = alpha_j xi_j + beta_j eta_j``, ``n_j = gamma_j xi_j + delta_j eta_j``.
+
+    Returns
+    -------
+    ndarray, shape (..., 6)
+
+    Raises
+    ------
+    ValueError
+        Points off the curve, offsets ``zd`` inconsistent with ``z1, z2``,
+        ``z1 = z2``, a bad branch, or data that give a complex state.
+    """
+    _check_a(a)
+    _check_b(b)
+    z1 = np.asarray(k.z1, dtype=complex)
+    shape = z1.shape
+
+    def c2(x: Any) -> np.ndarray:
+        return np.ascontiguousarray(np.asarray(x, dtype=complex).reshape(-1, 3))
+
+    def c1(x: Any) -> np.ndarray:
+        return np.ascontiguousarray(np.asarray(x, dtype=complex).reshape(-1))
+
+    br = np.ascontiguousarray(np.asarray(k.branch, dtype=np.int8).reshape(-1, 5))
+    zd = None
+    if k.zd is not None:
+        zd = np.asarray(k.zd, dtype=complex)
+        if zd.shape != shape + (2, 5):
+            raise ValueError(f"k.zd must have shape {shape + (2, 5)}, got {zd.shape}")
+        zd = np.ascontiguousarray(zd.reshape(-1, 2, 5))
+    out = _core.kotter_from_points(
+        c2(k.alpha),
+        c2(k.beta),
+        c2(k.gamma),
+        c2(k.delta),
+        c2(k.d),
+        c1(k.z1),
+        c1(k.y1),
+        c1(k.z2),
+        c1(k.y2),
+        c1(k.g),
+        br,
+        zd,
+    )
+    return np.asarray(out).reshape(shape + (6,))

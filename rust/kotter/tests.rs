@@ -1,0 +1,389 @@
+#![allow(clippy::needless_range_loop)]
+use super::*;
+use approx::assert_relative_eq;
+use proptest::prelude::*;
+
+const A: [f64; 4] = [0.3, 1.1, 2.0, 3.7];
+const L0: [f64; 6] = [0.8, -0.3, 0.5, 1.1, -0.7, 0.2];
+
+fn dot(x: &[C; 3], y: &[C; 3]) -> C {
+    x[0] * y[0] + x[1] * y[1] + x[2] * y[2]
+}
+
+/// (14): f(s) = l(s)·l(s) = h1 s² − h2 s + h3 + 2 h0 √G on the branch √s_j4 √s_kl = √G.
+#[test]
+fn closed_form_14() {
+    let h = integrals(&A, &L0);
+    for s in [C::new(0.7, 0.4), C::new(-1.3, 2.0), C::new(5.0, -0.1)] {
+        for sg in [1.0, -1.0] {
+            let sqrt_g = sg * sqrt_principal(g_poly(&A, s));
+            let (lv, _) = schottky(&A, &L0, s, sqrt_g).unwrap();
+            let f = dot(&lv, &lv);
+            let closed = p_poly(&h, s) + 2.0 * h[0] * sqrt_g;
+            assert_relative_eq!(
+                (f - closed).norm(),
+                0.0,
+                epsilon = 1e-13 * closed.norm().max(1.0)
+            );
+        }
+    }
+}
+
+/// (18)–(20): f(s_p) = 0 on the branch σ_p, (l^(p))² = 0, Σ_p (l_k^(p))² = 0.
+#[test]
+fn roots_and_relations_20() {
+    let k = kotter_constants(&A, &L0).unwrap();
+    let lp = l_p(&k, &L0);
+    for p in 0..4 {
+        assert_relative_eq!(
+            (k.sigma[p] * k.sigma[p] - g_poly(&A, k.s[p])).norm(),
+            0.0,
+            epsilon = 1e-12
+        );
+        assert!(dot(&lp[p], &lp[p]).norm() < 1e-13);
+    }
+    for j in 0..3 {
+        let s: C = (0..4).map(|p| lp[p][j] * lp[p][j]).sum();
+        assert!(s.norm() < 1e-13);
+    }
+}
+
+/// (11) and the exact inverse (23).
+#[test]
+fn quadrics_11_and_inverse_23() {
+    let k = kotter_constants(&A, &L0).unwrap();
+    let (xi, eta) = xi_eta(&k, &L0);
+    let q1: C = (0..3).map(|j| xi[j] * xi[j] + eta[j] * eta[j]).sum();
+    let q2: C = (0..3).map(|j| xi[j] * eta[j]).sum();
+    let q3: C = (0..3)
+        .map(|j| k.d[j] * xi[j] * xi[j] + eta[j] * eta[j] / k.d[j])
+        .sum();
+    assert!(
+        q1.norm() < 1e-13 && q2.norm() < 1e-13 && q3.norm() < 1e-12,
+        "{q1} {q2} {q3}"
+    );
+    let back = l_from_xi_eta(&k, &xi, &eta).unwrap();
+    for i in 0..6 {
+        assert_relative_eq!(back[i], L0[i], epsilon = 1e-14);
+    }
+}
+
+#[test]
+fn degenerate_inputs_are_errors() {
+    // m = n: h1^2 = 4 h0^2
+    let sd = [1.0, -0.5, 0.3, 0.3, 0.5, 1.0];
+    let (m, n) = m_n(&sd);
+    assert_eq!(m, n);
+    assert!(matches!(
+        kotter_constants(&A, &sd),
+        Err(Error::InvalidArgument { .. })
+    ));
+    // h0 = 0
+    let z = [1.0, 0.0, 0.0, 0.0, 0.0, 0.0];
+    assert!(matches!(
+        kotter_constants(&A, &z),
+        Err(Error::InvalidArgument { .. })
+    ));
+    assert!(matches!(
+        kotter_constants(&[1.0, 1.0, 2.0, 3.0], &L0),
+        Err(Error::RepeatedA { .. })
+    ));
+    let mut bad = L0;
+    bad[2] = f64::NAN;
+    assert!(matches!(
+        kotter_constants(&A, &bad),
+        Err(Error::NonFinite { .. })
+    ));
+}
+
+/// Roots of F at least 5% of their scale apart (the well-conditioned regime).
+fn well_separated(s: &[C; 4]) -> bool {
+    let scale = s.iter().fold(1.0f64, |m, v| m.max(v.norm()));
+    (0..4).all(|i| ((i + 1)..4).all(|j| (s[i] - s[j]).norm() > 0.05 * scale))
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(64))]
+    /// The round trip l → (ξ, η) → l and the quadrics (11) for random states.
+    #[test]
+    fn round_trip_random(l in proptest::array::uniform6(-2.0f64..2.0)) {
+        let h = integrals(&A, &l);
+        prop_assume!(h[0].abs() > 0.05 && h[1] * h[1] - 4.0 * h[0] * h[0] > 0.05);
+        if let Ok(k) = kotter_constants(&A, &l) {
+            prop_assume!(well_separated(&k.s));
+            let (xi, eta) = xi_eta(&k, &l);
+            let back = l_from_xi_eta(&k, &xi, &eta).unwrap();
+            for i in 0..6 {
+                prop_assert!((back[i] - l[i]).abs() < 1e-11);
+            }
+            let q3: C = (0..3).map(|j| k.d[j] * xi[j] * xi[j] + eta[j] * eta[j] / k.d[j]).sum();
+            let size: f64 = (0..3).map(|j| (k.d[j] * xi[j] * xi[j]).norm() + (eta[j] * eta[j] / k.d[j]).norm()).sum();
+            prop_assert!(q3.norm() < 1e-10 * size);
+        }
+    }
+}
+
+/// Uniformization round trip l → (z1, y1, z2, y2, g) → l and the corrected (41).
+#[test]
+fn uniformization_round_trip() {
+    let st = kotter(&A, &L0).unwrap();
+    let p = st.points;
+    let back = from_kotter(
+        &st.constants.coefficients23(),
+        st.constants.d,
+        [p.z1, p.z2],
+        [p.y1, p.y2],
+        Some([p.zd1, p.zd2]),
+        p.g,
+        p.eps,
+    )
+    .unwrap();
+    for i in 0..6 {
+        assert_relative_eq!(back[i], L0[i], epsilon = 1e-12);
+    }
+    let w = st
+        .curve
+        .wurzel(p.z1, p.y1, p.z2, p.y2, Some(p.eps))
+        .unwrap();
+    assert_relative_eq!((w.p[0] - st.p0).norm(), 0.0, epsilon = 1e-10 * st.p0.norm());
+    let k = &st.constants;
+    let lhs = k.k * p.g * p.g * (ONE - k.eps * w.p[0]) * (ONE - k.eps * w.p[0]);
+    assert_relative_eq!((lhs - k.h[0]).norm(), 0.0, epsilon = 1e-10);
+}
+
+/// A state with a root of F at 8e-6 from a_3 (found by proptest): the
+/// offsets s_p − a_i are re-solved to full relative accuracy, so the third
+/// quadric holds to rounding (it held only to 4e-10 with s_p − a_3 formed by
+/// subtraction).
+#[test]
+fn root_near_a_j_keeps_accuracy() {
+    let l = [
+        0.0,
+        0.3001954042337765,
+        1.492521782957833,
+        0.9726016280674399,
+        -0.30541071596704544,
+        -1.3666729134014255,
+    ];
+    let k = kotter_constants(&A, &l).unwrap();
+    assert!(k.s.iter().any(|s| (s - A[2]).norm() < 1e-4));
+    let (xi, eta) = xi_eta(&k, &l);
+    let q3: C = (0..3)
+        .map(|j| k.d[j] * xi[j] * xi[j] + eta[j] * eta[j] / k.d[j])
+        .sum();
+    let size: f64 = (0..3)
+        .map(|j| (k.d[j] * xi[j] * xi[j]).norm() + (eta[j] * eta[j] / k.d[j]).norm())
+        .sum();
+    assert!(q3.norm() < 1e-13 * size, "{}", q3.norm() / size);
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(64))]
+    /// (14) on both branches of √G, random states and s.
+    #[test]
+    fn closed_form_14_random(l in proptest::array::uniform6(-2.0f64..2.0),
+                             re in -3.0f64..6.0, im in -2.0f64..2.0, sg in proptest::bool::ANY) {
+        let s = C::new(re, im);
+        prop_assume!(A.iter().all(|&a| (s - a).norm() > 1e-3));
+        let h = integrals(&A, &l);
+        let sqrt_g = if sg { 1.0 } else { -1.0 } * sqrt_principal(g_poly(&A, s));
+        let (lv, _) = schottky(&A, &l, s, sqrt_g).unwrap();
+        let f = dot(&lv, &lv);
+        let closed = p_poly(&h, s) + 2.0 * h[0] * sqrt_g;
+        let scale = h[1] * (s.norm() + 4.0).powi(2);
+        prop_assert!((f - closed).norm() < 1e-13 * scale);
+    }
+
+    /// (19)–(20) for random states.
+    #[test]
+    fn relations_20_random(l in proptest::array::uniform6(-2.0f64..2.0)) {
+        if let Ok(k) = kotter_constants(&A, &l) {
+            // Well-separated roots only: roots δ apart are known to ~u/δ and
+            // (l^(p))² = f(s_p)/F'(s_p) amplifies that by 1/|F'(s_p)|
+            // (documented in docs/kotter.md, "Accuracy").
+            prop_assume!(well_separated(&k.s));
+            let lp = l_p(&k, &l);
+            // relative to the size of the terms Σ |l_k^(p)|²: clustered roots make
+            // |l^(p)| large and the sums cancel
+            let size: f64 = lp.iter().flatten().map(|z| z.norm_sqr()).sum();
+            for p in 0..4 {
+                prop_assert!(dot(&lp[p], &lp[p]).norm() < 1e-11 * size);
+            }
+            for j in 0..3 {
+                let s: C = (0..4).map(|p| lp[p][j] * lp[p][j]).sum();
+                prop_assert!(s.norm() < 1e-11 * size);
+            }
+        }
+    }
+}
+
+/// The `near_degenerate` top (`a_1 ≈ a_2`, so `d_1, d_2` 3.8e-5 apart) at two
+/// states of its trajectory (t = 9.25 and 9.75 of `tests/test_kotter.py`'s
+/// DOP853 run) where `z2` is within 4e-10 and 4e-9 of `d_1`: with the offsets
+/// `zd` the round trip closes to 1e-12 (through `z` alone it missed by 2e-10).
+#[test]
+fn round_trip_near_branch_point_uses_offsets() {
+    let a = [1.0, 1.000001, 2.0, 3.0];
+    let states = [
+        [
+            0.2000006371045653,
+            0.011753815424631086,
+            1.1269601730352368,
+            1.1028921558453333,
+            -0.08331349214505068,
+            -0.36947275403496677,
+        ],
+        [
+            0.20000050766187902,
+            -0.07657169519910106,
+            1.1671090490419718,
+            1.060236109278101,
+            -0.2965262832063264,
+            -0.22352761803461338,
+        ],
+    ];
+    for l in states {
+        let st = kotter(&a, &l).unwrap();
+        let p = st.points;
+        let near = st
+            .curve
+            .branch_points()
+            .iter()
+            .map(|dj| (p.z2 - dj).norm().min((p.z1 - dj).norm()))
+            .fold(f64::INFINITY, f64::min);
+        assert!(near < 1e-8, "{near}");
+        let coef = st.constants.coefficients23();
+        let d = st.constants.d;
+        let back = from_kotter(
+            &coef,
+            d,
+            [p.z1, p.z2],
+            [p.y1, p.y2],
+            Some([p.zd1, p.zd2]),
+            p.g,
+            p.eps,
+        )
+        .unwrap();
+        let size = l.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        for i in 0..6 {
+            assert!(
+                (back[i] - l[i]).abs() < 1e-12 * size,
+                "{i}: {} vs {}",
+                back[i],
+                l[i]
+            );
+        }
+    }
+}
+
+/// Frahm's equations (1) with (2), written here independently: `l̇ = [l, ω]`,
+/// `ω_ij = c_ij l_ij`, state order `(l12, l13, l14, l23, l24, l34)`.
+fn frahm_rhs(a: &[f64; 4], b: &[f64; 4], l: &[f64; 6]) -> [f64; 6] {
+    const P: [(usize, usize); 6] = [(0, 1), (0, 2), (0, 3), (1, 2), (1, 3), (2, 3)];
+    let mut lm = [[0.0; 4]; 4];
+    let mut w = [[0.0; 4]; 4];
+    for (q, &(i, j)) in P.iter().enumerate() {
+        let c = (b[i] - b[j]) / (a[i] - a[j]);
+        lm[i][j] = l[q];
+        lm[j][i] = -l[q];
+        w[i][j] = c * l[q];
+        w[j][i] = -c * l[q];
+    }
+    std::array::from_fn(|q| {
+        let (i, j) = P[q];
+        (0..4)
+            .map(|k| lm[i][k] * w[k][j] - w[i][k] * lm[k][j])
+            .sum()
+    })
+}
+
+proptest! {
+    /// The cubic interpolant reproduces b at the four a_i.
+    #[test]
+    fn cubic_interpolant_reproduces_b(
+        a in proptest::array::uniform4(-3.0f64..3.0),
+        b in proptest::array::uniform4(-2.0f64..2.0),
+    ) {
+        prop_assume!((0..4).all(|i| ((i + 1)..4).all(|j| (a[i] - a[j]).abs() > 0.2)));
+        let p = cubic_interpolant(&a, &b).unwrap();
+        for i in 0..4 {
+            let v = p[0] + a[i] * (p[1] + a[i] * (p[2] + a[i] * p[3]));
+            prop_assert!((v - b[i]).abs() < 1e-12 * (1.0 + p.iter().map(|x| x.abs()).sum::<f64>()));
+        }
+    }
+
+    /// (15) corrected: l̇(s) = m_b(s) × l(s) (i.e. L̇ = [L, M_b] with the hat map of (17))
+    /// for random a, b, l, s on both branches of √G.
+    #[test]
+    fn lax_pair_general_b(
+        a in proptest::array::uniform4(-3.0f64..3.0),
+        b in proptest::array::uniform4(-2.0f64..2.0),
+        l in proptest::array::uniform6(-2.0f64..2.0),
+        sre in -3.0f64..3.0, sim in 0.1f64..2.0, flip in proptest::bool::ANY,
+    ) {
+        prop_assume!((0..4).all(|i| ((i + 1)..4).all(|j| (a[i] - a[j]).abs() > 0.2)));
+        let s = C::new(sre, sim);
+        let sg = sqrt_principal(g_poly(&a, s)) * if flip { -1.0 } else { 1.0 };
+        let (lv, mv) = schottky(&a, &l, s, sg).unwrap();
+        let (ldv, _) = schottky(&a, &frahm_rhs(&a, &b, &l), s, sg).unwrap();
+        let mb = lax_m(&a, &b, &l, s, sg).unwrap();
+        let cross = [
+            mb[1] * lv[2] - mb[2] * lv[1],
+            mb[2] * lv[0] - mb[0] * lv[2],
+            mb[0] * lv[1] - mb[1] * lv[0],
+        ];
+        let cmax = (0..4)
+            .flat_map(|i| (0..4).filter(move |&j| j != i).map(move |j| (i, j)))
+            .map(|(i, j)| ((b[i] - b[j]) / (a[i] - a[j])).abs())
+            .fold(0.0, f64::max);
+        let n = |v: &[C; 3]| v.iter().map(|x| x.norm()).fold(0.0, f64::max);
+        let scale = n(&ldv).max(n(&lv) * n(&mb)).max(n(&lv) * n(&mv) * cmax).max(f64::MIN_POSITIVE);
+        for j in 0..3 {
+            prop_assert!((ldv[j] - cross[j]).norm() < 1e-12 * scale);
+        }
+    }
+}
+
+/// The corrected (39) with the closed-form `K = κ Σ c̃_j d_j β_j δ_j`,
+/// `2Kε = κ Σ c̃_j (α_j δ_j + β_j γ_j)` is an identity on the whole quadric
+/// variety: at complex point pairs of the curve with complex `g`,
+/// `Σ_j m_j n_j` of (23) applied to (36) equals `K g² (1 − ε P_0)²`.
+#[test]
+fn h0_39_closed_form_on_point_pairs() {
+    let st = kotter(&A, &L0).unwrap();
+    let k = &st.constants;
+    let d = k.d;
+    let d4 = d[0] * d[1] * d[2];
+    let kappa = (d[0] - d4) * (d[1] - d4) * (d[2] - d4);
+    let ct = st.curve.c_tilde();
+    let k_closed: C = kappa
+        * (0..3)
+            .map(|j| ct[j] * d[j] * k.beta[j] * k.delta[j])
+            .sum::<C>();
+    let ke_closed: C = 0.5
+        * kappa
+        * (0..3)
+            .map(|j| ct[j] * (k.alpha[j] * k.delta[j] + k.beta[j] * k.gamma[j]))
+            .sum::<C>();
+    assert!((k.k - k_closed).norm() < 1e-12 * k_closed.norm());
+    assert!((k.k * k.eps - ke_closed).norm() < 1e-12 * ke_closed.norm());
+    for (z1, z2, g) in [
+        (C::new(0.4, 1.3), C::new(-2.1, 0.7), C::new(0.9, -0.3)),
+        (C::new(3.3, -0.2), C::new(0.1, -1.9), C::new(-0.4, 1.2)),
+        (C::new(-5.0, 2.5), C::new(7.0, 1.0), C::new(2.0, 0.5)),
+    ] {
+        let (y1, y2) = (st.curve.y(z1), -st.curve.y(z2));
+        let (xi, eta) = st.curve.xi_eta(z1, y1, z2, y2, g, None, None).unwrap();
+        let p0 = st.curve.wurzel(z1, y1, z2, y2, None).unwrap().p[0];
+        let mut h0 = ZERO;
+        let mut size = 0.0;
+        for j in 0..3 {
+            let mj = k.alpha[j] * xi[j] + k.beta[j] * eta[j];
+            let nj = k.gamma[j] * xi[j] + k.delta[j] * eta[j];
+            h0 += mj * nj;
+            size += (mj * nj).norm();
+        }
+        let rhs = k.k * g * g * (ONE - k.eps * p0) * (ONE - k.eps * p0);
+        assert!((h0 - rhs).norm() < 1e-11 * size, "{h0} vs {rhs}");
+    }
+}
