@@ -1,0 +1,38 @@
+"""The scripts in examples/ run and print what they claim."""
+
+import re
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
+
+# What each example must print: a pattern whose number must be below a bound.
+# The bounds are the claims the examples make (roundoff-level conservation and
+# round trip), not the values they happen to print.
+CLAIMS = {
+    "long_run.py": (["1e4"], r"drift of\s+H0: ([0-9.e+-]+)", 1e-13),
+    "kotter_along_trajectory.py": (["generic"], r"round trip .*: ([0-9.e+-]+)", 1e-12),
+    "theta_identities.py": ([], r"relative error: ([0-9.e+-]+)", 1e-13),
+}
+
+
+@pytest.mark.parametrize("name", sorted(CLAIMS))
+def test_example_runs_and_meets_its_claim(name):
+    args, pattern, bound = CLAIMS[name]
+    out = subprocess.run(
+        [sys.executable, str(EXAMPLES / name), *args],
+        capture_output=True,
+        text=True,
+        timeout=120,
+        check=True,
+    ).stdout
+    m = re.search(pattern, out)
+    assert m, out
+    assert float(m.group(1)) <= bound, out
+
+
+def test_every_example_is_tested():
+    assert {p.name for p in EXAMPLES.glob("*.py")} == set(CLAIMS)
