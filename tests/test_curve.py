@@ -1,4 +1,4 @@
-"""The curve (8), the Wurzelfunktionen (27)-(28), identities (29)-(33), inverse of (36).
+"""The curve (8), the Wurzelfunktionen (27)-(28), identities (29)-(33), inverse of (37).
 
 Reference values come from an independent numpy implementation of (27)-(28)
 *as printed* (written here, not calling the package) and from mpmath at 40
@@ -430,12 +430,12 @@ def test_31b_encodes_the_product_convention():
 
 
 # ----------------------------------------------------------------------------
-# The inverse of (36)
+# The inverse of (37)
 # ----------------------------------------------------------------------------
 
 
 def np_xi_eta(d, z1, y1, z2, y2, g, eps=(1, 1, 1, 1, 1)):
-    """(36) with the printed (27)-(28) and principal sqrt(c_j)."""
+    """(37) with the printed (27)-(28) and principal sqrt(c_j)."""
     _, Pjk = np_wurzel(d, z1, y1, z2, y2, eps)
     c, _ = np_c(d)
     sc = np_sqrt(c)
@@ -740,8 +740,8 @@ def test_exports():
 
 
 @pytest.mark.parametrize("seed", range(10))
-def test_36_xi_eta_lie_on_koetter_quadrics_11(seed):
-    """(36) maps every point pair and g onto the three quadrics (11): the first
+def test_37_xi_eta_lie_on_koetter_quadrics_11(seed):
+    """(37) maps every point pair and g onto the three quadrics (11): the first
     is the s**-2 coefficient of (29), the second (31a), the third (32)."""
     rng = np.random.default_rng(5000 + seed)
     dd, d, (z1, y1, z2, y2) = random_setup(rng)
@@ -751,7 +751,7 @@ def test_36_xi_eta_lie_on_koetter_quadrics_11(seed):
     dj = d[1:4]
     for terms in (xi**2 + eta**2, xi * eta, dj * xi**2 + eta**2 / dj):
         assert abs(terms.sum()) <= IDENTITY_RTOL * np.abs(terms).sum()
-    # And (36) itself, against the independent numpy evaluation.
+    # And (37) itself, against the independent numpy evaluation.
     xn, en = np_xi_eta(d, z1, y1, z2, y2, g, all_eps()[seed % 16])
     scale = max(np.abs(xn).max(), np.abs(en).max())
     np.testing.assert_allclose(xi, xn, rtol=0, atol=NUMPY_RTOL * scale)
@@ -796,7 +796,7 @@ def test_real_branch_points_and_points_on_cuts(dd, z1, z2, sheets):
 def test_wurzel_symmetries(seed):
     """Choices the result must not depend on: the order of the two points; and
     the hyperelliptic involution on both points, (y1, y2) -> (-y1, -y2), which
-    leaves every P_j and flips every P_jk (so it is the same as g -> -g in (36))."""
+    leaves every P_j and flips every P_jk (so it is the same as g -> -g in (37))."""
     rng = np.random.default_rng(6000 + seed)
     dd, d, (z1, y1, z2, y2) = random_setup(rng, bp_dist=0.0)
     k = KotterCurve(*dd)
@@ -813,7 +813,7 @@ def test_wurzel_symmetries(seed):
 
 @pytest.mark.parametrize("scale", [1e-170, 1e-20, 1e20, 1e300])
 def test_inverse_is_homogeneous_in_g(scale):
-    """(36) is linear in g: scaling (xi, eta) by s scales g by s and leaves the
+    """(37) is linear in g: scaling (xi, eta) by s scales g by s and leaves the
     points, even where g**2 would under- or overflow."""
     k = KotterCurve(2.0, 3.0, -0.5 + 1j)
     z1, z2 = 0.3 + 0.2j, -1.0 + 0.5j

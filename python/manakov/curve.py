@@ -92,7 +92,7 @@ class Wurzel:
 
 @dataclass(frozen=True)
 class CurvePoints:
-    """Points of the curve, factor ``g`` and branch ``eps`` recovered from (36).
+    """Points of the curve, factor ``g`` and branch ``eps`` recovered from (37).
 
     Attributes
     ----------
@@ -100,7 +100,7 @@ class CurvePoints:
         The two points; ``z1`` is the root of ``x**2 - (z1+z2) x + z1 z2`` of
         larger modulus (the pair is unordered: (27)-(28) are symmetric).
     g : complex or ndarray
-        The factor of (36): ``xi_j = sqrt(c_j) g P_kl``, ``eta_j = sqrt(c_j) g P_j4``.
+        The factor of (37): ``xi_j = sqrt(c_j) g P_kl``, ``eta_j = sqrt(c_j) g P_j4``.
     eps : ndarray of int8, shape (..., 5)
         The branch of the Wurzelfunktionen (product +1, normalised to
         ``eps[..., 4] == 1``): ``curve.wurzel(z1, y1, z2, y2, eps=eps)``
@@ -272,7 +272,7 @@ class KotterCurve:
         eps: Any = None,
         sqrt_c: Any = None,
     ) -> tuple[np.ndarray, np.ndarray]:
-        """Kötter's vectors from points of the curve, (36).
+        """Kötter's vectors from points of the curve, (37).
 
         .. math:: \\xi_j = \\sqrt{c_j}\\, g\\, P_{kl}, \\qquad \\eta_j = \\sqrt{c_j}\\, g\\, P_{j4}
 
@@ -311,7 +311,7 @@ class KotterCurve:
         g_ref: Any = None,
         rtol: float = INVERSE_RTOL,
     ) -> CurvePoints:
-        """Invert (36): points ``(z1, y1), (z2, y2)``, ``g`` and branch ``eps`` from ``xi, eta``.
+        """Invert (37): points ``(z1, y1), (z2, y2)``, ``g`` and branch ``eps`` from ``xi, eta``.
 
         Given ``xi_j = sqrt(c_j) g P_kl`` and ``eta_j = sqrt(c_j) g P_j4``
         (``j = 1, 2, 3``, ``(j, k, l)`` cyclic), put ``X_j = xi_j/sqrt(c_j)``,
@@ -337,7 +337,7 @@ class KotterCurve:
         sqrt_c : array_like, shape (3,), optional, keyword-only
             The square roots of ``c_j`` used to make ``xi, eta``; default principal.
         g_ref : complex or array_like, optional, keyword-only
-            Selects the sign of ``g`` (e.g. ``g = 1/(1 - eps P_0)`` of (41)).
+            Selects the sign of ``g`` (e.g. ``g = 1/(1 - eps P_0)`` of (42)).
         rtol : float, keyword-only
             The recovered points must reproduce ``(xi, eta)`` to
             ``rtol * max|(xi, eta)|``.

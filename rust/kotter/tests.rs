@@ -10,7 +10,7 @@ fn dot(x: &[C; 3], y: &[C; 3]) -> C {
     x[0] * y[0] + x[1] * y[1] + x[2] * y[2]
 }
 
-/// (14): f(s) = l(s)·l(s) = h1 s² − h2 s + h3 + 2 h0 √G on the branch √s_j4 √s_kl = √G.
+/// (14)–(15): f(s) = l(s)·l(s) = h1 s² − h2 s + h3 + 2 h0 √G on the branch √s_j4 √s_kl = √G.
 #[test]
 fn closed_form_14() {
     let h = integrals(&A, &L0);
@@ -29,7 +29,7 @@ fn closed_form_14() {
     }
 }
 
-/// (18)–(20): f(s_p) = 0 on the branch σ_p, (l^(p))² = 0, Σ_p (l_k^(p))² = 0.
+/// (19)–(21): f(s_p) = 0 on the branch σ_p, (l^(p))² = 0, Σ_p (l_k^(p))² = 0.
 #[test]
 fn roots_and_relations_20() {
     let k = kotter_constants(&A, &L0).unwrap();
@@ -123,7 +123,7 @@ proptest! {
     }
 }
 
-/// Uniformization round trip l → (z1, y1, z2, y2, g) → l and the corrected (41).
+/// Uniformization round trip l → (z1, y1, z2, y2, g) → l and the corrected (42).
 #[test]
 fn uniformization_round_trip() {
     let st = kotter(&A, &L0).unwrap();
@@ -179,9 +179,9 @@ fn root_near_a_j_keeps_accuracy() {
 
 proptest! {
     #![proptest_config(ProptestConfig::with_cases(64))]
-    /// (14) on both branches of √G, random states and s.
+    /// (15) on both branches of √G, random states and s.
     #[test]
-    fn closed_form_14_random(l in proptest::array::uniform6(-2.0f64..2.0),
+    fn closed_form_15_random(l in proptest::array::uniform6(-2.0f64..2.0),
                              re in -3.0f64..6.0, im in -2.0f64..2.0, sg in proptest::bool::ANY) {
         let s = C::new(re, im);
         prop_assume!(A.iter().all(|&a| (s - a).norm() > 1e-3));
@@ -194,7 +194,7 @@ proptest! {
         prop_assert!((f - closed).norm() < 1e-13 * scale);
     }
 
-    /// (19)–(20) for random states.
+    /// (20)–(21) for random states.
     #[test]
     fn relations_20_random(l in proptest::array::uniform6(-2.0f64..2.0)) {
         if let Ok(k) = kotter_constants(&A, &l) {
@@ -312,7 +312,7 @@ proptest! {
         }
     }
 
-    /// (15) corrected: l̇(s) = m_b(s) × l(s) (i.e. L̇ = [L, M_b] with the hat map of (17))
+    /// (16) corrected: l̇(s) = m_b(s) × l(s) (i.e. L̇ = [L, M_b] with the hat map of (18))
     /// for random a, b, l, s on both branches of √G.
     #[test]
     fn lax_pair_general_b(
@@ -344,12 +344,12 @@ proptest! {
     }
 }
 
-/// The corrected (39) with the closed-form `K = κ Σ c̃_j d_j β_j δ_j`,
+/// The corrected (40) with the closed-form `K = κ Σ c̃_j d_j β_j δ_j`,
 /// `2Kε = κ Σ c̃_j (α_j δ_j + β_j γ_j)` is an identity on the whole quadric
 /// variety: at complex point pairs of the curve with complex `g`,
-/// `Σ_j m_j n_j` of (23) applied to (36) equals `K g² (1 − ε P_0)²`.
+/// `Σ_j m_j n_j` of (23) applied to (37) equals `K g² (1 − ε P_0)²`.
 #[test]
-fn h0_39_closed_form_on_point_pairs() {
+fn h0_40_closed_form_on_point_pairs() {
     let st = kotter(&A, &L0).unwrap();
     let k = &st.constants;
     let d = k.d;

@@ -143,7 +143,7 @@ fn curve_wurzel_py<'py>(
     Ok((out.0.into_pyarray(py), out.1.into_pyarray(py)))
 }
 
-/// Kötter's `ξ, η` (36) of `n` point pairs with factors `g`: two `(n, 3)` arrays.
+/// Kötter's `ξ, η` (37) of `n` point pairs with factors `g`: two `(n, 3)` arrays.
 #[pyfunction(name = "curve_xi_eta")]
 #[pyo3(signature = (d, z1, y1, z2, y2, g, eps=None, sqrt_c=None))]
 #[allow(clippy::too_many_arguments, clippy::type_complexity)]
@@ -187,7 +187,7 @@ fn curve_xi_eta_py<'py>(
     Ok((out.0.into_pyarray(py), out.1.into_pyarray(py)))
 }
 
-/// The inverse of (36) for `n` rows of `(ξ, η)`: `z1, y1, z2, y2, g, residual`
+/// The inverse of (37) for `n` rows of `(ξ, η)`: `z1, y1, z2, y2, g, residual`
 /// (each `(n,)`) and `eps` `(n, 5)`.
 #[pyfunction(name = "curve_points_from_xi_eta")]
 #[pyo3(signature = (d, xi, eta, sqrt_c=None, g_ref=None, rtol=1e-8))]

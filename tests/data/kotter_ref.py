@@ -1,14 +1,14 @@
 # ruff: noqa: E741  (l is the paper's name for the state)
 """Independent numpy reference for the Schottky-Koetter reduction (tests only).
 
-Written from the paper's formulas (12)-(41) and the corrections pinned down in
+Written from the paper's formulas (12)-(42) and the corrections pinned down in
 ``kotter_explore.py`` (see docs/errata-kotter.md); it does not import the
 package. Conventions (the same ones the package documents in docs/kotter.md):
 
 * state l = (l12, l13, l14, l23, l24, l34), m_j = l_kl, n_j = l_j4 (13),
   (j, k, l) cyclic: m = (l23, l31, l12), n = (l14, l24, l34);
-* h0..h3 with the complementary-pair H2, H3 (erratum (7)/(14));
-* F(s) (18) monic; at a root s_p the branch of sqrt(G) is
+* h0..h3 with the complementary-pair H2, H3 (erratum (7)/(15));
+* F(s) (19) monic; at a root s_p the branch of sqrt(G) is
   sigma_p = -(h1 s_p^2 - h2 s_p + h3) / (2 h0) (so that f(s_p) = 0);
 * sqrt(s_j4) principal, sqrt(s_kl) = sigma / sqrt(s_j4), sqrt(F'(s_p)) principal;
 * root order: s1 = non-real root of largest Im, s2 its conjugate, s3 the
@@ -111,19 +111,19 @@ def l_of_s(s, a, l, sqrtG):
 
 
 def m_of_s(s, a, l, sqrtG):
-    """m(s) (16) on the same branch."""
+    """m(s) (17) on the same branch."""
     m, n = mn(l)
     r = np.array([np.sqrt(complex(s_pair(s, a, j, 3))) for (j, k, ll) in CYC])
     return sqrtG / r * m + r * n
 
 
 def skew3(v):
-    """L(s), M(s) of (17)."""
+    """L(s), M(s) of (18)."""
     return np.array([[0, v[2], -v[1]], [-v[2], 0, v[0]], [v[1], -v[0], 0]])
 
 
 def F_coeffs(a, h):
-    """(18): monic quartic, highest power first."""
+    """(19): monic quartic, highest power first."""
     h0, h1, h2, h3 = h
     P = np.array([h1, -h2, h3])
     G = np.poly(a)
@@ -171,7 +171,7 @@ def uv(sp, a, h):
 
 
 def l_p(sp, a, h, l):
-    """(19) l^(p) = l(s_p)/sqrt(F'(s_p))."""
+    """(20) l^(p) = l(s_p)/sqrt(F'(s_p))."""
     m, n = mn(l)
     u, v = uv(sp, a, h)
     return u * m + v * n
@@ -201,7 +201,7 @@ def kotter_constants(a, h, s):
 
 
 def xi_eta(l, a, h, s):
-    """(21)"""
+    """(22)"""
     L1 = l_p(s[0], a, h, l)
     L2 = l_p(s[1], a, h, l)
     return L1 + 1j * L2, L1 - 1j * L2
