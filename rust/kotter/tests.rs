@@ -12,7 +12,7 @@ fn dot(x: &[C; 3], y: &[C; 3]) -> C {
 
 /// (14)–(15): f(s) = l(s)·l(s) = h1 s² − h2 s + h3 + 2 h0 √G on the branch √s_j4 √s_kl = √G.
 #[test]
-fn closed_form_14() {
+fn closed_form_15() {
     let h = integrals(&A, &L0);
     for s in [C::new(0.7, 0.4), C::new(-1.3, 2.0), C::new(5.0, -0.1)] {
         for sg in [1.0, -1.0] {
@@ -31,7 +31,7 @@ fn closed_form_14() {
 
 /// (19)–(21): f(s_p) = 0 on the branch σ_p, (l^(p))² = 0, Σ_p (l_k^(p))² = 0.
 #[test]
-fn roots_and_relations_20() {
+fn roots_and_relations_19_21() {
     let k = kotter_constants(&A, &L0).unwrap();
     let lp = l_p(&k, &L0);
     for p in 0..4 {
@@ -196,7 +196,7 @@ proptest! {
 
     /// (20)–(21) for random states.
     #[test]
-    fn relations_20_random(l in proptest::array::uniform6(-2.0f64..2.0)) {
+    fn relations_20_21_random(l in proptest::array::uniform6(-2.0f64..2.0)) {
         if let Ok(k) = kotter_constants(&A, &l) {
             // Well-separated roots only: roots δ apart are known to ~u/δ and
             // (l^(p))² = f(s_p)/F'(s_p) amplifies that by 1/|F'(s_p)|
