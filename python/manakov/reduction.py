@@ -245,10 +245,14 @@ class Kotter:
         (23): ``m_j = alpha_j xi_j + beta_j eta_j``,
         ``n_j = gamma_j xi_j + delta_j eta_j`` ((24) corrected).
     A, B : ndarray (3,) complex
-        (38): on the quadrics (11), ``H0 = sum_j A_j (xi_j^2 - eta_j^2) + B_j xi_j eta_j``.
+        (38): on the quadrics (11), ``H0 = sum_j A_j (xi_j^2 - eta_j^2) + B_j xi_j eta_j``
+        (the unique representative of that form; holds as printed).
     abgd39 : ndarray (4,) complex
         The constants ``(alpha, beta, gamma, delta)`` of (39):
-        ``A_j = alpha + beta d_j + gamma/d_j``, ``B_j = delta (d_j + 1/d_j)``.
+        ``A_j = alpha + beta d_j + gamma/d_j``, ``B_j = delta (d_j + 1/d_j)``, in closed
+        form with ``K``, ``eps`` below, ``kappa`` and ``e1 = d1 + d2 + d3``:
+        ``beta = -K/kappa``, ``gamma = eps^2 d4^2 K/kappa``, ``delta = 2 eps d4 K/kappa``,
+        ``alpha = K/(2 kappa) (kappa eps^2 + (e1 - d4)(1 - eps^2 d4^2))``.
     eps, K : complex
         (40) corrected: ``H0 = K g^2 (1 - eps P_0)^2`` with
         ``K = kappa sum_j c~_j d_j beta_j delta_j`` and

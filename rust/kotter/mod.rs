@@ -25,7 +25,6 @@
 //!   `(√s_j4^(q) √s_kl^(r) − √s_j4^(r) √s_kl^(q)) / (√F'(s_q) √F'(s_r))`
 //!   (erratum: printed with one root over the whole difference).
 
-use nalgebra::{DMatrix, DVector};
 use num_complex::Complex64;
 
 use crate::curve::{CurvePoint, KotterCurve, WurzelPoints};
@@ -59,12 +58,13 @@ pub const REPEATED_ROOT_RTOL: f64 = 1e-7;
 /// reported as repeated anyway).
 pub const ROOT_STAGNATION: f64 = 1e-8;
 
-/// Residual (relative to the size of the data) above which the structural
-/// fits of (38)–(39) and the perfect square of the corrected (40) are
-/// reported as failing: they hold to rounding (a few 1e-13 on the reference
-/// tops, up to ~1e-7 when two `d_j` nearly coincide, which amplifies rounding
-/// in `α_j … δ_j` by `1/|d_j − d_k|`); 1e-6 still rejects an inconsistent
-/// structure, whose residual is O(1).
+/// Residual (relative to the size of the terms) above which the existence
+/// conditions of (38)–(39) (`Σ c_j q_j = 0`, `Σ c_j (p_j + r_j) = 0`) and the
+/// perfect square of the corrected (40) are reported as failing: they hold to
+/// rounding (a few 1e-13 on the reference tops, up to ~1e-7 when two `d_j`
+/// nearly coincide, which amplifies rounding in `α_j … δ_j` by
+/// `1/|d_j − d_k|`); 1e-6 still rejects an inconsistent structure, whose
+/// residual is O(1).
 pub const STRUCTURE_RTOL: f64 = 1e-6;
 
 /// The principal square root of the curve module (`−π/2 < arg √w ≤ π/2`,
@@ -466,12 +466,16 @@ pub struct KotterConstants {
     pub gamma: [C; 3],
     /// See [`KotterConstants::alpha`].
     pub delta: [C; 3],
-    /// `A_j` of (38)–(39): on Kötter's quadrics
-    /// `H0 = Σ_j A_j (ξ_j² − η_j²) + B_j ξ_j η_j`.
+    /// `A_j = α + β d_j + γ/d_j` of (38)–(39): on Kötter's quadrics
+    /// `H0 = Σ_j A_j (ξ_j² − η_j²) + B_j ξ_j η_j` (the unique representative of
+    /// that form).
     pub a_coef: [C; 3],
-    /// `B_j` of (38)–(39).
+    /// `B_j = δ (d_j + 1/d_j)` of (38)–(39).
     pub b_coef: [C; 3],
-    /// `(α, β, γ, δ)` of (39) (the paper's unnamed constants; not the `α_j` of (24)).
+    /// `(α, β, γ, δ)` of (39) (the paper's unnamed constants; not the `α_j` of (24)),
+    /// in closed form with `K`, `ε` of the corrected (40), `κ = Π_{m=1}^{3} (d_m − d_4)`,
+    /// `e1 = d_1 + d_2 + d_3`: `β = −K/κ`, `γ = ε² d_4² K/κ`, `δ = 2 ε d_4 K/κ`,
+    /// `α = (K/(2κ)) (κ ε² + (e1 − d_4)(1 − ε² d_4²))`.
     pub abgd39: [C; 4],
     /// `ε` of (40)–(41), corrected: `H0 = K g² (1 − ε P_0)²` with [`KotterConstants::k`];
     /// `ε = Σ_j c̃_j (α_j δ_j + β_j γ_j) / (2 Σ_j c̃_j d_j β_j δ_j)`.
@@ -682,49 +686,30 @@ fn constants_impl(a: &[f64; 4], h: &[f64; 4], p_at_a: &[f64; 4]) -> Result<Kotte
 
 type H0Structure = ([C; 3], [C; 3], [C; 4], C, C);
 
-/// Least-squares solve of a small complex system, returning the solution and
-/// the residual relative to `|rhs|`.
-fn lstsq(rows: &[Vec<C>], rhs: &[C]) -> Result<(Vec<C>, f64)> {
-    let nr = rows.len();
-    let nc = rows.first().map_or(0, |r| r.len());
-    // Columns are equilibrated first: the unknowns (K ε², 2Kε, K, ...) differ
-    // by many orders of magnitude, and an unscaled SVD cut-off would discard
-    // the small ones.
-    let colnorm: Vec<f64> = (0..nc)
-        .map(|j| {
-            let n = rows.iter().map(|r| r[j].norm_sqr()).sum::<f64>().sqrt();
-            if n > 0.0 {
-                n
-            } else {
-                1.0
-            }
-        })
-        .collect();
-    let m = DMatrix::from_fn(nr, nc, |i, j| rows[i][j] / colnorm[j]);
-    let b = DVector::from_row_slice(rhs);
-    let svd = m.clone().svd(true, true);
-    let y = svd.solve(&b, 1e-14).map_err(|e| Error::InvalidArgument {
-        what: "Koetter constants",
-        reason: format!("least-squares solve failed: {e}"),
-    })?;
-    let res = (&m * &y - &b).norm() / b.norm().max(f64::MIN_POSITIVE);
-    Ok(((0..nc).map(|j| y[j] / colnorm[j]).collect(), res))
-}
-
 /// (38)–(40): `H0 = Σ_j m_j n_j` as a quadratic form in `ξ, η`, reduced modulo
-/// Kötter's quadrics (11).
+/// Kötter's quadrics (11), all in closed form.
 ///
-/// `H0 = Σ_j a_j ξ_j² + b_j ξ_j η_j + c_j η_j²` with `a_j = α_j γ_j`,
-/// `b_j = α_j δ_j + β_j γ_j`, `c_j = β_j δ_j` (from (23)). Adding
+/// `H0 = Σ_j p_j ξ_j² + q_j ξ_j η_j + r_j η_j²` with `p_j = α_j γ_j`,
+/// `q_j = α_j δ_j + β_j γ_j`, `r_j = β_j δ_j` (from (23)). Adding
 /// `λ Q1 + μ Q2 + ν Q3` of (11) gives the form (38) when
-/// `a_j + λ + ν d_j = −(c_j + λ + ν/d_j) =: A_j` and `B_j = b_j + μ`; the
-/// paper's (39) then reads `A_j = α + β d_j + γ/d_j`, `B_j = δ (d_j + 1/d_j)`.
+/// `p_j + λ + ν d_j = −(r_j + λ + ν/d_j) =: A_j` and `B_j = q_j + μ`; (39) asks
+/// `A_j = α + β d_j + γ/d_j`, `B_j = δ (d_j + 1/d_j)`. Times `d_j`, these are
+/// values at `x = d_j` of quadratics in `x`, so a representative exists iff the
+/// Lagrange interpolants through `d_1, d_2, d_3` have equal `x²` and `x⁰`
+/// coefficients: `Σ_j c_j q_j = 0` and `Σ_j c_j (p_j + r_j) = 0` (`c_j` of (33));
+/// both hold identically (they are checked here to [`STRUCTURE_RTOL`]).
+///
 /// The corrected (40): on the quadrics, by (30a), (30b), (31b),
 /// `H0 ≡ K/d4 Σ η_j²/(d_j − d4) + 2Kε Σ ξ_jη_j/(d_j − d4) + Kε² Σ d_j ξ_j²/(d_j − d4)`
 /// `= K g² (1 − ε P_0)²` with, in closed form (`κ = Π_m (d_m − d4)`,
 /// `c̃_j` of (33)),
 /// `K = κ Σ_j c̃_j d_j β_j δ_j`, `2Kε = κ Σ_j c̃_j (α_j δ_j + β_j γ_j)`,
 /// `Kε² = (κ/d4) Σ_j c̃_j α_j γ_j`; the perfect square `(Kε)² = K · Kε²` is checked.
+/// Reducing this representative to the form (38) (the residue sums
+/// `Σ_j c̃_j d_j^n/(d_j − d4) = d4^n/κ`, `n ≤ 2`) gives (39) explicitly:
+/// `β = −K/κ`, `γ = ε² d4² K/κ`, `δ = 2 ε d4 K/κ`,
+/// `α = (K/(2κ)) (κ ε² + (e1 − d4)(1 − ε² d4²))`, `e1 = d1 + d2 + d3`
+/// (docs/kotter.md §7).
 fn h0_structure(
     alpha: &[C; 3],
     beta: &[C; 3],
@@ -736,24 +721,30 @@ fn h0_structure(
     let ac: [C; 3] = std::array::from_fn(|j| alpha[j] * gamma[j]);
     let bc: [C; 3] = std::array::from_fn(|j| alpha[j] * delta[j] + beta[j] * gamma[j]);
     let cc: [C; 3] = std::array::from_fn(|j| beta[j] * delta[j]);
+    let ct: [C; 3] = std::array::from_fn(|j| {
+        let (k2, l2) = ((j + 1) % 3, (j + 2) % 3);
+        ONE / ((d[j] - d[k2]) * (d[j] - d[l2]))
+    });
+    let c33: [C; 3] = std::array::from_fn(|j| (d[j] - d4) * ct[j]);
 
-    // (38): unknowns (λ, ν) from a_j + c_j + 2λ + ν (d_j + 1/d_j) = 0; μ and δ39 from
-    // b_j + μ = δ39 (d_j + 1/d_j).
-    let rows: Vec<Vec<C>> = (0..3)
-        .map(|j| vec![C::new(2.0, 0.0), d[j] + ONE / d[j]])
-        .collect();
-    let rhs: Vec<C> = (0..3).map(|j| -(ac[j] + cc[j])).collect();
-    let (x, r1) = lstsq(&rows, &rhs)?;
-    let (lam, nu) = (x[0], x[1]);
-    let a_coef: [C; 3] = std::array::from_fn(|j| ac[j] + lam + nu * d[j]);
-    let rows: Vec<Vec<C>> = (0..3).map(|j| vec![-ONE, d[j] + ONE / d[j]]).collect();
-    let (x, r2) = lstsq(&rows, &bc)?;
-    let (mu, delta39) = (x[0], x[1]);
-    let b_coef: [C; 3] = std::array::from_fn(|j| bc[j] + mu);
-    // A_j = α + β d_j + γ / d_j: three equations, three unknowns.
-    let rows: Vec<Vec<C>> = (0..3).map(|j| vec![ONE, d[j], ONE / d[j]]).collect();
-    let (x, _) = lstsq(&rows, &a_coef)?;
-    let abgd39 = [x[0], x[1], x[2], delta39];
+    // (38)–(39) exist iff Σ c_j q_j = 0 and Σ c_j (p_j + r_j) = 0 (the x² and x⁰
+    // coefficients of the interpolants agree); relative to the size of the products
+    // that enter (q_j and p_j + r_j themselves can cancel, and the sums cancel by
+    // 1/|d_j − d_k| when two d_j nearly coincide).
+    let rel_sum = |t: [C; 3], size: [f64; 3]| {
+        let size: f64 = size.iter().sum();
+        (t[0] + t[1] + t[2]).norm() / size.max(f64::MIN_POSITIVE)
+    };
+    let r1 = rel_sum(
+        std::array::from_fn(|j| c33[j] * (ac[j] + cc[j])),
+        std::array::from_fn(|j| c33[j].norm() * (ac[j].norm() + cc[j].norm())),
+    );
+    let r2 = rel_sum(
+        std::array::from_fn(|j| c33[j] * bc[j]),
+        std::array::from_fn(|j| {
+            c33[j].norm() * ((alpha[j] * delta[j]).norm() + (beta[j] * gamma[j]).norm())
+        }),
+    );
 
     // (40) corrected, in closed form. On the quadrics H0 ≡ K g² − 2Kε g²P_0 +
     // Kε² g²P_0², with g² = Σ η_j²/((d_j − d4) d4) (30a), g²P_0 = −Σ ξ_jη_j/(d_j − d4)
@@ -762,17 +753,15 @@ fn h0_structure(
     // (and d_j) gives polynomials of degree ≤ 2 in d_j whose value at x = d4 —
     // the Lagrange interpolant through d1, d2, d3, L_j(d4) = c̃_j (d4 − d_k)(d4 − d_l)
     // — isolates the K terms, since the multiplier terms vanish at x = d4:
-    // K = κ Σ c̃_j d_j c_j, 2Kε = κ Σ c̃_j b_j, Kε² d4 = κ Σ c̃_j a_j, with
+    // K = κ Σ c̃_j d_j r_j, 2Kε = κ Σ c̃_j q_j, Kε² d4 = κ Σ c̃_j p_j, with
     // κ = Π (d_m − d4) (docs/kotter.md §7).
-    let ct: [C; 3] = std::array::from_fn(|j| {
-        let (k2, l2) = ((j + 1) % 3, (j + 2) % 3);
-        ONE / ((d[j] - d[k2]) * (d[j] - d[l2]))
-    });
     let kappa = (d[0] - d4) * (d[1] - d4) * (d[2] - d4);
-    let k: C = kappa * (0..3).map(|j| ct[j] * d[j] * cc[j]).sum::<C>();
-    // 2Kε: (d_j − d4) b_j is of degree 1 in d_j, so two nodes suffice and the
-    // symmetric three-node form κ Σ c̃_j b_j equals the slope
-    // (b_j − b_k)/(w_j − w_k), w_j = 1/(d_j − d4), through any pair. The pair with
+    // K/κ directly (no division by κ, which vanishes when some d_j = d4).
+    let k_over_kappa: C = (0..3).map(|j| ct[j] * d[j] * cc[j]).sum::<C>();
+    let k = kappa * k_over_kappa;
+    // 2Kε: (d_j − d4) q_j is of degree 1 in d_j, so two nodes suffice and the
+    // symmetric three-node form κ Σ c̃_j q_j equals the slope
+    // (q_j − q_k)/(w_j − w_k), w_j = 1/(d_j − d4), through any pair. The pair with
     // the most separated w avoids the cancellation of the three-node form when
     // two d_j nearly coincide (c̃_j ~ 1/(d_1 − d_2): 1e12 on near_degenerate states).
     let w: [C; 3] = std::array::from_fn(|j| ONE / (d[j] - d4));
@@ -787,7 +776,7 @@ fn h0_structure(
         });
     let k_eps: C = 0.5 * (bc[pj] - bc[pk]) / (w[pj] - w[pk]);
     let eps = k_eps / k;
-    // The perfect square of (40), (Kε)² = K · Kε², with Kε² d4 = κ Σ c̃_j a_j;
+    // The perfect square of (40), (Kε)² = K · Kε², with Kε² d4 = κ Σ c̃_j p_j;
     // relative to the size of the terms (the sum cancels when two d_j are close).
     let terms_e2: f64 = (0..3).map(|j| (ct[j] * ac[j]).norm()).sum();
     let k_eps2: C = kappa / d4 * (0..3).map(|j| ct[j] * ac[j]).sum::<C>();
@@ -803,6 +792,39 @@ fn h0_structure(
             ),
         });
     }
+
+    // (39) in closed form: the (40) representative p_j = Kε² d_j w_j,
+    // q_j = 2Kε w_j, r_j = K w_j/d4 reduced to the form (38) (the representative
+    // of that form is unique, so these are the paper's α, β, γ, δ).
+    let e1 = d[0] + d[1] + d[2];
+    let eps2 = eps * eps;
+    let beta39 = -k_over_kappa;
+    let gamma39 = eps2 * d4 * d4 * k_over_kappa;
+    let delta39 = 2.0 * d4 * k_eps / kappa;
+    let alpha39 = 0.5 * k_over_kappa * (kappa * eps2 + (e1 - d4) * (ONE - eps2 * d4 * d4));
+    // A_j, B_j themselves from the same reduction applied to p, q, r per j:
+    // ν = −(s_j − s_k)/(t_j − t_k), s = p + r, t_j = d_j + 1/d_j, then
+    // A_j = (p_j − r_j)/2 + (ν/2)(d_j − 1/d_j); B_j = q_j + μ with
+    // μ = δ t_j − q_j, δ = (q_j − q_k)/(t_j − t_k). Two nodes (the most separated
+    // t) suffice and keep A_j, B_j accurate when two d_j nearly coincide, where
+    // α, β, γ (three-node quantities, through K) are only known to ~u/|d_j − d_k|².
+    let t: [C; 3] = std::array::from_fn(|j| d[j] + ONE / d[j]);
+    let (tj, tk) = [(0, 1), (0, 2), (1, 2)]
+        .into_iter()
+        .fold((0, 1), |best, (j, kk)| {
+            if (t[j] - t[kk]).norm() > (t[best.0] - t[best.1]).norm() {
+                (j, kk)
+            } else {
+                best
+            }
+        });
+    let nu = -((ac[tj] + cc[tj]) - (ac[tk] + cc[tk])) / (t[tj] - t[tk]);
+    let delta_two = (bc[tj] - bc[tk]) / (t[tj] - t[tk]);
+    let mu = delta_two * t[tj] - bc[tj];
+    let a_coef: [C; 3] =
+        std::array::from_fn(|j| 0.5 * (ac[j] - cc[j]) + 0.5 * nu * (d[j] - ONE / d[j]));
+    let b_coef: [C; 3] = std::array::from_fn(|j| bc[j] + mu);
+    let abgd39 = [alpha39, beta39, gamma39, delta39];
     Ok((a_coef, b_coef, abgd39, eps, k))
 }
 

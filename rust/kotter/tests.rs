@@ -387,3 +387,40 @@ fn h0_40_closed_form_on_point_pairs() {
         assert!((h0 - rhs).norm() < 1e-11 * size, "{h0} vs {rhs}");
     }
 }
+
+/// (38)–(39) with the closed forms of `(α, β, γ, δ)`: an identity on the whole
+/// quadric variety. At complex point pairs with complex `g`, `Σ_j m_j n_j` of
+/// (23) applied to (37) equals `Σ_j A_j (ξ_j² − η_j²) + B_j ξ_j η_j` with
+/// `A_j = α + β d_j + γ/d_j`, `B_j = δ (d_j + 1/d_j)`; and `δ² = −4βγ`.
+#[test]
+fn h0_38_39_closed_form_on_point_pairs() {
+    let st = kotter(&A, &L0).unwrap();
+    let k = &st.constants;
+    let d = k.d;
+    let [al, be, ga, de] = k.abgd39;
+    assert!((de * de + 4.0 * be * ga).norm() < 1e-12 * (de * de).norm());
+    let a_j: [C; 3] = std::array::from_fn(|j| al + be * d[j] + ga / d[j]);
+    let b_j: [C; 3] = std::array::from_fn(|j| de * (d[j] + ONE / d[j]));
+    for j in 0..3 {
+        assert!((a_j[j] - k.a_coef[j]).norm() < 1e-12 * a_j[j].norm());
+        assert!((b_j[j] - k.b_coef[j]).norm() < 1e-12 * b_j[j].norm());
+    }
+    for (z1, z2, g) in [
+        (C::new(0.4, 1.3), C::new(-2.1, 0.7), C::new(0.9, -0.3)),
+        (C::new(3.3, -0.2), C::new(0.1, -1.9), C::new(-0.4, 1.2)),
+        (C::new(-5.0, 2.5), C::new(7.0, 1.0), C::new(2.0, 0.5)),
+    ] {
+        let (y1, y2) = (st.curve.y(z1), -st.curve.y(z2));
+        let (xi, eta) = st.curve.xi_eta(z1, y1, z2, y2, g, None, None).unwrap();
+        let (mut lhs, mut rhs, mut size) = (ZERO, ZERO, 0.0);
+        for j in 0..3 {
+            let mj = k.alpha[j] * xi[j] + k.beta[j] * eta[j];
+            let nj = k.gamma[j] * xi[j] + k.delta[j] * eta[j];
+            let r = a_j[j] * (xi[j] * xi[j] - eta[j] * eta[j]) + b_j[j] * xi[j] * eta[j];
+            lhs += mj * nj;
+            rhs += r;
+            size += (mj * nj).norm() + r.norm();
+        }
+        assert!((lhs - rhs).norm() < 1e-11 * size, "{lhs} vs {rhs}");
+    }
+}
