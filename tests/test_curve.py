@@ -825,3 +825,69 @@ def test_inverse_is_homogeneous_in_g(scale):
         assert abs(a - r) <= EXAMPLE_RTOL * max(abs(r), 1)
     assert abs(b.g / scale - ref.g) <= EXAMPLE_RTOL * abs(ref.g)
     np.testing.assert_array_equal(b.eps, ref.eps)
+
+
+# ----------------------------------------------------------------------------
+# Offsets zd = z_i - d_j (accuracy near branch points)
+# ----------------------------------------------------------------------------
+
+#: Offsets returned by points_from_wurzel are t + (d_b - d_j) with t the offset to the
+#: nearest branch point: they differ from the rounded z - d_j by a few roundings of
+#: numbers of size |z| + max|d_j| (the Rust OFFSET_RTOL, 16 ulps).
+OFFSET_RTOL = 16 * np.finfo(float).eps
+
+
+@pytest.mark.parametrize("seed", range(8))
+def test_points_from_wurzel_offsets(seed):
+    """CurvePoints.zd (shape (..., 2, 5)) agree with z_i - d_j to rounding, and (37)
+    evaluated from them (xi_eta(..., zd=)) reproduces the data as the bare points do
+    (separated points: both to NUMPY_RTOL of the independent numpy data); wurzel with and
+    without zd agree to rounding there."""
+    rng = np.random.default_rng(7000 + seed)
+    dd, d, (z1, y1, z2, y2) = random_setup(rng)
+    k = KotterCurve(*dd)
+    g = rand_c(rng, -2, 2, 3)
+    eps = all_eps()[seed % 16]
+    data = [np_xi_eta(d, z1, y1, z2, y2, gi, eps) for gi in g]
+    xi = np.array([x for x, _ in data])
+    eta = np.array([e for _, e in data])
+    pts = k.points_from_wurzel(xi, eta, g_ref=g)
+    assert pts.zd.shape == (3, 2, 5)
+    zz = np.stack([pts.z1[:, None] - d, pts.z2[:, None] - d], axis=1)
+    size = np.maximum(np.abs(pts.z1), np.abs(pts.z2))[:, None, None] + np.abs(d).max()
+    assert np.all(np.abs(pts.zd - zz) <= OFFSET_RTOL * size)
+    args = (pts.z1, pts.y1, pts.z2, pts.y2, pts.g)
+    xz, ez = k.xi_eta(*args, eps=pts.eps, zd=pts.zd)
+    scale = max(np.abs(xi).max(), np.abs(eta).max())
+    assert np.abs(np.concatenate([xz - xi, ez - eta])).max() <= NUMPY_RTOL * scale
+    w0 = k.wurzel(pts.z1, pts.y1, pts.z2, pts.y2, eps=pts.eps)
+    w1 = k.wurzel(pts.z1, pts.y1, pts.z2, pts.y2, eps=pts.eps, zd=pts.zd)
+    assert np.abs(w1.Pjk - w0.Pjk).max() <= NUMPY_RTOL * np.abs(w0.Pjk).max()
+    # One pair: scalar points, zd of shape (2, 5), accepted back as such.
+    one = k.points_from_wurzel(xi[0], eta[0], g_ref=g[0])
+    assert one.zd.shape == (2, 5)
+    x1, e1 = k.xi_eta(one.z1, one.y1, one.z2, one.y2, one.g, eps=one.eps, zd=one.zd)
+    assert x1.shape == (3,) and np.abs(x1 - xi[0]).max() <= NUMPY_RTOL * scale
+
+
+def test_bad_offsets():
+    k = KotterCurve(0.5 + 0.3j, -1.2 + 0.1j, 2.0 - 0.4j)
+    z1, z2 = 0.7 + 1.1j, -1.5 + 0.4j
+    y1, y2 = k.y(z1), k.y(z2)
+    d = np.asarray(k.branch_points)
+    zd = np.stack([z1 - d, z2 - d])
+    k.wurzel(z1, y1, z2, y2, zd=zd)  # consistent: accepted
+    with pytest.raises(ValueError, match="shape"):
+        k.wurzel(z1, y1, z2, y2, zd=zd[:, :4])
+    bad = zd.copy()
+    bad[1, 2] += 1e-6
+    with pytest.raises(ValueError, match="offset"):
+        k.wurzel(z1, y1, z2, y2, zd=bad)
+    with pytest.raises(ValueError, match="offset"):
+        k.xi_eta(z1, y1, z2, y2, 1.0, zd=bad)
+    bad[1, 2] = np.nan
+    with pytest.raises(ValueError):
+        k.xi_eta(z1, y1, z2, y2, 1.0, zd=bad)
+    zd_copy = zd.copy()
+    k.xi_eta(z1, y1, z2, y2, 1.0, zd=zd)
+    np.testing.assert_array_equal(zd, zd_copy)
