@@ -1,5 +1,5 @@
 //! Criterion benches of the curve module: the Wurzelfunktionen (27)–(28) of a
-//! point pair, the map (36) and its inverse, per call, on a fixed seeded set of
+//! point pair, the map (37) and its inverse, per call, on a fixed seeded set of
 //! random pairs.
 
 use criterion::{black_box, criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};

@@ -1,4 +1,4 @@
-"""The curve (8), the Wurzelfunktionen (27)-(28), identities (29)-(33), inverse of (36).
+"""The curve (8), the Wurzelfunktionen (27)-(28), identities (29)-(33), inverse of (37).
 
 Reference values come from an independent numpy implementation of (27)-(28)
 *as printed* (written here, not calling the package) and from mpmath at 40
@@ -430,12 +430,12 @@ def test_31b_encodes_the_product_convention():
 
 
 # ----------------------------------------------------------------------------
-# The inverse of (36)
+# The inverse of (37)
 # ----------------------------------------------------------------------------
 
 
 def np_xi_eta(d, z1, y1, z2, y2, g, eps=(1, 1, 1, 1, 1)):
-    """(36) with the printed (27)-(28) and principal sqrt(c_j)."""
+    """(37) with the printed (27)-(28) and principal sqrt(c_j)."""
     _, Pjk = np_wurzel(d, z1, y1, z2, y2, eps)
     c, _ = np_c(d)
     sc = np_sqrt(c)
@@ -740,8 +740,8 @@ def test_exports():
 
 
 @pytest.mark.parametrize("seed", range(10))
-def test_36_xi_eta_lie_on_koetter_quadrics_11(seed):
-    """(36) maps every point pair and g onto the three quadrics (11): the first
+def test_37_xi_eta_lie_on_koetter_quadrics_11(seed):
+    """(37) maps every point pair and g onto the three quadrics (11): the first
     is the s**-2 coefficient of (29), the second (31a), the third (32)."""
     rng = np.random.default_rng(5000 + seed)
     dd, d, (z1, y1, z2, y2) = random_setup(rng)
@@ -751,7 +751,7 @@ def test_36_xi_eta_lie_on_koetter_quadrics_11(seed):
     dj = d[1:4]
     for terms in (xi**2 + eta**2, xi * eta, dj * xi**2 + eta**2 / dj):
         assert abs(terms.sum()) <= IDENTITY_RTOL * np.abs(terms).sum()
-    # And (36) itself, against the independent numpy evaluation.
+    # And (37) itself, against the independent numpy evaluation.
     xn, en = np_xi_eta(d, z1, y1, z2, y2, g, all_eps()[seed % 16])
     scale = max(np.abs(xn).max(), np.abs(en).max())
     np.testing.assert_allclose(xi, xn, rtol=0, atol=NUMPY_RTOL * scale)
@@ -796,7 +796,7 @@ def test_real_branch_points_and_points_on_cuts(dd, z1, z2, sheets):
 def test_wurzel_symmetries(seed):
     """Choices the result must not depend on: the order of the two points; and
     the hyperelliptic involution on both points, (y1, y2) -> (-y1, -y2), which
-    leaves every P_j and flips every P_jk (so it is the same as g -> -g in (36))."""
+    leaves every P_j and flips every P_jk (so it is the same as g -> -g in (37))."""
     rng = np.random.default_rng(6000 + seed)
     dd, d, (z1, y1, z2, y2) = random_setup(rng, bp_dist=0.0)
     k = KotterCurve(*dd)
@@ -813,7 +813,7 @@ def test_wurzel_symmetries(seed):
 
 @pytest.mark.parametrize("scale", [1e-170, 1e-20, 1e20, 1e300])
 def test_inverse_is_homogeneous_in_g(scale):
-    """(36) is linear in g: scaling (xi, eta) by s scales g by s and leaves the
+    """(37) is linear in g: scaling (xi, eta) by s scales g by s and leaves the
     points, even where g**2 would under- or overflow."""
     k = KotterCurve(2.0, 3.0, -0.5 + 1j)
     z1, z2 = 0.3 + 0.2j, -1.0 + 0.5j
@@ -825,3 +825,69 @@ def test_inverse_is_homogeneous_in_g(scale):
         assert abs(a - r) <= EXAMPLE_RTOL * max(abs(r), 1)
     assert abs(b.g / scale - ref.g) <= EXAMPLE_RTOL * abs(ref.g)
     np.testing.assert_array_equal(b.eps, ref.eps)
+
+
+# ----------------------------------------------------------------------------
+# Offsets zd = z_i - d_j (accuracy near branch points)
+# ----------------------------------------------------------------------------
+
+#: Offsets returned by points_from_wurzel are t + (d_b - d_j) with t the offset to the
+#: nearest branch point: they differ from the rounded z - d_j by a few roundings of
+#: numbers of size |z| + max|d_j| (the Rust OFFSET_RTOL, 16 ulps).
+OFFSET_RTOL = 16 * np.finfo(float).eps
+
+
+@pytest.mark.parametrize("seed", range(8))
+def test_points_from_wurzel_offsets(seed):
+    """CurvePoints.zd (shape (..., 2, 5)) agree with z_i - d_j to rounding, and (37)
+    evaluated from them (xi_eta(..., zd=)) reproduces the data as the bare points do
+    (separated points: both to NUMPY_RTOL of the independent numpy data); wurzel with and
+    without zd agree to rounding there."""
+    rng = np.random.default_rng(7000 + seed)
+    dd, d, (z1, y1, z2, y2) = random_setup(rng)
+    k = KotterCurve(*dd)
+    g = rand_c(rng, -2, 2, 3)
+    eps = all_eps()[seed % 16]
+    data = [np_xi_eta(d, z1, y1, z2, y2, gi, eps) for gi in g]
+    xi = np.array([x for x, _ in data])
+    eta = np.array([e for _, e in data])
+    pts = k.points_from_wurzel(xi, eta, g_ref=g)
+    assert pts.zd.shape == (3, 2, 5)
+    zz = np.stack([pts.z1[:, None] - d, pts.z2[:, None] - d], axis=1)
+    size = np.maximum(np.abs(pts.z1), np.abs(pts.z2))[:, None, None] + np.abs(d).max()
+    assert np.all(np.abs(pts.zd - zz) <= OFFSET_RTOL * size)
+    args = (pts.z1, pts.y1, pts.z2, pts.y2, pts.g)
+    xz, ez = k.xi_eta(*args, eps=pts.eps, zd=pts.zd)
+    scale = max(np.abs(xi).max(), np.abs(eta).max())
+    assert np.abs(np.concatenate([xz - xi, ez - eta])).max() <= NUMPY_RTOL * scale
+    w0 = k.wurzel(pts.z1, pts.y1, pts.z2, pts.y2, eps=pts.eps)
+    w1 = k.wurzel(pts.z1, pts.y1, pts.z2, pts.y2, eps=pts.eps, zd=pts.zd)
+    assert np.abs(w1.Pjk - w0.Pjk).max() <= NUMPY_RTOL * np.abs(w0.Pjk).max()
+    # One pair: scalar points, zd of shape (2, 5), accepted back as such.
+    one = k.points_from_wurzel(xi[0], eta[0], g_ref=g[0])
+    assert one.zd.shape == (2, 5)
+    x1, e1 = k.xi_eta(one.z1, one.y1, one.z2, one.y2, one.g, eps=one.eps, zd=one.zd)
+    assert x1.shape == (3,) and np.abs(x1 - xi[0]).max() <= NUMPY_RTOL * scale
+
+
+def test_bad_offsets():
+    k = KotterCurve(0.5 + 0.3j, -1.2 + 0.1j, 2.0 - 0.4j)
+    z1, z2 = 0.7 + 1.1j, -1.5 + 0.4j
+    y1, y2 = k.y(z1), k.y(z2)
+    d = np.asarray(k.branch_points)
+    zd = np.stack([z1 - d, z2 - d])
+    k.wurzel(z1, y1, z2, y2, zd=zd)  # consistent: accepted
+    with pytest.raises(ValueError, match="shape"):
+        k.wurzel(z1, y1, z2, y2, zd=zd[:, :4])
+    bad = zd.copy()
+    bad[1, 2] += 1e-6
+    with pytest.raises(ValueError, match="offset"):
+        k.wurzel(z1, y1, z2, y2, zd=bad)
+    with pytest.raises(ValueError, match="offset"):
+        k.xi_eta(z1, y1, z2, y2, 1.0, zd=bad)
+    bad[1, 2] = np.nan
+    with pytest.raises(ValueError):
+        k.xi_eta(z1, y1, z2, y2, 1.0, zd=bad)
+    zd_copy = zd.copy()
+    k.xi_eta(z1, y1, z2, y2, 1.0, zd=zd)
+    np.testing.assert_array_equal(zd, zd_copy)

@@ -254,8 +254,8 @@ def schottky_f(a, l, s):
 
 
 @pytest.mark.parametrize("s", [4.0, 5.5, 10.0])
-def test_generating_function_14_holds_with_corrected_7_and_fails_as_printed(s):
-    """(14): f(s) = h1 s^2 - h2 s + h3 + 2 h0 sqrt(G(s)); s > max a_i so every root is real."""
+def test_generating_function_15_holds_with_corrected_7_and_fails_as_printed(s):
+    """(15): f(s) = h1 s^2 - h2 s + h3 + 2 h0 sqrt(G(s)); s > max a_i so every root is real."""
     p = manakov.problem("generic")
     rng = np.random.default_rng(5)
     for l in [p.l0, *rng.normal(size=(3, 6))]:

@@ -56,6 +56,7 @@ def curve_wurzel(
     z2: npt.NDArray[np.complex128],
     y2: npt.NDArray[np.complex128],
     eps: npt.NDArray[np.int8] | None = None,
+    zd: npt.NDArray[np.complex128] | None = None,
 ) -> tuple[npt.NDArray[np.complex128], npt.NDArray[np.complex128]]: ...
 def curve_xi_eta(
     d: npt.NDArray[np.complex128],
@@ -66,6 +67,7 @@ def curve_xi_eta(
     g: npt.NDArray[np.complex128],
     eps: npt.NDArray[np.int8] | None = None,
     sqrt_c: npt.NDArray[np.complex128] | None = None,
+    zd: npt.NDArray[np.complex128] | None = None,
 ) -> tuple[npt.NDArray[np.complex128], npt.NDArray[np.complex128]]: ...
 def curve_points_from_xi_eta(
     d: npt.NDArray[np.complex128],
@@ -74,7 +76,12 @@ def curve_points_from_xi_eta(
     sqrt_c: npt.NDArray[np.complex128] | None = None,
     g_ref: npt.NDArray[np.complex128] | None = None,
     rtol: float = 1e-08,
-) -> tuple[npt.NDArray[np.complex128], npt.NDArray[np.int8], npt.NDArray[np.float64]]: ...
+) -> tuple[
+    npt.NDArray[np.complex128],
+    npt.NDArray[np.int8],
+    npt.NDArray[np.float64],
+    npt.NDArray[np.complex128],
+]: ...
 
 # --- so4 / integrate (rust/python/so4.rs) ---
 def manakov_c(a: NDArray[np.float64], b: NDArray[np.float64]) -> NDArray[np.float64]: ...

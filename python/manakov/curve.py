@@ -26,6 +26,16 @@ Square-root conventions (all of them; see ``docs/curve.md``)
   ``z in d_j + (-inf, 0]``, and a continuous choice along a trajectory is
   carried by ``eps`` (``points_from_wurzel`` returns it).
 * (28) fixes the ``P_jk`` from the ``P_j`` and ``sqrt(R(z_i)) = y_i``.
+
+Offsets ``zd``
+--------------
+A double ``z`` fixes ``z - d_j`` only to an absolute ``u |z|`` (``u`` the unit
+roundoff), so a point very close to a branch point loses relative accuracy in
+``sqrt(z - d_j)`` and hence in (27)-(28). :meth:`KotterCurve.points_from_wurzel`
+therefore also returns the offsets ``zd[..., i-1, j] = z_i - d_j`` (``j = 0..4``)
+to full relative accuracy, and :meth:`KotterCurve.wurzel` and
+:meth:`KotterCurve.xi_eta` accept them (``zd=``) and take the roots from them.
+Offsets must agree with ``z - d_j`` to rounding (else ``ValueError``).
 """
 
 from __future__ import annotations
@@ -60,6 +70,17 @@ def _scalar_or(a: np.ndarray, scalar: bool) -> Any:
     return a[()] if scalar else _frozen(a)
 
 
+def _zd_rows(zd: Any, shape: tuple[int, ...]) -> np.ndarray | None:
+    """Offsets of shape (..., 2, 5) broadcast to ``shape`` and flattened to rows of 10."""
+    if zd is None:
+        return None
+    z = _c(zd)
+    if z.shape[-2:] != (2, 5):
+        raise ValueError(f"zd must have trailing shape (2, 5), got {z.shape}")
+    z = np.broadcast_to(z, (*shape, 2, 5))
+    return np.ascontiguousarray(z.reshape(-1, 10))
+
+
 def _eps_rows(eps: Any, shape: tuple[int, ...]) -> np.ndarray | None:
     if eps is None:
         return None
@@ -92,7 +113,7 @@ class Wurzel:
 
 @dataclass(frozen=True)
 class CurvePoints:
-    """Points of the curve, factor ``g`` and branch ``eps`` recovered from (36).
+    """Points of the curve, factor ``g`` and branch ``eps`` recovered from (37).
 
     Attributes
     ----------
@@ -100,13 +121,20 @@ class CurvePoints:
         The two points; ``z1`` is the root of ``x**2 - (z1+z2) x + z1 z2`` of
         larger modulus (the pair is unordered: (27)-(28) are symmetric).
     g : complex or ndarray
-        The factor of (36): ``xi_j = sqrt(c_j) g P_kl``, ``eta_j = sqrt(c_j) g P_j4``.
+        The factor of (37): ``xi_j = sqrt(c_j) g P_kl``, ``eta_j = sqrt(c_j) g P_j4``.
     eps : ndarray of int8, shape (..., 5)
         The branch of the Wurzelfunktionen (product +1, normalised to
         ``eps[..., 4] == 1``): ``curve.wurzel(z1, y1, z2, y2, eps=eps)``
         reproduces the data.
     residual : float or ndarray
         ``max |(xi, eta) - (xi, eta)(z1, y1, z2, y2, g, eps)|``.
+    zd : ndarray, complex, shape (..., 2, 5)
+        The offsets ``zd[..., i-1, j] = z_i - d_j`` (``j = 0..4``, ``d_0 = 0``,
+        ``d_4 = d1 d2 d3``) to full relative accuracy (the polish works in the
+        offset from the nearest branch point). Pass them on as
+        ``curve.xi_eta(..., zd=pts.zd)`` or ``curve.wurzel(..., zd=pts.zd)`` to keep
+        that accuracy for points close to a branch point, where the bare ``z_i``
+        fix ``z_i - d_j`` only to ``u |z_i|``.
     """
 
     z1: Any
@@ -116,6 +144,7 @@ class CurvePoints:
     g: Any
     eps: np.ndarray
     residual: Any
+    zd: np.ndarray
 
 
 class KotterCurve:
@@ -218,7 +247,9 @@ class KotterCurve:
         _, y = _core.curve_eval(self._d123(), xa.reshape(-1))
         return _scalar_or(sheet * y.reshape(xa.shape), xa.ndim == 0)
 
-    def wurzel(self, z1: Any, y1: Any, z2: Any, y2: Any, *, eps: Any = None) -> Wurzel:
+    def wurzel(
+        self, z1: Any, y1: Any, z2: Any, y2: Any, *, eps: Any = None, zd: Any = None
+    ) -> Wurzel:
         """Weierstrass' Wurzelfunktionen (27)-(28) of the point pairs ``(z1, y1), (z2, y2)``.
 
         .. math::
@@ -238,6 +269,10 @@ class KotterCurve:
             Points of the curve; broadcast together.
         eps : array_like of {+1, -1}, shape (..., 5), optional, keyword-only
             Branch of the ``P_j`` (product must be +1); default all +1.
+        zd : array_like, complex, shape (..., 2, 5), optional, keyword-only
+            Offsets ``zd[..., i-1, j] = z_i - d_j`` (e.g. ``CurvePoints.zd``); the
+            roots ``sqrt(z_i - d_j)`` are taken from them (full accuracy near
+            branch points). Default: formed from ``z1, z2``.
 
         Returns
         -------
@@ -249,16 +284,20 @@ class KotterCurve:
         ValueError
             Non-finite input, a point off the curve (``|y**2 - R(z)|`` above
             1e-8 of the size of the terms of ``R``), ``z1 == z2`` where (28)
-            divides by zero, or an invalid ``eps``.
+            divides by zero, an invalid ``eps``, or offsets ``zd`` of the wrong
+            shape or inconsistent with ``z1, z2``.
         """
         arrs = list(np.broadcast_arrays(_c(z1), _c(y1), _c(z2), _c(y2)))
         shape = arrs[0].shape
         if eps is not None:
             shape = np.broadcast_shapes(shape, np.shape(eps)[:-1])
-            arrs = [np.broadcast_to(a, shape) for a in arrs]
+        if zd is not None:
+            shape = np.broadcast_shapes(shape, np.shape(zd)[:-2])
+        arrs = [np.broadcast_to(a, shape) for a in arrs]
         e = _eps_rows(eps, shape)
+        zr = _zd_rows(zd, shape)
         z1f, y1f, z2f, y2f = (np.ascontiguousarray(a.reshape(-1)) for a in arrs)
-        p, pjk = _core.curve_wurzel(self._d123(), z1f, y1f, z2f, y2f, e)
+        p, pjk = _core.curve_wurzel(self._d123(), z1f, y1f, z2f, y2f, e, zr)
         return Wurzel(P=_frozen(p.reshape(*shape, 5)), Pjk=_frozen(pjk.reshape(*shape, 5, 5)))
 
     def xi_eta(
@@ -271,8 +310,9 @@ class KotterCurve:
         *,
         eps: Any = None,
         sqrt_c: Any = None,
+        zd: Any = None,
     ) -> tuple[np.ndarray, np.ndarray]:
-        """Kötter's vectors from points of the curve, (36).
+        """Kötter's vectors from points of the curve, (37).
 
         .. math:: \\xi_j = \\sqrt{c_j}\\, g\\, P_{kl}, \\qquad \\eta_j = \\sqrt{c_j}\\, g\\, P_{j4}
 
@@ -286,20 +326,30 @@ class KotterCurve:
             Branch of the Wurzelfunktionen, as in :meth:`wurzel`.
         sqrt_c : array_like, shape (3,), optional, keyword-only
             The square roots of ``c_j`` to use; default the principal roots.
+        zd : array_like, complex, shape (..., 2, 5), optional, keyword-only
+            Offsets ``z_i - d_j`` as in :meth:`wurzel` (e.g. ``CurvePoints.zd``).
 
         Returns
         -------
         xi, eta : ndarray, complex, shape (..., 3)
+
+        Raises
+        ------
+        ValueError
+            As :meth:`wurzel`, and a non-finite ``g`` or an invalid ``sqrt_c``.
         """
         arrs = list(np.broadcast_arrays(_c(z1), _c(y1), _c(z2), _c(y2), _c(g)))
         shape = arrs[0].shape
         if eps is not None:
             shape = np.broadcast_shapes(shape, np.shape(eps)[:-1])
-            arrs = [np.broadcast_to(a, shape) for a in arrs]
+        if zd is not None:
+            shape = np.broadcast_shapes(shape, np.shape(zd)[:-2])
+        arrs = [np.broadcast_to(a, shape) for a in arrs]
         e = _eps_rows(eps, shape)
+        zr = _zd_rows(zd, shape)
         z1f, y1f, z2f, y2f, gf = (np.ascontiguousarray(a.reshape(-1)) for a in arrs)
         sc = None if sqrt_c is None else np.ascontiguousarray(_c(sqrt_c).reshape(-1))
-        xi, eta = _core.curve_xi_eta(self._d123(), z1f, y1f, z2f, y2f, gf, e, sc)
+        xi, eta = _core.curve_xi_eta(self._d123(), z1f, y1f, z2f, y2f, gf, e, sc, zr)
         return _frozen(xi.reshape(*shape, 3)), _frozen(eta.reshape(*shape, 3))
 
     def points_from_wurzel(
@@ -311,7 +361,7 @@ class KotterCurve:
         g_ref: Any = None,
         rtol: float = INVERSE_RTOL,
     ) -> CurvePoints:
-        """Invert (36): points ``(z1, y1), (z2, y2)``, ``g`` and branch ``eps`` from ``xi, eta``.
+        """Invert (37): points ``(z1, y1), (z2, y2)``, ``g`` and branch ``eps`` from ``xi, eta``.
 
         Given ``xi_j = sqrt(c_j) g P_kl`` and ``eta_j = sqrt(c_j) g P_j4``
         (``j = 1, 2, 3``, ``(j, k, l)`` cyclic), put ``X_j = xi_j/sqrt(c_j)``,
@@ -337,7 +387,7 @@ class KotterCurve:
         sqrt_c : array_like, shape (3,), optional, keyword-only
             The square roots of ``c_j`` used to make ``xi, eta``; default principal.
         g_ref : complex or array_like, optional, keyword-only
-            Selects the sign of ``g`` (e.g. ``g = 1/(1 - eps P_0)`` of (41)).
+            Selects the sign of ``g`` (e.g. ``g = 1/(1 - eps P_0)`` of (42)).
         rtol : float, keyword-only
             The recovered points must reproduce ``(xi, eta)`` to
             ``rtol * max|(xi, eta)|``.
@@ -368,7 +418,9 @@ class KotterCurve:
         if g_ref is not None:
             gr = np.ascontiguousarray(np.broadcast_to(_c(g_ref), shape).reshape(-1))
         sc = None if sqrt_c is None else np.ascontiguousarray(_c(sqrt_c).reshape(-1))
-        pts, eps, res = _core.curve_points_from_xi_eta(self._d123(), xr, er, sc, gr, float(rtol))
+        pts, eps, res, zd = _core.curve_points_from_xi_eta(
+            self._d123(), xr, er, sc, gr, float(rtol)
+        )
         cols = [pts[:, i].reshape(shape) for i in range(5)]
         return CurvePoints(
             z1=_scalar_or(cols[0], scalar),
@@ -378,4 +430,5 @@ class KotterCurve:
             g=_scalar_or(cols[4], scalar),
             eps=_frozen(eps.reshape(*shape, 5)),
             residual=res.reshape(shape)[()] if scalar else _frozen(res.reshape(shape)),
+            zd=_frozen(zd.reshape(*shape, 2, 5)),
         )

@@ -5,17 +5,17 @@ The chain, with the paper's equation numbers (details and every convention in
 ``docs/kotter.md``; corrected formulas in ``docs/errata-kotter.md``):
 
 * Schottky's vector (12) ``l_j(s) = sqrt(s_j4) m_j + sqrt(s_kl) n_j`` with
-  ``m_j = l_kl``, ``n_j = l_j4`` (13), and its square (14)
+  ``m_j = l_kl``, ``n_j = l_j4`` (13), and its square (14) with its closed form (15)
   ``f(s) = h1 s^2 - h2 s + h3 + 2 h0 sqrt(G(s))`` (with the complementary-pair
   ``h2``, ``h3``);
-* the quartic ``F(s)`` (18), its roots ``s_p`` and the isotropic vectors
-  ``l^(p) = l(s_p)/sqrt(F'(s_p))`` (19)-(20);
-* Kötter's ``xi = l^(1) + i l^(2)``, ``eta = l^(1) - i l^(2)`` (21), the linear
+* the quartic ``F(s)`` (19), its roots ``s_p`` and the isotropic vectors
+  ``l^(p) = l(s_p)/sqrt(F'(s_p))`` (20)-(21);
+* Kötter's ``xi = l^(1) + i l^(2)``, ``eta = l^(1) - i l^(2)`` (22), the linear
   map (23)-(24) back to ``(m, n)``, the constants ``d_j`` (25)-(26) of the
   quadrics (11);
-* ``H0`` on the quadrics (37)-(39), ``eps`` and ``g`` (40)-(41) (corrected);
+* ``H0`` on the quadrics (38)-(40), ``eps`` and ``g`` (41)-(42) (corrected);
 * the points ``(z1, y1), (z2, y2)`` of the curve ``y^2 = prod_{j=0}^4 (x - d_j)``
-  (8) with ``xi_j = sqrt(c_j) g P_kl``, ``eta_j = sqrt(c_j) g P_j4`` (36).
+  (8) with ``xi_j = sqrt(c_j) g P_kl``, ``eta_j = sqrt(c_j) g P_j4`` (37).
 
 The state is ordered ``l = (l12, l13, l14, l23, l24, l34)``.
 """
@@ -67,12 +67,12 @@ def _states(l: Any) -> tuple[np.ndarray, tuple[int, ...]]:
 
 
 def integrals(a: Any, l: Any) -> np.ndarray:
-    """The integrals ``(h0, h1, h2, h3)`` in the form consistent with (14).
+    """The integrals ``(h0, h1, h2, h3)`` in the form consistent with (15).
 
     ``h0 = l12 l34 + l23 l14 + l31 l24`` (6), ``h1 = sum l_jk^2`` (7), and
     ``h2 = sum_{j<k} (a_l + a_m) l_jk^2``, ``h3 = sum_{j<k} a_l a_m l_jk^2``
     with ``{l, m}`` the complement of ``{j, k}`` (the pairs printed in (7),
-    ``a_j + a_k`` and ``a_j a_k``, do not give (14); see docs/errata-kotter.md).
+    ``a_j + a_k`` and ``a_j a_k``, do not give (15); see docs/errata-kotter.md).
 
     Parameters
     ----------
@@ -91,13 +91,13 @@ def integrals(a: Any, l: Any) -> np.ndarray:
 
 
 def schottky(a: Any, l: Any, s: Any, *, sqrt_g: Any = None) -> tuple[np.ndarray, np.ndarray]:
-    """Schottky's vectors ``l(s)`` (12) and ``m(s)`` (16).
+    """Schottky's vectors ``l(s)`` (12) and ``m(s)`` (17).
 
     ``l_j(s) = sqrt(s_j4) m_j + sqrt(s_kl) n_j``, ``m_j(s) = sqrt(s_kl) m_j + sqrt(s_j4) n_j``,
     ``s_jk = (s - a_j)(s - a_k)``, ``(j, k, l)`` cyclic. Branch: ``sqrt(s_j4)``
     principal and ``sqrt(s_kl) = sqrt_g / sqrt(s_j4)``, so that
     ``sqrt(s_j4) sqrt(s_kl) = sqrt(G(s))`` for every ``j`` (needed for the
-    cross term ``2 h0 sqrt(G)`` of (14)).
+    cross term ``2 h0 sqrt(G)`` of (15)).
 
     Parameters
     ----------
@@ -135,23 +135,23 @@ def _skew3(v: np.ndarray) -> np.ndarray:
 def lax_pair(
     a: Any, b: Any, l: Any, s: Any, *, sqrt_g: Any = None
 ) -> tuple[np.ndarray, np.ndarray]:
-    """The Lax pair ``L(s)``, ``M_b(s)`` of (15)-(17) for the top ``(a, b)``, corrected.
+    """The Lax pair ``L(s)``, ``M_b(s)`` of (16)-(18) for the top ``(a, b)``, corrected.
 
     ``L = [[0, l3, -l2], [-l3, 0, l1], [l2, -l1, 0]]`` from Schottky's ``l(s)`` (12),
     and ``M_b`` the same antisymmetric matrix built from
 
     ``m_b(s) = -tau [p2 m(s) + p3 (e2 m(s) + m^[w3](s)) / (e1 - s)]``,
 
-    so that ``dL/dt = [L, M_b]`` (15) along the flow (1)-(2) on either branch of
+    so that ``dL/dt = [L, M_b]`` (16) along the flow (1)-(2) on either branch of
     ``sqrt(G)``. Here ``b_i = p0 + p1 a_i + p2 a_i^2 + p3 a_i^3`` is the cubic
     interpolant of ``b`` over ``a`` (``p3`` the third divided difference),
-    ``m(s)`` is the vector (16), ``m^[X](s)`` the same built from an
+    ``m(s)`` is the vector (17), ``m^[X](s)`` the same built from an
     antisymmetric ``X`` instead of ``l`` (``m^[X]_j = sqrt(s_kl) X_kl +
     sqrt(s_j4) X_j4``), ``(w3)_ij = (a_i^2 + a_i a_j + a_j^2) l_ij`` the angular
     velocity of the top with ``b = a^3``, ``e1 = sum a_i``,
     ``e2 = sum_{i<j} a_i a_j``, and
     ``tau = sqrt(s_14) sqrt(s_24) sqrt(s_34) sqrt(G) / ((s - a4) G(s)) = +-1``.
-    The printed ``M(s)`` (16)-(17), which does not involve ``b``, is the case
+    The printed ``M(s)`` (17)-(18), which does not involve ``b``, is the case
     ``b = a^2`` (``p2 = 1, p3 = 0``) on the branch ``tau = -1``; for a general
     ``b`` it does not give the flow (see docs/errata-kotter.md).
 
@@ -193,14 +193,14 @@ def lax_pair(
 
 
 def quartic(a: Any, h: Any) -> np.ndarray:
-    """Coefficients of ``F(s)`` (18), monic, highest power first.
+    """Coefficients of ``F(s)`` (19), monic, highest power first.
 
     ``F(s) = [(h1 s^2 - h2 s + h3)^2 - 4 h0^2 G(s)] / (h1^2 - 4 h0^2)``.
 
     Raises
     ------
     ValueError
-        If ``h1^2 = 4 h0^2`` (a self-dual or anti-self-dual state): (18) is not defined.
+        If ``h1^2 = 4 h0^2`` (a self-dual or anti-self-dual state): (19) is not defined.
     """
     a = _check_a(a)
     h = np.array(h, dtype=float)
@@ -224,7 +224,7 @@ class Kotter:
     h : ndarray (4,)
         ``(h0, h1, h2, h3)`` (6)-(7), complementary-pair ``h2``, ``h3``.
     s : ndarray (4,) complex
-        Roots ``s_1 .. s_4`` of ``F`` (18): ``s1`` the non-real root of largest
+        Roots ``s_1 .. s_4`` of ``F`` (19): ``s1`` the non-real root of largest
         imaginary part, ``s2`` the root nearest ``conj(s1)``, ``s3`` the
         remaining one of larger imaginary part (then real part), ``s4`` the
         last; all real: descending.
@@ -234,30 +234,34 @@ class Kotter:
     sqrt_fprime : ndarray (4,) complex
         ``sqrt(F'(s_p))``, principal.
     l_p : ndarray (4, 3) complex
-        ``l^(p) = l(s_p)/sqrt(F'(s_p))`` (19); ``l_p[p-1]`` is ``l^(p)``.
+        ``l^(p) = l(s_p)/sqrt(F'(s_p))`` (20); ``l_p[p-1]`` is ``l^(p)``.
     Delta : ndarray (3, 3) complex
         ``Delta[p-1, j-1] = Delta_j^(p)`` (25), corrected (a determinant).
     xi, eta : ndarray (3,) complex
-        Kötter's vectors (21).
+        Kötter's vectors (22).
     sqrt_d, d : ndarray (3,) complex
         ``sqrt(d_j)`` and ``d_j`` (26).
     alpha, beta, gamma, delta : ndarray (3,) complex
         (23): ``m_j = alpha_j xi_j + beta_j eta_j``,
         ``n_j = gamma_j xi_j + delta_j eta_j`` ((24) corrected).
     A, B : ndarray (3,) complex
-        (37): on the quadrics (11), ``H0 = sum_j A_j (xi_j^2 - eta_j^2) + B_j xi_j eta_j``.
-    abgd38 : ndarray (4,) complex
-        The constants ``(alpha, beta, gamma, delta)`` of (38):
-        ``A_j = alpha + beta d_j + gamma/d_j``, ``B_j = delta (d_j + 1/d_j)``.
+        (38): on the quadrics (11), ``H0 = sum_j A_j (xi_j^2 - eta_j^2) + B_j xi_j eta_j``
+        (the unique representative of that form; holds as printed).
+    abgd39 : ndarray (4,) complex
+        The constants ``(alpha, beta, gamma, delta)`` of (39):
+        ``A_j = alpha + beta d_j + gamma/d_j``, ``B_j = delta (d_j + 1/d_j)``, in closed
+        form with ``K``, ``eps`` below, ``kappa`` and ``e1 = d1 + d2 + d3``:
+        ``beta = -K/kappa``, ``gamma = eps^2 d4^2 K/kappa``, ``delta = 2 eps d4 K/kappa``,
+        ``alpha = K/(2 kappa) (kappa eps^2 + (e1 - d4)(1 - eps^2 d4^2))``.
     eps, K : complex
-        (39) corrected: ``H0 = K g^2 (1 - eps P_0)^2`` with
+        (40) corrected: ``H0 = K g^2 (1 - eps P_0)^2`` with
         ``K = kappa sum_j c~_j d_j beta_j delta_j`` and
         ``2 K eps = kappa sum_j c~_j (alpha_j delta_j + beta_j gamma_j)``,
         ``kappa = prod_{m=1}^3 (d_m - d4)``, ``c~_j`` of (33).
     P0 : complex
         ``P_0 = sqrt(z1 z2)`` (27) in the curve's branch.
     g : complex
-        The factor of (36); (41) corrected: ``g = sqrt(h0/K) / (1 - eps P_0)``.
+        The factor of (37); (42) corrected: ``g = sqrt(h0/K) / (1 - eps P_0)``.
     z1, y1, z2, y2 : complex
         The two points of the curve (8), ``y_i^2 = R(z_i)``.
     branch : ndarray (5,) int8
@@ -292,7 +296,7 @@ class Kotter:
     delta: np.ndarray
     A: np.ndarray
     B: np.ndarray
-    abgd38: np.ndarray
+    abgd39: np.ndarray
     eps: Any
     K: Any
     P0: Any
@@ -323,7 +327,7 @@ _FIELD_SHAPES = {
     "delta": (3,),
     "A": (3,),
     "B": (3,),
-    "abgd38": (4,),
+    "abgd39": (4,),
     "eps": (),
     "K": (),
     "P0": (),
@@ -348,7 +352,7 @@ def _make_curve(d: np.ndarray) -> Any:
 def kotter(a: Any, b: Any, l: Any) -> Kotter:
     """Schottky-Kötter coordinates of states ``l`` of the top ``(a, b)``.
 
-    Computes (12)-(26), (37)-(41) and the points of the curve (36) for each
+    Computes (12)-(26), (38)-(42) and the points of the curve (37) for each
     state; see :class:`Kotter` for the fields and ``docs/kotter.md`` for every
     convention. Only ``a`` and the state enter: ``b`` (checked) fixes the
     time evolution, not the reduction.
@@ -368,7 +372,7 @@ def kotter(a: Any, b: Any, l: Any) -> Kotter:
     ------
     ValueError
         Non-finite input; repeated ``a_i``; ``h0 = 0`` or ``h1^2 = 4 h0^2``
-        (``F`` (18) undefined or with double roots); repeated roots of ``F``;
+        (``F`` (19) undefined or with double roots); repeated roots of ``F``;
         a root of ``F`` at some ``a_j``; coinciding branch points ``d_j`` of
         the curve (its genus drops); ``z1 = z2``; ``1 - eps P_0 = 0``.
     """
@@ -399,7 +403,7 @@ def from_kotter(a: Any, b: Any, k: Kotter) -> np.ndarray:
     Uses only the curve's points (with their offsets ``zd`` from the branch
     points when ``k.zd`` is not ``None``), ``g`` and the branch of the ``P_j``
     (with the level set's constants ``d_j`` and ``alpha_j .. delta_j``):
-    ``xi_j = sqrt(c_j) g P_kl``, ``eta_j = sqrt(c_j) g P_j4`` (36), then (23)
+    ``xi_j = sqrt(c_j) g P_kl``, ``eta_j = sqrt(c_j) g P_j4`` (37), then (23)
     ``m_j = alpha_j xi_j + beta_j eta_j``, ``n_j = gamma_j xi_j + delta_j eta_j``.
 
     Returns

@@ -575,9 +575,9 @@ class ManakovTop(FrahmTop):
         """Schottky–Kötter coordinates of the state(s) ``l`` (n = 4 only).
 
         Shorthand for :func:`manakov.kotter` ``(self.a, self.b, l)``: the roots of
-        F (18), Kötter's vectors ξ, η (21), the curve constants d (26), and the two
+        F (19), Kötter's vectors ξ, η (22), the curve constants d (26), and the two
         points of the curve (8) with g, such that ξ_j = √c_j g P_kl, η_j = √c_j g P_j4
-        (36), (41). See ``docs/kotter.md``.
+        (37), (42). See ``docs/kotter.md``.
 
         Returns
         -------
@@ -592,7 +592,7 @@ class ManakovTop(FrahmTop):
         """Map Schottky–Kötter coordinates back to the state l (n = 4 only).
 
         Shorthand for :func:`manakov.from_kotter` ``(self.a, self.b, k)``: rebuilds
-        ξ, η from the curve points and g by (36) and inverts (23).
+        ξ, η from the curve points and g by (37) and inverts (23).
 
         Returns
         -------

@@ -1,5 +1,5 @@
 //! The genus-2 curve (8), Weierstrass' Wurzelfunktionen (27)–(28), their
-//! identities (29)–(33), and the inverse map from Kötter's (ξ, η) (36) back to
+//! identities (29)–(33), and the inverse map from Kötter's (ξ, η) (37) back to
 //! the points of the curve.
 //!
 //! # The curve
@@ -134,7 +134,7 @@ pub struct WurzelPoints {
     pub z2: Complex64,
     /// Its `y`.
     pub y2: Complex64,
-    /// The factor of (36): `ξ_j = √c_j g P_kl`, `η_j = √c_j g P_j4`.
+    /// The factor of (37): `ξ_j = √c_j g P_kl`, `η_j = √c_j g P_j4`.
     pub g: Complex64,
     /// The branch of the `P_j` (see the module docs), normalised to `eps[4] = +1`.
     pub eps: [i8; 5],
@@ -410,7 +410,7 @@ impl KotterCurve {
         self.wurzel_unchecked(&self.point(z1, y1), &self.point(z2, y2), eps)
     }
 
-    /// Kötter's vectors (36): `ξ_j = √c_j g P_kl`, `η_j = √c_j g P_j4`,
+    /// Kötter's vectors (37): `ξ_j = √c_j g P_kl`, `η_j = √c_j g P_j4`,
     /// `(j, k, l)` cyclic, from the points, `g` and the branch `eps`.
     /// `sqrt_c = None` takes `√c_j = sqrt_principal(c_j)`.
     #[allow(clippy::too_many_arguments)]
@@ -455,7 +455,7 @@ impl KotterCurve {
         }
     }
 
-    /// The inverse of (36): from `ξ_j = √c_j g P_kl`, `η_j = √c_j g P_j4`
+    /// The inverse of (37): from `ξ_j = √c_j g P_kl`, `η_j = √c_j g P_j4`
     /// (`j = 1, 2, 3`, `(j, k, l)` cyclic) recover `g`, the points
     /// `(z1, y1)`, `(z2, y2)` and the branch `eps` of the `P_j`.
     ///
@@ -499,7 +499,7 @@ impl KotterCurve {
         let sc = self.sqrt_c_checked(sqrt_c)?;
         let ct = self.c_tilde();
         let d = &self.d;
-        // (36) is homogeneous in g: solve for the data scaled to max|·| = 1
+        // (37) is homogeneous in g: solve for the data scaled to max|·| = 1
         // (so that g² neither overflows nor underflows) and scale g back.
         let scale = xi
             .iter()
@@ -788,7 +788,7 @@ impl KotterCurve {
     }
 }
 
-/// (36) from the Wurzelfunktionen: `ξ_j = √c_j g P_kl`, `η_j = √c_j g P_j4`.
+/// (37) from the Wurzelfunktionen: `ξ_j = √c_j g P_kl`, `η_j = √c_j g P_j4`.
 fn xi_eta_of(w: &Wurzel, sc: &[Complex64; 3], g: Complex64) -> ([Complex64; 3], [Complex64; 3]) {
     let mut xi = [Complex64::new(0.0, 0.0); 3];
     let mut eta = xi;

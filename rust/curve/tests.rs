@@ -1,5 +1,5 @@
 //! Tests of the curve (8), the Wurzelfunktionen (27)–(28), the identities
-//! (29)–(33) and the inverse of (36).
+//! (29)–(33) and the inverse of (37).
 
 use super::*;
 use approx::assert_relative_eq;
@@ -305,7 +305,7 @@ proptest! {
         }
     }
 
-    /// (z1, y1, z2, y2, g, eps) → (ξ, η) (36) → back, with g's sign from g_ref.
+    /// (z1, y1, z2, y2, g, eps) → (ξ, η) (37) → back, with g's sign from g_ref.
     #[test]
     fn inverse_round_trip(d1 in cplx(-2.0, 2.0), d2 in cplx(-2.0, 2.0), d3 in cplx(-2.0, 2.0),
                           z1 in cplx(-3.0, 3.0), z2 in cplx(-3.0, 3.0), g in cplx(-2.0, 2.0),
@@ -509,7 +509,7 @@ fn stats_forward_error() {
 /// A point 1e-11 from the branch point `d_1` (offsets exact by construction):
 /// the inverse map returns offsets `zd` that resolve it — the offset to `d_1`
 /// comes back to 1e-8 relative (a double `z` alone fixes it only to
-/// `u |z| / 1e-11` ≈ 2e-5) — and (36) at the recovered points, evaluated from
+/// `u |z| / 1e-11` ≈ 2e-5) — and (37) at the recovered points, evaluated from
 /// the offsets, reproduces `(ξ, η)` to [`BACKWARD_RTOL`].
 #[test]
 fn inverse_resolves_points_near_branch_points() {

@@ -1,5 +1,5 @@
-//! Schottky's `l(s)`, `f(s)` (12)–(17) and Kötter's reduction (18)–(26),
-//! (37)–(41): from a state `l` of the top to the vectors `ξ, η`, the constants
+//! Schottky's `l(s)`, `f(s)` (12)–(18) and Kötter's reduction (19)–(26),
+//! (38)–(42): from a state `l` of the top to the vectors `ξ, η`, the constants
 //! `d_j` of Kötter's quadrics (11) and of the curve (8), and back.
 //!
 //! # Notation and conventions (all of them; see `docs/kotter.md`)
@@ -10,11 +10,11 @@
 //! * Integrals: `h0 = l12 l34 + l23 l14 + l31 l24` (6), `h1 = Σ l_jk²`, and
 //!   **`h2 = Σ_{j<k} (a_l + a_m) l_jk²`, `h3 = Σ_{j<k} a_l a_m l_jk²`** with
 //!   `{l, m}` the complement of `{j, k}` — the forms for which the closed form
-//!   (14) holds (erratum to (7)/(14), `docs/errata-kotter.md`).
+//!   (15) holds (erratum to (7)/(15), `docs/errata-kotter.md`).
 //! * `√s_j4` is the principal root of `s_j4 = (s − a_j)(s − a_4)`, and
 //!   `√s_kl := √G / √s_j4` for a chosen branch `√G` of `G(s) = Π (s − a_j)`,
-//!   so that `√s_j4 √s_kl = √G` for every `j` (the cross term of (14)).
-//! * At a root `s_p` of `F` (18), the branch of `√G` is
+//!   so that `√s_j4 √s_kl = √G` for every `j` (the cross term of (15)).
+//! * At a root `s_p` of `F` (19), the branch of `√G` is
 //!   `σ_p = −(h1 s_p² − h2 s_p + h3)/(2 h0)`, the one on which `f(s_p) = 0`.
 //! * `√F'(s_p)` principal. Order of the roots: `s1` the non-real root of
 //!   largest imaginary part, `s2` the root nearest `conj(s1)`, `s3` the
@@ -25,7 +25,6 @@
 //!   `(√s_j4^(q) √s_kl^(r) − √s_j4^(r) √s_kl^(q)) / (√F'(s_q) √F'(s_r))`
 //!   (erratum: printed with one root over the whole difference).
 
-use nalgebra::{DMatrix, DVector};
 use num_complex::Complex64;
 
 use crate::curve::{CurvePoint, KotterCurve, WurzelPoints};
@@ -41,13 +40,13 @@ const I: C = C::new(0.0, 1.0);
 pub const CYCLIC: [(usize, usize, usize); 3] = [(0, 1, 2), (1, 2, 0), (2, 0, 1)];
 
 /// `|h1² − 4 h0²| ≤ DEGENERATE_RTOL · h1²` is treated as `h1² = 4 h0²`: the
-/// denominator of (18) vanishes. `h1² − 4h0² = |m − n|² |m + n|² ≥ 0` is a
+/// denominator of (19) vanishes. `h1² − 4h0² = |m − n|² |m + n|² ≥ 0` is a
 /// difference of rounded squares, accurate to a few ulps of `h1²`; 1e-12
 /// leaves room for that and for states given to ~12 digits.
 pub const DEGENERATE_RTOL: f64 = 1e-12;
 
 /// Roots of `F` closer than `REPEATED_ROOT_RTOL` times their scale are
-/// treated as repeated: then `F'(s_p) → 0` and `l^(p)` (19) is undefined. A
+/// treated as repeated: then `F'(s_p) → 0` and `l^(p)` (20) is undefined. A
 /// double root is located only to `√ε ≈ 1.5e-8` relative, so two roots
 /// within 1e-7 are indistinguishable from a double root.
 pub const REPEATED_ROOT_RTOL: f64 = 1e-7;
@@ -59,12 +58,13 @@ pub const REPEATED_ROOT_RTOL: f64 = 1e-7;
 /// reported as repeated anyway).
 pub const ROOT_STAGNATION: f64 = 1e-8;
 
-/// Residual (relative to the size of the data) above which the structural
-/// fits of (37)–(38) and the perfect square of the corrected (39) are
-/// reported as failing: they hold to rounding (a few 1e-13 on the reference
-/// tops, up to ~1e-7 when two `d_j` nearly coincide, which amplifies rounding
-/// in `α_j … δ_j` by `1/|d_j − d_k|`); 1e-6 still rejects an inconsistent
-/// structure, whose residual is O(1).
+/// Residual (relative to the size of the terms) above which the existence
+/// conditions of (38)–(39) (`Σ c_j q_j = 0`, `Σ c_j (p_j + r_j) = 0`) and the
+/// perfect square of the corrected (40) are reported as failing: they hold to
+/// rounding (a few 1e-13 on the reference tops, up to ~1e-7 when two `d_j`
+/// nearly coincide, which amplifies rounding in `α_j … δ_j` by
+/// `1/|d_j − d_k|`); 1e-6 still rejects an inconsistent structure, whose
+/// residual is O(1).
 pub const STRUCTURE_RTOL: f64 = 1e-6;
 
 /// The principal square root of the curve module (`−π/2 < arg √w ≤ π/2`,
@@ -95,7 +95,7 @@ pub fn l_from_m_n(m: &[f64; 3], n: &[f64; 3]) -> [f64; 6] {
 }
 
 /// The integrals `(h0, h1, h2, h3)`: `H0` (6), `H1` (7), and `H2`, `H3` in the
-/// form consistent with (14): `H2 = Σ_{j<k} (a_l + a_m) l_jk²`,
+/// form consistent with (15): `H2 = Σ_{j<k} (a_l + a_m) l_jk²`,
 /// `H3 = Σ_{j<k} a_l a_m l_jk²`, `{l, m}` the complement of `{j, k}`.
 pub fn integrals(a: &[f64; 4], l: &[f64; 6]) -> [f64; 4] {
     let (m, n) = m_n(l);
@@ -115,12 +115,12 @@ fn s_pair(s: C, a: &[f64; 4], j: usize, k: usize) -> C {
     (s - a[j]) * (s - a[k])
 }
 
-/// `G(s) = Π_{j=1}^{4} (s − a_j)` (14).
+/// `G(s) = Π_{j=1}^{4} (s − a_j)` (15).
 pub fn g_poly(a: &[f64; 4], s: C) -> C {
     a.iter().fold(ONE, |acc, &aj| acc * (s - aj))
 }
 
-/// Schottky's vector (12) and the vector `m(s)` of (16) on the branch
+/// Schottky's vector (12) and the vector `m(s)` of (17) on the branch
 /// `√s_j4 √s_kl = sqrt_g` (`√s_j4` principal, see the module docs):
 /// `l_j(s) = √s_j4 m_j + √s_kl n_j`, `m_j(s) = √s_kl m_j + √s_j4 n_j`.
 ///
@@ -202,19 +202,19 @@ pub fn branch_sign(a: &[f64; 4], s: C, sqrt_g: C) -> Result<f64> {
     Ok(if tau.re >= 0.0 { 1.0 } else { -1.0 })
 }
 
-/// The vector `m_b(s)` of the Lax matrix `M_b(s)` (17) for the top with
-/// parameters `(a, b)`, so that `L̇(s) = [L(s), M_b(s)]` (15) along the flow
+/// The vector `m_b(s)` of the Lax matrix `M_b(s)` (18) for the top with
+/// parameters `(a, b)`, so that `L̇(s) = [L(s), M_b(s)]` (16) along the flow
 /// (1)–(2), on the branch `√s_j4 √s_kl = sqrt_g` (`√s_j4` principal):
 ///
 /// `m_b(s) = −τ [p2 m(s) + p3 (e2 m(s) + m^[ω3](s)) / (e1 − s)]`
 ///
 /// with `(p0, …, p3)` the cubic interpolant of `b` over `a`
-/// ([`cubic_interpolant`]), `m(s)` the vector (16) (`m^[l]`), `m^[X](s)` the
+/// ([`cubic_interpolant`]), `m(s)` the vector (17) (`m^[l]`), `m^[X](s)` the
 /// same built from an antisymmetric `X` instead of `l`
 /// (`m^[X]_j = √s_kl X_kl + √s_j4 X_j4`), `(ω3)_ij = (a_i² + a_i a_j + a_j²) l_ij`
 /// (the angular velocity of the top with `b = a³`), `e1 = Σ a_i`,
 /// `e2 = Σ_{i<j} a_i a_j`, and `τ = ±1` the branch sign ([`branch_sign`]).
-/// The printed (16)–(17) is the case `b = a²` on the branch `τ = −1`
+/// The printed (17)–(18) is the case `b = a²` on the branch `τ = −1`
 /// (erratum, `docs/errata-kotter.md`; derivation in `docs/kotter.md` §2).
 ///
 /// Errors: those of [`schottky`] and [`branch_sign`]; `s = e1` when
@@ -252,15 +252,15 @@ pub fn lax_m(a: &[f64; 4], b: &[f64; 4], l: &[f64; 6], s: C, sqrt_g: C) -> Resul
     Ok(mb.map(|v| -tau * v))
 }
 
-/// The polynomial part `h1 s² − h2 s + h3` of (14).
+/// The polynomial part `h1 s² − h2 s + h3` of (15).
 pub fn p_poly(h: &[f64; 4], s: C) -> C {
     (s * h[1] - h[2]) * s + h[3]
 }
 
-/// Coefficients of `F(s)` (18), monic, highest power first:
+/// Coefficients of `F(s)` (19), monic, highest power first:
 /// `F = [(h1 s² − h2 s + h3)² − 4 h0² G(s)] / (h1² − 4 h0²)`.
 ///
-/// Errors: `h1² = 4 h0²` (to [`DEGENERATE_RTOL`]), i.e. `m = ±n`: (18) is not
+/// Errors: `h1² = 4 h0²` (to [`DEGENERATE_RTOL`]), i.e. `m = ±n`: (19) is not
 /// defined (and `f(s)` has fewer than four zeros).
 pub fn quartic_f(a: &[f64; 4], h: &[f64; 4]) -> Result<[f64; 5]> {
     let [h0, h1, h2, h3] = *h;
@@ -270,7 +270,7 @@ pub fn quartic_f(a: &[f64; 4], h: &[f64; 4]) -> Result<[f64; 5]> {
             what: "state l",
             reason: format!(
                 "h1^2 - 4 h0^2 = {den:e} vanishes (h1 = {h1}, h0 = {h0}; the state is \
-                 self-dual or anti-self-dual, m = +-n): F(s) (18) is not defined"
+                 self-dual or anti-self-dual, m = +-n): F(s) (19) is not defined"
             ),
         });
     }
@@ -305,12 +305,12 @@ fn horner(c: &[f64; 5], s: C) -> (C, C) {
     (p, dp)
 }
 
-/// The four roots of the monic quartic `F` (18), by the Aberth–Ehrlich
+/// The four roots of the monic quartic `F` (19), by the Aberth–Ehrlich
 /// iteration followed by Newton polishing, in the documented order (module
 /// docs).
 ///
 /// Errors: two roots closer than [`REPEATED_ROOT_RTOL`] (repeated roots of
-/// F, where (19) divides by `F'(s_p) = 0`); no convergence.
+/// F, where (20) divides by `F'(s_p) = 0`); no convergence.
 pub fn quartic_roots(f: &[f64; 5]) -> Result<[C; 4]> {
     check_finite("F coefficients", f)?;
     // Cauchy bound for the initial circle.
@@ -361,7 +361,7 @@ pub fn quartic_roots(f: &[f64; 5]) -> Result<[C; 4]> {
                 return Err(Error::InvalidArgument {
                     what: "state l",
                     reason: format!(
-                        "F(s) (18) has a repeated root s = {} (|s_{} - s_{}| = {:e}): l^(p) (19) \
+                        "F(s) (19) has a repeated root s = {} (|s_{} - s_{}| = {:e}): l^(p) (20) \
                          divides by sqrt(F'(s_p)) = 0",
                         z[i],
                         i + 1,
@@ -374,7 +374,7 @@ pub fn quartic_roots(f: &[f64; 5]) -> Result<[C; 4]> {
     }
     if !converged && last > ROOT_STAGNATION {
         return Err(Error::NoConvergence {
-            what: "roots of F(s) (18)",
+            what: "roots of F(s) (19)",
             tol: ROOT_STAGNATION,
             reached: last,
             iterations: 500,
@@ -441,13 +441,13 @@ fn order_roots(z: [C; 4], scale: f64) -> [C; 4] {
 pub struct KotterConstants {
     /// `(h0, h1, h2, h3)` ([`integrals`]).
     pub h: [f64; 4],
-    /// Roots `s_1 … s_4` of `F` (18), in the documented order.
+    /// Roots `s_1 … s_4` of `F` (19), in the documented order.
     pub s: [C; 4],
     /// `σ_p`, the branch of `√G(s_p)` on which `f(s_p) = 0`.
     pub sigma: [C; 4],
     /// `√F'(s_p)`, principal.
     pub sqrt_fprime: [C; 4],
-    /// `u[p][j] = √s_j4(s_p) / √F'(s_p)` (coefficient of `m_j` in `l_j^(p)` (19)).
+    /// `u[p][j] = √s_j4(s_p) / √F'(s_p)` (coefficient of `m_j` in `l_j^(p)` (20)).
     pub u: [[C; 3]; 4],
     /// `v[p][j] = √s_kl(s_p) / √F'(s_p)` (coefficient of `n_j`).
     pub v: [[C; 3]; 4],
@@ -466,17 +466,21 @@ pub struct KotterConstants {
     pub gamma: [C; 3],
     /// See [`KotterConstants::alpha`].
     pub delta: [C; 3],
-    /// `A_j` of (37)–(38): on Kötter's quadrics
-    /// `H0 = Σ_j A_j (ξ_j² − η_j²) + B_j ξ_j η_j`.
+    /// `A_j = α + β d_j + γ/d_j` of (38)–(39): on Kötter's quadrics
+    /// `H0 = Σ_j A_j (ξ_j² − η_j²) + B_j ξ_j η_j` (the unique representative of
+    /// that form).
     pub a_coef: [C; 3],
-    /// `B_j` of (37)–(38).
+    /// `B_j = δ (d_j + 1/d_j)` of (38)–(39).
     pub b_coef: [C; 3],
-    /// `(α, β, γ, δ)` of (38) (the paper's unnamed constants; not the `α_j` of (24)).
-    pub abgd38: [C; 4],
-    /// `ε` of (39)–(40), corrected: `H0 = K g² (1 − ε P_0)²` with [`KotterConstants::k`];
+    /// `(α, β, γ, δ)` of (39) (the paper's unnamed constants; not the `α_j` of (24)),
+    /// in closed form with `K`, `ε` of the corrected (40), `κ = Π_{m=1}^{3} (d_m − d_4)`,
+    /// `e1 = d_1 + d_2 + d_3`: `β = −K/κ`, `γ = ε² d_4² K/κ`, `δ = 2 ε d_4 K/κ`,
+    /// `α = (K/(2κ)) (κ ε² + (e1 − d_4)(1 − ε² d_4²))`.
+    pub abgd39: [C; 4],
+    /// `ε` of (40)–(41), corrected: `H0 = K g² (1 − ε P_0)²` with [`KotterConstants::k`];
     /// `ε = Σ_j c̃_j (α_j δ_j + β_j γ_j) / (2 Σ_j c̃_j d_j β_j δ_j)`.
     pub eps: C,
-    /// `K` of the corrected (39) (printed as `1/(4 ε d_4)`):
+    /// `K` of the corrected (40) (printed as `1/(4 ε d_4)`):
     /// `K = κ Σ_j c̃_j d_j β_j δ_j`, `κ = Π_{m=1}^{3} (d_m − d_4)`, `c̃_j` of (33).
     pub k: C,
 }
@@ -485,7 +489,7 @@ pub struct KotterConstants {
 /// parameters `a` (only `a` and the integrals of `l` enter).
 ///
 /// Errors: non-finite or repeated `a`; non-finite `l`; `h0 = 0` or
-/// `h1² = 4h0²` (F (18) not defined or with double roots); repeated roots of
+/// `h1² = 4h0²` (F (19) not defined or with double roots); repeated roots of
 /// `F`; a root `s_p` at some `a_j` (then `√s_kl` is 0/0); `Δ_j^(3) = 0`
 /// (the pair `s1, s2` does not determine `m_j, n_j`); `d_j` zero or infinite.
 pub fn kotter_constants(a: &[f64; 4], l: &[f64; 6]) -> Result<KotterConstants> {
@@ -526,7 +530,7 @@ pub fn constants_from_h(a: &[f64; 4], h: &[f64; 4]) -> Result<KotterConstants> {
 /// When `s_p` is nearer to `a_i` than a tenth of the distance from `a_i` to the
 /// other `a`'s, `t = s_p − a_i` is re-solved by Newton's method on
 /// `(P(a_i) + P'(a_i) t + h1 t²)² − 4 h0² t Π_{m≠i}(a_i − a_m + t) = 0`
-/// (the numerator of (18) at `s = a_i + t`, using `G(a_i) = 0`), whose terms
+/// (the numerator of (19) at `s = a_i + t`, using `G(a_i) = 0`), whose terms
 /// are all of the size of `t`; the other offsets are `(a_i − a_m) + t`.
 fn root_offsets(a: &[f64; 4], h: &[f64; 4], p_at_a: &[f64; 4], sp: C) -> ([C; 4], C) {
     let mut best = 0;
@@ -580,7 +584,7 @@ fn constants_impl(a: &[f64; 4], h: &[f64; 4], p_at_a: &[f64; 4]) -> Result<Kotte
         return Err(Error::InvalidArgument {
             what: "state l",
             reason: format!(
-                "h0 = {} vanishes: F(s) (18) = (h1 s^2 - h2 s + h3)^2 / h1^2 has double roots and \
+                "h0 = {} vanishes: F(s) (19) = (h1 s^2 - h2 s + h3)^2 / h1^2 has double roots and \
                  the branch sigma = -(h1 s^2 - h2 s + h3)/(2 h0) is undefined",
                 h[0]
             ),
@@ -604,7 +608,7 @@ fn constants_impl(a: &[f64; 4], h: &[f64; 4], p_at_a: &[f64; 4]) -> Result<Kotte
                 return Err(Error::InvalidArgument {
                     what: "state l",
                     reason: format!(
-                        "the root s_{} = {} of F (18) coincides with a_{} = {aj}: sqrt(s_kl) = \
+                        "the root s_{} = {} of F (19) coincides with a_{} = {aj}: sqrt(s_kl) = \
                          sqrt(G)/sqrt(s_j4) is 0/0 there",
                         p + 1,
                         s[p],
@@ -657,7 +661,7 @@ fn constants_impl(a: &[f64; 4], h: &[f64; 4], p_at_a: &[f64; 4]) -> Result<Kotte
             });
         }
     }
-    let (a_coef, b_coef, abgd38, eps, k) = h0_structure(&alpha, &beta, &gamma, &delta, &d)?;
+    let (a_coef, b_coef, abgd39, eps, k) = h0_structure(&alpha, &beta, &gamma, &delta, &d)?;
     Ok(KotterConstants {
         h: *h,
         s,
@@ -674,7 +678,7 @@ fn constants_impl(a: &[f64; 4], h: &[f64; 4], p_at_a: &[f64; 4]) -> Result<Kotte
         delta,
         a_coef,
         b_coef,
-        abgd38,
+        abgd39,
         eps,
         k,
     })
@@ -682,49 +686,30 @@ fn constants_impl(a: &[f64; 4], h: &[f64; 4], p_at_a: &[f64; 4]) -> Result<Kotte
 
 type H0Structure = ([C; 3], [C; 3], [C; 4], C, C);
 
-/// Least-squares solve of a small complex system, returning the solution and
-/// the residual relative to `|rhs|`.
-fn lstsq(rows: &[Vec<C>], rhs: &[C]) -> Result<(Vec<C>, f64)> {
-    let nr = rows.len();
-    let nc = rows.first().map_or(0, |r| r.len());
-    // Columns are equilibrated first: the unknowns (K ε², 2Kε, K, ...) differ
-    // by many orders of magnitude, and an unscaled SVD cut-off would discard
-    // the small ones.
-    let colnorm: Vec<f64> = (0..nc)
-        .map(|j| {
-            let n = rows.iter().map(|r| r[j].norm_sqr()).sum::<f64>().sqrt();
-            if n > 0.0 {
-                n
-            } else {
-                1.0
-            }
-        })
-        .collect();
-    let m = DMatrix::from_fn(nr, nc, |i, j| rows[i][j] / colnorm[j]);
-    let b = DVector::from_row_slice(rhs);
-    let svd = m.clone().svd(true, true);
-    let y = svd.solve(&b, 1e-14).map_err(|e| Error::InvalidArgument {
-        what: "Koetter constants",
-        reason: format!("least-squares solve failed: {e}"),
-    })?;
-    let res = (&m * &y - &b).norm() / b.norm().max(f64::MIN_POSITIVE);
-    Ok(((0..nc).map(|j| y[j] / colnorm[j]).collect(), res))
-}
-
-/// (37)–(39): `H0 = Σ_j m_j n_j` as a quadratic form in `ξ, η`, reduced modulo
-/// Kötter's quadrics (11).
+/// (38)–(40): `H0 = Σ_j m_j n_j` as a quadratic form in `ξ, η`, reduced modulo
+/// Kötter's quadrics (11), all in closed form.
 ///
-/// `H0 = Σ_j a_j ξ_j² + b_j ξ_j η_j + c_j η_j²` with `a_j = α_j γ_j`,
-/// `b_j = α_j δ_j + β_j γ_j`, `c_j = β_j δ_j` (from (23)). Adding
-/// `λ Q1 + μ Q2 + ν Q3` of (11) gives the form (37) when
-/// `a_j + λ + ν d_j = −(c_j + λ + ν/d_j) =: A_j` and `B_j = b_j + μ`; the
-/// paper's (38) then reads `A_j = α + β d_j + γ/d_j`, `B_j = δ (d_j + 1/d_j)`.
-/// The corrected (39): on the quadrics, by (30a), (30b), (31b),
+/// `H0 = Σ_j p_j ξ_j² + q_j ξ_j η_j + r_j η_j²` with `p_j = α_j γ_j`,
+/// `q_j = α_j δ_j + β_j γ_j`, `r_j = β_j δ_j` (from (23)). Adding
+/// `λ Q1 + μ Q2 + ν Q3` of (11) gives the form (38) when
+/// `p_j + λ + ν d_j = −(r_j + λ + ν/d_j) =: A_j` and `B_j = q_j + μ`; (39) asks
+/// `A_j = α + β d_j + γ/d_j`, `B_j = δ (d_j + 1/d_j)`. Times `d_j`, these are
+/// values at `x = d_j` of quadratics in `x`, so a representative exists iff the
+/// Lagrange interpolants through `d_1, d_2, d_3` have equal `x²` and `x⁰`
+/// coefficients: `Σ_j c_j q_j = 0` and `Σ_j c_j (p_j + r_j) = 0` (`c_j` of (33));
+/// both hold identically (they are checked here to [`STRUCTURE_RTOL`]).
+///
+/// The corrected (40): on the quadrics, by (30a), (30b), (31b),
 /// `H0 ≡ K/d4 Σ η_j²/(d_j − d4) + 2Kε Σ ξ_jη_j/(d_j − d4) + Kε² Σ d_j ξ_j²/(d_j − d4)`
 /// `= K g² (1 − ε P_0)²` with, in closed form (`κ = Π_m (d_m − d4)`,
 /// `c̃_j` of (33)),
 /// `K = κ Σ_j c̃_j d_j β_j δ_j`, `2Kε = κ Σ_j c̃_j (α_j δ_j + β_j γ_j)`,
 /// `Kε² = (κ/d4) Σ_j c̃_j α_j γ_j`; the perfect square `(Kε)² = K · Kε²` is checked.
+/// Reducing this representative to the form (38) (the residue sums
+/// `Σ_j c̃_j d_j^n/(d_j − d4) = d4^n/κ`, `n ≤ 2`) gives (39) explicitly:
+/// `β = −K/κ`, `γ = ε² d4² K/κ`, `δ = 2 ε d4 K/κ`,
+/// `α = (K/(2κ)) (κ ε² + (e1 − d4)(1 − ε² d4²))`, `e1 = d1 + d2 + d3`
+/// (docs/kotter.md §7).
 fn h0_structure(
     alpha: &[C; 3],
     beta: &[C; 3],
@@ -736,43 +721,47 @@ fn h0_structure(
     let ac: [C; 3] = std::array::from_fn(|j| alpha[j] * gamma[j]);
     let bc: [C; 3] = std::array::from_fn(|j| alpha[j] * delta[j] + beta[j] * gamma[j]);
     let cc: [C; 3] = std::array::from_fn(|j| beta[j] * delta[j]);
+    let ct: [C; 3] = std::array::from_fn(|j| {
+        let (k2, l2) = ((j + 1) % 3, (j + 2) % 3);
+        ONE / ((d[j] - d[k2]) * (d[j] - d[l2]))
+    });
+    let c33: [C; 3] = std::array::from_fn(|j| (d[j] - d4) * ct[j]);
 
-    // (37): unknowns (λ, ν) from a_j + c_j + 2λ + ν (d_j + 1/d_j) = 0; μ and δ38 from
-    // b_j + μ = δ38 (d_j + 1/d_j).
-    let rows: Vec<Vec<C>> = (0..3)
-        .map(|j| vec![C::new(2.0, 0.0), d[j] + ONE / d[j]])
-        .collect();
-    let rhs: Vec<C> = (0..3).map(|j| -(ac[j] + cc[j])).collect();
-    let (x, r1) = lstsq(&rows, &rhs)?;
-    let (lam, nu) = (x[0], x[1]);
-    let a_coef: [C; 3] = std::array::from_fn(|j| ac[j] + lam + nu * d[j]);
-    let rows: Vec<Vec<C>> = (0..3).map(|j| vec![-ONE, d[j] + ONE / d[j]]).collect();
-    let (x, r2) = lstsq(&rows, &bc)?;
-    let (mu, delta38) = (x[0], x[1]);
-    let b_coef: [C; 3] = std::array::from_fn(|j| bc[j] + mu);
-    // A_j = α + β d_j + γ / d_j: three equations, three unknowns.
-    let rows: Vec<Vec<C>> = (0..3).map(|j| vec![ONE, d[j], ONE / d[j]]).collect();
-    let (x, _) = lstsq(&rows, &a_coef)?;
-    let abgd38 = [x[0], x[1], x[2], delta38];
+    // (38)–(39) exist iff Σ c_j q_j = 0 and Σ c_j (p_j + r_j) = 0 (the x² and x⁰
+    // coefficients of the interpolants agree); relative to the size of the products
+    // that enter (q_j and p_j + r_j themselves can cancel, and the sums cancel by
+    // 1/|d_j − d_k| when two d_j nearly coincide).
+    let rel_sum = |t: [C; 3], size: [f64; 3]| {
+        let size: f64 = size.iter().sum();
+        (t[0] + t[1] + t[2]).norm() / size.max(f64::MIN_POSITIVE)
+    };
+    let r1 = rel_sum(
+        std::array::from_fn(|j| c33[j] * (ac[j] + cc[j])),
+        std::array::from_fn(|j| c33[j].norm() * (ac[j].norm() + cc[j].norm())),
+    );
+    let r2 = rel_sum(
+        std::array::from_fn(|j| c33[j] * bc[j]),
+        std::array::from_fn(|j| {
+            c33[j].norm() * ((alpha[j] * delta[j]).norm() + (beta[j] * gamma[j]).norm())
+        }),
+    );
 
-    // (39) corrected, in closed form. On the quadrics H0 ≡ K g² − 2Kε g²P_0 +
+    // (40) corrected, in closed form. On the quadrics H0 ≡ K g² − 2Kε g²P_0 +
     // Kε² g²P_0², with g² = Σ η_j²/((d_j − d4) d4) (30a), g²P_0 = −Σ ξ_jη_j/(d_j − d4)
     // (31b), g²P_0² = Σ d_j ξ_j²/(d_j − d4) (30b), up to λQ1 + μQ2 + νQ3 of (11).
     // Matching the coefficients of η_j², ξ_jη_j, ξ_j² and multiplying by (d_j − d4)
     // (and d_j) gives polynomials of degree ≤ 2 in d_j whose value at x = d4 —
     // the Lagrange interpolant through d1, d2, d3, L_j(d4) = c̃_j (d4 − d_k)(d4 − d_l)
     // — isolates the K terms, since the multiplier terms vanish at x = d4:
-    // K = κ Σ c̃_j d_j c_j, 2Kε = κ Σ c̃_j b_j, Kε² d4 = κ Σ c̃_j a_j, with
+    // K = κ Σ c̃_j d_j r_j, 2Kε = κ Σ c̃_j q_j, Kε² d4 = κ Σ c̃_j p_j, with
     // κ = Π (d_m − d4) (docs/kotter.md §7).
-    let ct: [C; 3] = std::array::from_fn(|j| {
-        let (k2, l2) = ((j + 1) % 3, (j + 2) % 3);
-        ONE / ((d[j] - d[k2]) * (d[j] - d[l2]))
-    });
     let kappa = (d[0] - d4) * (d[1] - d4) * (d[2] - d4);
-    let k: C = kappa * (0..3).map(|j| ct[j] * d[j] * cc[j]).sum::<C>();
-    // 2Kε: (d_j − d4) b_j is of degree 1 in d_j, so two nodes suffice and the
-    // symmetric three-node form κ Σ c̃_j b_j equals the slope
-    // (b_j − b_k)/(w_j − w_k), w_j = 1/(d_j − d4), through any pair. The pair with
+    // K/κ directly (no division by κ, which vanishes when some d_j = d4).
+    let k_over_kappa: C = (0..3).map(|j| ct[j] * d[j] * cc[j]).sum::<C>();
+    let k = kappa * k_over_kappa;
+    // 2Kε: (d_j − d4) q_j is of degree 1 in d_j, so two nodes suffice and the
+    // symmetric three-node form κ Σ c̃_j q_j equals the slope
+    // (q_j − q_k)/(w_j − w_k), w_j = 1/(d_j − d4), through any pair. The pair with
     // the most separated w avoids the cancellation of the three-node form when
     // two d_j nearly coincide (c̃_j ~ 1/(d_1 − d_2): 1e12 on near_degenerate states).
     let w: [C; 3] = std::array::from_fn(|j| ONE / (d[j] - d4));
@@ -787,7 +776,7 @@ fn h0_structure(
         });
     let k_eps: C = 0.5 * (bc[pj] - bc[pk]) / (w[pj] - w[pk]);
     let eps = k_eps / k;
-    // The perfect square of (39), (Kε)² = K · Kε², with Kε² d4 = κ Σ c̃_j a_j;
+    // The perfect square of (40), (Kε)² = K · Kε², with Kε² d4 = κ Σ c̃_j p_j;
     // relative to the size of the terms (the sum cancels when two d_j are close).
     let terms_e2: f64 = (0..3).map(|j| (ct[j] * ac[j]).norm()).sum();
     let k_eps2: C = kappa / d4 * (0..3).map(|j| ct[j] * ac[j]).sum::<C>();
@@ -798,21 +787,54 @@ fn h0_structure(
         return Err(Error::InvalidArgument {
             what: "Koetter constants",
             reason: format!(
-                "H0 does not reduce to the form (37)/(39) on Koetter's quadrics: relative \
+                "H0 does not reduce to the form (38)/(40) on Koetter's quadrics: relative \
                  residual {worst:e} > {STRUCTURE_RTOL:e}"
             ),
         });
     }
-    Ok((a_coef, b_coef, abgd38, eps, k))
+
+    // (39) in closed form: the (40) representative p_j = Kε² d_j w_j,
+    // q_j = 2Kε w_j, r_j = K w_j/d4 reduced to the form (38) (the representative
+    // of that form is unique, so these are the paper's α, β, γ, δ).
+    let e1 = d[0] + d[1] + d[2];
+    let eps2 = eps * eps;
+    let beta39 = -k_over_kappa;
+    let gamma39 = eps2 * d4 * d4 * k_over_kappa;
+    let delta39 = 2.0 * d4 * k_eps / kappa;
+    let alpha39 = 0.5 * k_over_kappa * (kappa * eps2 + (e1 - d4) * (ONE - eps2 * d4 * d4));
+    // A_j, B_j themselves from the same reduction applied to p, q, r per j:
+    // ν = −(s_j − s_k)/(t_j − t_k), s = p + r, t_j = d_j + 1/d_j, then
+    // A_j = (p_j − r_j)/2 + (ν/2)(d_j − 1/d_j); B_j = q_j + μ with
+    // μ = δ t_j − q_j, δ = (q_j − q_k)/(t_j − t_k). Two nodes (the most separated
+    // t) suffice and keep A_j, B_j accurate when two d_j nearly coincide, where
+    // α, β, γ (three-node quantities, through K) are only known to ~u/|d_j − d_k|².
+    let t: [C; 3] = std::array::from_fn(|j| d[j] + ONE / d[j]);
+    let (tj, tk) = [(0, 1), (0, 2), (1, 2)]
+        .into_iter()
+        .fold((0, 1), |best, (j, kk)| {
+            if (t[j] - t[kk]).norm() > (t[best.0] - t[best.1]).norm() {
+                (j, kk)
+            } else {
+                best
+            }
+        });
+    let nu = -((ac[tj] + cc[tj]) - (ac[tk] + cc[tk])) / (t[tj] - t[tk]);
+    let delta_two = (bc[tj] - bc[tk]) / (t[tj] - t[tk]);
+    let mu = delta_two * t[tj] - bc[tj];
+    let a_coef: [C; 3] =
+        std::array::from_fn(|j| 0.5 * (ac[j] - cc[j]) + 0.5 * nu * (d[j] - ONE / d[j]));
+    let b_coef: [C; 3] = std::array::from_fn(|j| bc[j] + mu);
+    let abgd39 = [alpha39, beta39, gamma39, delta39];
+    Ok((a_coef, b_coef, abgd39, eps, k))
 }
 
-/// `l^(p) = l(s_p)/√F'(s_p)` (19) for `p = 1 … 4`, on the documented branches.
+/// `l^(p) = l(s_p)/√F'(s_p)` (20) for `p = 1 … 4`, on the documented branches.
 pub fn l_p(k: &KotterConstants, l: &[f64; 6]) -> [[C; 3]; 4] {
     let (m, n) = m_n(l);
     std::array::from_fn(|p| std::array::from_fn(|j| k.u[p][j] * m[j] + k.v[p][j] * n[j]))
 }
 
-/// Kötter's vectors (21): `ξ = l^(1) + i l^(2)`, `η = l^(1) − i l^(2)`.
+/// Kötter's vectors (22): `ξ = l^(1) + i l^(2)`, `η = l^(1) − i l^(2)`.
 pub fn xi_eta(k: &KotterConstants, l: &[f64; 6]) -> ([C; 3], [C; 3]) {
     let lp = l_p(k, l);
     let xi = std::array::from_fn(|j| lp[0][j] + I * lp[1][j]);
@@ -873,44 +895,44 @@ fn real_state(k: &Coefficients23, xi: &[C; 3], eta: &[C; 3]) -> Result<[f64; 6]>
 pub const UNIFORM_RTOL: f64 = 1e-6;
 
 /// Relative agreement required between `g` from (30a) (the curve's inverse
-/// map) and the corrected (41). The sign choice needs only `|Δg| ≪ |g|`; the
+/// map) and the corrected (42). The sign choice needs only `|Δg| ≪ |g|`; the
 /// accuracy of the closed forms for `K`, `ε` (sums with `c̃_j ~ 1/(d_j − d_k)`)
 /// degrades with the conditioning of the `d_j` (clustered roots of F give
 /// ~1e-8), so 1e-6 flags a wrong structure, not rounding.
-pub const G41_RTOL: f64 = 1e-6;
+pub const G42_RTOL: f64 = 1e-6;
 
 /// A state in Kötter's coordinates: the constants of its level set, the
-/// vectors `l^(p)`, `ξ, η`, the curve (8) and the point pair with `g` (36), (41).
+/// vectors `l^(p)`, `ξ, η`, the curve (8) and the point pair with `g` (37), (42).
 #[derive(Debug, Clone, PartialEq)]
 pub struct KotterState {
     /// Constants of the level set.
     pub constants: KotterConstants,
-    /// `l^(p)` (19), `p = 1 … 4`.
+    /// `l^(p)` (20), `p = 1 … 4`.
     pub l_p: [[C; 3]; 4],
-    /// `ξ` (21).
+    /// `ξ` (22).
     pub xi: [C; 3],
-    /// `η` (21).
+    /// `η` (22).
     pub eta: [C; 3],
     /// The curve (8) with the `d_j` of (26).
     pub curve: KotterCurve,
     /// `P_0 = √(z1 z2)` in the curve's branch, from (31b): `P_0 = −Σ_j c̃_j P_j4 P_kl`.
     pub p0: C,
     /// The points, `g` and the branch of the `P_j` (see [`crate::curve`]),
-    /// with `ξ_j = √c_j g P_kl`, `η_j = √c_j g P_j4` (36); the sign of `g` is
-    /// fixed by the corrected (41): `g (1 − ε P_0) = √(h0/K)` (principal root).
+    /// with `ξ_j = √c_j g P_kl`, `η_j = √c_j g P_j4` (37); the sign of `g` is
+    /// fixed by the corrected (42): `g (1 − ε P_0) = √(h0/K)` (principal root).
     pub points: WurzelPoints,
 }
 
 /// From a state `l` of the top with parameters `a` to Kötter's coordinates
-/// and the points of the curve (the algebraic uniformization (36), (41)).
+/// and the points of the curve (the algebraic uniformization (37), (42)).
 ///
-/// `g` (36) is fixed up to sign by (30a), `g² = Σ_j c̃_j (η_j/√c_j)² / d4`;
-/// the corrected (39) reads `h0 = K g² (1 − ε P_0)²`, so the corrected (41)
+/// `g` (37) is fixed up to sign by (30a), `g² = Σ_j c̃_j (η_j/√c_j)² / d4`;
+/// the corrected (40) reads `h0 = K g² (1 − ε P_0)²`, so the corrected (42)
 /// is `g = √(h0/K) / (1 − ε P_0)`, which fixes the sign (and is checked).
 ///
 /// Errors: those of [`kotter_constants`], of [`KotterCurve::new`] (coinciding
 /// branch points `d_j`: the genus drops) and of the inverse map of the curve
-/// module (`z1 = z2`, data off the quadrics); and `1 − ε P_0 = 0` (then (41)
+/// module (`z1 = z2`, data off the quadrics); and `1 − ε P_0 = 0` (then (42)
 /// puts `g` at infinity: `ξ, η` are not finite multiples of the `P_jk`).
 pub fn kotter(a: &[f64; 4], l: &[f64; 6]) -> Result<KotterState> {
     let constants = kotter_constants(a, l)?;
@@ -938,17 +960,17 @@ pub fn kotter_with(constants: KotterConstants, l: &[f64; 6]) -> Result<KotterSta
     if one_m.norm().is_nan() || one_m.norm() <= 1e-12 * size {
         return Err(Error::InvalidArgument {
             what: "state l",
-            reason: format!("1 - eps P_0 = {one_m} vanishes: g (41) is infinite at this state"),
+            reason: format!("1 - eps P_0 = {one_m} vanishes: g (42) is infinite at this state"),
         });
     }
-    let g41 = sqrt_principal(C::new(constants.h[0], 0.0) / constants.k) / one_m;
-    let points = curve.points_from_xi_eta(xi, eta, None, Some(g41), UNIFORM_RTOL)?;
-    let mis = (points.g - g41).norm();
-    if mis.is_nan() || mis > G41_RTOL * g41.norm() {
+    let g42 = sqrt_principal(C::new(constants.h[0], 0.0) / constants.k) / one_m;
+    let points = curve.points_from_xi_eta(xi, eta, None, Some(g42), UNIFORM_RTOL)?;
+    let mis = (points.g - g42).norm();
+    if mis.is_nan() || mis > G42_RTOL * g42.norm() {
         return Err(Error::InvalidArgument {
             what: "state l",
             reason: format!(
-                "the corrected (41) g = sqrt(h0/K)/(1 - eps P0) = {g41} disagrees with g = {} \
+                "the corrected (42) g = sqrt(h0/K)/(1 - eps P0) = {g42} disagrees with g = {} \
                  from (30a) (|difference| = {mis:e})",
                 points.g
             ),
@@ -966,7 +988,7 @@ pub fn kotter_with(constants: KotterConstants, l: &[f64; 6]) -> Result<KotterSta
 }
 
 /// The inverse of [`kotter`]: the state `l` from the curve's points, `g`
-/// and the branch of the `P_j` by (36) and (23):
+/// and the branch of the `P_j` by (37) and (23):
 /// `ξ_j = √c_j g P_kl`, `η_j = √c_j g P_j4`, `m_j = α_j ξ_j + β_j η_j`,
 /// `n_j = γ_j ξ_j + δ_j η_j`, `l = (m3, −m2, n1, m1, n2, n3)`.
 ///

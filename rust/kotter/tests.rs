@@ -10,9 +10,9 @@ fn dot(x: &[C; 3], y: &[C; 3]) -> C {
     x[0] * y[0] + x[1] * y[1] + x[2] * y[2]
 }
 
-/// (14): f(s) = l(s)·l(s) = h1 s² − h2 s + h3 + 2 h0 √G on the branch √s_j4 √s_kl = √G.
+/// (14)–(15): f(s) = l(s)·l(s) = h1 s² − h2 s + h3 + 2 h0 √G on the branch √s_j4 √s_kl = √G.
 #[test]
-fn closed_form_14() {
+fn closed_form_15() {
     let h = integrals(&A, &L0);
     for s in [C::new(0.7, 0.4), C::new(-1.3, 2.0), C::new(5.0, -0.1)] {
         for sg in [1.0, -1.0] {
@@ -29,9 +29,9 @@ fn closed_form_14() {
     }
 }
 
-/// (18)–(20): f(s_p) = 0 on the branch σ_p, (l^(p))² = 0, Σ_p (l_k^(p))² = 0.
+/// (19)–(21): f(s_p) = 0 on the branch σ_p, (l^(p))² = 0, Σ_p (l_k^(p))² = 0.
 #[test]
-fn roots_and_relations_20() {
+fn roots_and_relations_19_21() {
     let k = kotter_constants(&A, &L0).unwrap();
     let lp = l_p(&k, &L0);
     for p in 0..4 {
@@ -123,7 +123,7 @@ proptest! {
     }
 }
 
-/// Uniformization round trip l → (z1, y1, z2, y2, g) → l and the corrected (41).
+/// Uniformization round trip l → (z1, y1, z2, y2, g) → l and the corrected (42).
 #[test]
 fn uniformization_round_trip() {
     let st = kotter(&A, &L0).unwrap();
@@ -179,9 +179,9 @@ fn root_near_a_j_keeps_accuracy() {
 
 proptest! {
     #![proptest_config(ProptestConfig::with_cases(64))]
-    /// (14) on both branches of √G, random states and s.
+    /// (15) on both branches of √G, random states and s.
     #[test]
-    fn closed_form_14_random(l in proptest::array::uniform6(-2.0f64..2.0),
+    fn closed_form_15_random(l in proptest::array::uniform6(-2.0f64..2.0),
                              re in -3.0f64..6.0, im in -2.0f64..2.0, sg in proptest::bool::ANY) {
         let s = C::new(re, im);
         prop_assume!(A.iter().all(|&a| (s - a).norm() > 1e-3));
@@ -194,9 +194,9 @@ proptest! {
         prop_assert!((f - closed).norm() < 1e-13 * scale);
     }
 
-    /// (19)–(20) for random states.
+    /// (20)–(21) for random states.
     #[test]
-    fn relations_20_random(l in proptest::array::uniform6(-2.0f64..2.0)) {
+    fn relations_20_21_random(l in proptest::array::uniform6(-2.0f64..2.0)) {
         if let Ok(k) = kotter_constants(&A, &l) {
             // Well-separated roots only: roots δ apart are known to ~u/δ and
             // (l^(p))² = f(s_p)/F'(s_p) amplifies that by 1/|F'(s_p)|
@@ -312,7 +312,7 @@ proptest! {
         }
     }
 
-    /// (15) corrected: l̇(s) = m_b(s) × l(s) (i.e. L̇ = [L, M_b] with the hat map of (17))
+    /// (16) corrected: l̇(s) = m_b(s) × l(s) (i.e. L̇ = [L, M_b] with the hat map of (18))
     /// for random a, b, l, s on both branches of √G.
     #[test]
     fn lax_pair_general_b(
@@ -344,12 +344,12 @@ proptest! {
     }
 }
 
-/// The corrected (39) with the closed-form `K = κ Σ c̃_j d_j β_j δ_j`,
+/// The corrected (40) with the closed-form `K = κ Σ c̃_j d_j β_j δ_j`,
 /// `2Kε = κ Σ c̃_j (α_j δ_j + β_j γ_j)` is an identity on the whole quadric
 /// variety: at complex point pairs of the curve with complex `g`,
-/// `Σ_j m_j n_j` of (23) applied to (36) equals `K g² (1 − ε P_0)²`.
+/// `Σ_j m_j n_j` of (23) applied to (37) equals `K g² (1 − ε P_0)²`.
 #[test]
-fn h0_39_closed_form_on_point_pairs() {
+fn h0_40_closed_form_on_point_pairs() {
     let st = kotter(&A, &L0).unwrap();
     let k = &st.constants;
     let d = k.d;
@@ -385,5 +385,42 @@ fn h0_39_closed_form_on_point_pairs() {
         }
         let rhs = k.k * g * g * (ONE - k.eps * p0) * (ONE - k.eps * p0);
         assert!((h0 - rhs).norm() < 1e-11 * size, "{h0} vs {rhs}");
+    }
+}
+
+/// (38)–(39) with the closed forms of `(α, β, γ, δ)`: an identity on the whole
+/// quadric variety. At complex point pairs with complex `g`, `Σ_j m_j n_j` of
+/// (23) applied to (37) equals `Σ_j A_j (ξ_j² − η_j²) + B_j ξ_j η_j` with
+/// `A_j = α + β d_j + γ/d_j`, `B_j = δ (d_j + 1/d_j)`; and `δ² = −4βγ`.
+#[test]
+fn h0_38_39_closed_form_on_point_pairs() {
+    let st = kotter(&A, &L0).unwrap();
+    let k = &st.constants;
+    let d = k.d;
+    let [al, be, ga, de] = k.abgd39;
+    assert!((de * de + 4.0 * be * ga).norm() < 1e-12 * (de * de).norm());
+    let a_j: [C; 3] = std::array::from_fn(|j| al + be * d[j] + ga / d[j]);
+    let b_j: [C; 3] = std::array::from_fn(|j| de * (d[j] + ONE / d[j]));
+    for j in 0..3 {
+        assert!((a_j[j] - k.a_coef[j]).norm() < 1e-12 * a_j[j].norm());
+        assert!((b_j[j] - k.b_coef[j]).norm() < 1e-12 * b_j[j].norm());
+    }
+    for (z1, z2, g) in [
+        (C::new(0.4, 1.3), C::new(-2.1, 0.7), C::new(0.9, -0.3)),
+        (C::new(3.3, -0.2), C::new(0.1, -1.9), C::new(-0.4, 1.2)),
+        (C::new(-5.0, 2.5), C::new(7.0, 1.0), C::new(2.0, 0.5)),
+    ] {
+        let (y1, y2) = (st.curve.y(z1), -st.curve.y(z2));
+        let (xi, eta) = st.curve.xi_eta(z1, y1, z2, y2, g, None, None).unwrap();
+        let (mut lhs, mut rhs, mut size) = (ZERO, ZERO, 0.0);
+        for j in 0..3 {
+            let mj = k.alpha[j] * xi[j] + k.beta[j] * eta[j];
+            let nj = k.gamma[j] * xi[j] + k.delta[j] * eta[j];
+            let r = a_j[j] * (xi[j] * xi[j] - eta[j] * eta[j]) + b_j[j] * xi[j] * eta[j];
+            lhs += mj * nj;
+            rhs += r;
+            size += (mj * nj).norm() + r.norm();
+        }
+        assert!((lhs - rhs).norm() < 1e-11 * size, "{lhs} vs {rhs}");
     }
 }

@@ -10,7 +10,7 @@ use numpy::{
 };
 use pyo3::prelude::*;
 
-use crate::curve::KotterCurve;
+use crate::curve::{CurvePoint, KotterCurve};
 use crate::error::Error;
 
 type C = Complex64;
@@ -53,6 +53,21 @@ fn rows<T: Copy + numpy::Element, const K: usize>(
         .into_iter()
         .map(|r| std::array::from_fn(|k| r[k]))
         .collect())
+}
+
+/// The two points of row `i` with their offsets `zd = (zd1, zd2)` (a row of 10).
+fn points_with_offsets(z1: C, y1: C, z2: C, y2: C, zd: &[C; 10]) -> (CurvePoint, CurvePoint) {
+    let p1 = CurvePoint {
+        z: z1,
+        y: y1,
+        zd: std::array::from_fn(|j| zd[j]),
+    };
+    let p2 = CurvePoint {
+        z: z2,
+        y: y2,
+        zd: std::array::from_fn(|j| zd[5 + j]),
+    };
+    (p1, p2)
 }
 
 /// `(d0, …, d4)` of the curve (8) with the given `(d1, d2, d3)`, validated.
@@ -109,9 +124,11 @@ fn curve_eval_py<'py>(
 }
 
 /// The Wurzelfunktionen (27)–(28) of `n` point pairs: `P (n, 5)`, `Pjk (n, 5, 5)`.
+/// With `zd` (`(n, 10)`: `z1 − d_j` then `z2 − d_j`) the roots come from the
+/// offsets ([`KotterCurve::wurzel_points`]).
 #[pyfunction(name = "curve_wurzel")]
-#[pyo3(signature = (d, z1, y1, z2, y2, eps=None))]
-#[allow(clippy::type_complexity)]
+#[pyo3(signature = (d, z1, y1, z2, y2, eps=None, zd=None))]
+#[allow(clippy::type_complexity, clippy::too_many_arguments)]
 fn curve_wurzel_py<'py>(
     py: Python<'py>,
     d: PyReadonlyArray1<'py, C>,
@@ -120,17 +137,26 @@ fn curve_wurzel_py<'py>(
     z2: PyReadonlyArray1<'py, C>,
     y2: PyReadonlyArray1<'py, C>,
     eps: Option<PyReadonlyArray2<'py, i8>>,
+    zd: Option<PyReadonlyArray2<'py, C>>,
 ) -> PyResult<(Bound<'py, PyArray2<C>>, Bound<'py, PyArray3<C>>)> {
     let k = curve_of(&d)?;
     let n = z1.as_array().len();
     let (z1, y1) = (vec1(&z1, "z1", n)?, vec1(&y1, "y1", n)?);
     let (z2, y2) = (vec1(&z2, "z2", n)?, vec1(&y2, "y2", n)?);
     let eps: Option<Vec<[i8; 5]>> = eps.map(|e| rows(&e, "eps", n)).transpose()?;
+    let zd: Option<Vec<[C; 10]>> = zd.map(|z| rows(&z, "zd", n)).transpose()?;
     let out = py.detach(|| -> Result<(Array2<C>, Array3<C>), Error> {
         let mut p = Array2::<C>::zeros((n, 5));
         let mut pjk = Array3::<C>::zeros((n, 5, 5));
         for i in 0..n {
-            let w = k.wurzel(z1[i], y1[i], z2[i], y2[i], eps.as_ref().map(|e| e[i]))?;
+            let e = eps.as_ref().map(|e| e[i]);
+            let w = match &zd {
+                None => k.wurzel(z1[i], y1[i], z2[i], y2[i], e)?,
+                Some(zd) => {
+                    let (p1, p2) = points_with_offsets(z1[i], y1[i], z2[i], y2[i], &zd[i]);
+                    k.wurzel_points(&p1, &p2, e)?
+                }
+            };
             for j in 0..5 {
                 p[[i, j]] = w.p[j];
                 for m in 0..5 {
@@ -143,9 +169,11 @@ fn curve_wurzel_py<'py>(
     Ok((out.0.into_pyarray(py), out.1.into_pyarray(py)))
 }
 
-/// Kötter's `ξ, η` (36) of `n` point pairs with factors `g`: two `(n, 3)` arrays.
+/// Kötter's `ξ, η` (37) of `n` point pairs with factors `g`: two `(n, 3)` arrays.
+/// With `zd` (`(n, 10)`) the roots come from the offsets
+/// ([`KotterCurve::xi_eta_points`]).
 #[pyfunction(name = "curve_xi_eta")]
-#[pyo3(signature = (d, z1, y1, z2, y2, g, eps=None, sqrt_c=None))]
+#[pyo3(signature = (d, z1, y1, z2, y2, g, eps=None, sqrt_c=None, zd=None))]
 #[allow(clippy::too_many_arguments, clippy::type_complexity)]
 fn curve_xi_eta_py<'py>(
     py: Python<'py>,
@@ -157,6 +185,7 @@ fn curve_xi_eta_py<'py>(
     g: PyReadonlyArray1<'py, C>,
     eps: Option<PyReadonlyArray2<'py, i8>>,
     sqrt_c: Option<PyReadonlyArray1<'py, C>>,
+    zd: Option<PyReadonlyArray2<'py, C>>,
 ) -> PyResult<(Bound<'py, PyArray2<C>>, Bound<'py, PyArray2<C>>)> {
     let k = curve_of(&d)?;
     let n = z1.as_array().len();
@@ -164,6 +193,7 @@ fn curve_xi_eta_py<'py>(
     let (z2, y2) = (vec1(&z2, "z2", n)?, vec1(&y2, "y2", n)?);
     let g = vec1(&g, "g", n)?;
     let eps: Option<Vec<[i8; 5]>> = eps.map(|e| rows(&e, "eps", n)).transpose()?;
+    let zd: Option<Vec<[C; 10]>> = zd.map(|z| rows(&z, "zd", n)).transpose()?;
     let sqrt_c: Option<[C; 3]> = match sqrt_c {
         None => None,
         Some(s) => {
@@ -176,7 +206,13 @@ fn curve_xi_eta_py<'py>(
         let mut eta = Array2::<C>::zeros((n, 3));
         for i in 0..n {
             let e = eps.as_ref().map(|e| e[i]);
-            let (x, h) = k.xi_eta(z1[i], y1[i], z2[i], y2[i], g[i], e, sqrt_c)?;
+            let (x, h) = match &zd {
+                None => k.xi_eta(z1[i], y1[i], z2[i], y2[i], g[i], e, sqrt_c)?,
+                Some(zd) => {
+                    let (p1, p2) = points_with_offsets(z1[i], y1[i], z2[i], y2[i], &zd[i]);
+                    k.xi_eta_points(&p1, &p2, g[i], e, sqrt_c)?
+                }
+            };
             for j in 0..3 {
                 xi[[i, j]] = x[j];
                 eta[[i, j]] = h[j];
@@ -187,8 +223,9 @@ fn curve_xi_eta_py<'py>(
     Ok((out.0.into_pyarray(py), out.1.into_pyarray(py)))
 }
 
-/// The inverse of (36) for `n` rows of `(ξ, η)`: `z1, y1, z2, y2, g, residual`
-/// (each `(n,)`) and `eps` `(n, 5)`.
+/// The inverse of (37) for `n` rows of `(ξ, η)`: the columns `z1, y1, z2, y2, g`
+/// `(n, 5)`, `eps` `(n, 5)`, `residual` `(n,)` and the offsets `zd` `(n, 10)`
+/// (`z1 − d_j` then `z2 − d_j`, full relative accuracy).
 #[pyfunction(name = "curve_points_from_xi_eta")]
 #[pyo3(signature = (d, xi, eta, sqrt_c=None, g_ref=None, rtol=1e-8))]
 #[allow(clippy::type_complexity)]
@@ -204,6 +241,7 @@ fn curve_points_from_xi_eta_py<'py>(
     Bound<'py, PyArray2<C>>,
     Bound<'py, PyArray2<i8>>,
     Bound<'py, PyArray1<f64>>,
+    Bound<'py, PyArray2<C>>,
 )> {
     let k = curve_of(&d)?;
     let n = xi.as_array().shape()[0];
@@ -217,11 +255,13 @@ fn curve_points_from_xi_eta_py<'py>(
             Some([v[0], v[1], v[2]])
         }
     };
-    let out = py.detach(|| -> Result<(Array2<C>, Array2<i8>, Array1<f64>), Error> {
+    type Out = (Array2<C>, Array2<i8>, Array1<f64>, Array2<C>);
+    let out = py.detach(|| -> Result<Out, Error> {
         // Columns: z1, y1, z2, y2, g.
         let mut pts = Array2::<C>::zeros((n, 5));
         let mut eps = Array2::<i8>::zeros((n, 5));
         let mut res = Array1::<f64>::zeros(n);
+        let mut zd = Array2::<C>::zeros((n, 10));
         for i in 0..n {
             let gr = g_ref.as_ref().map(|g| g[i]);
             let b = k.points_from_xi_eta(xi[i], eta[i], sqrt_c, gr, rtol)?;
@@ -232,13 +272,18 @@ fn curve_points_from_xi_eta_py<'py>(
                 eps[[i, j]] = b.eps[j];
             }
             res[i] = b.residual;
+            for j in 0..5 {
+                zd[[i, j]] = b.zd1[j];
+                zd[[i, 5 + j]] = b.zd2[j];
+            }
         }
-        Ok((pts, eps, res))
+        Ok((pts, eps, res, zd))
     })?;
     Ok((
         out.0.into_pyarray(py),
         out.1.into_pyarray(py),
         out.2.into_pyarray(py),
+        out.3.into_pyarray(py),
     ))
 }
 

@@ -88,7 +88,7 @@ fn shape_err_msg(msg: String) -> PyErr {
     .into()
 }
 
-/// Schottky's l(s) (12) and m(s) (16) on the branch sqrt(s_j4) sqrt(s_kl) = sqrt_g.
+/// Schottky's l(s) (12) and m(s) (17) on the branch sqrt(s_j4) sqrt(s_kl) = sqrt_g.
 #[pyfunction(name = "kotter_schottky")]
 fn kotter_schottky_py<'py>(
     py: Python<'py>,
@@ -123,7 +123,7 @@ fn kotter_schottky_py<'py>(
     ))
 }
 
-/// The vectors m_b(s) of the Lax matrix M_b(s) (15)-(17) for the top (a, b), states (n, 6).
+/// The vectors m_b(s) of the Lax matrix M_b(s) (16)-(18) for the top (a, b), states (n, 6).
 #[pyfunction(name = "kotter_lax_m")]
 fn kotter_lax_m_py<'py>(
     py: Python<'py>,
@@ -156,7 +156,7 @@ fn kotter_lax_m_py<'py>(
     Ok(arr.into_pyarray(py).into_any())
 }
 
-/// Coefficients of F(s) (18), monic, highest power first, for integrals h of shape (n, 4).
+/// Coefficients of F(s) (19), monic, highest power first, for integrals h of shape (n, 4).
 #[pyfunction(name = "kotter_quartic")]
 fn kotter_quartic_py<'py>(
     py: Python<'py>,
@@ -244,8 +244,8 @@ fn kotter_batch_py<'py>(
     dict.set_item("A", c2(&|st| k(st).a_coef.to_vec(), 3)?.into_pyarray(py))?;
     dict.set_item("B", c2(&|st| k(st).b_coef.to_vec(), 3)?.into_pyarray(py))?;
     dict.set_item(
-        "abgd38",
-        c2(&|st| k(st).abgd38.to_vec(), 4)?.into_pyarray(py),
+        "abgd39",
+        c2(&|st| k(st).abgd39.to_vec(), 4)?.into_pyarray(py),
     )?;
     dict.set_item("eps", c1(&|st| st.constants.eps).into_pyarray(py))?;
     dict.set_item("K", c1(&|st| st.constants.k).into_pyarray(py))?;

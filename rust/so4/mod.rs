@@ -13,7 +13,7 @@
 //! in `tests/test_dynamics.py`).
 //!
 //! **Erratum (7).** As printed, `H3 = Σ_{j<k} a_j a_k l_jk²` is not conserved.
-//! The conserved forms consistent with Schottky's generating function (14) use
+//! The conserved forms consistent with Schottky's generating function (15) use
 //! the complementary pair `{l, m} = {1,2,3,4} \ {j, k}`:
 //! `H2 = Σ_{j<k} (a_l + a_m) l_jk²`, `H3 = Σ_{j<k} a_l a_m l_jk²`
 //! (see `docs/errata-so4.md`). [`integrals4`] returns the corrected forms.

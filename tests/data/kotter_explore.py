@@ -1,5 +1,5 @@
 # ruff: noqa: E741, B007, E501  (l is the paper's name for the state)
-"""Exploration: check the Schottky-Koetter formulas (12)-(41) as printed, numerically.
+"""Exploration: check the Schottky-Koetter formulas (12)-(42) as printed, numerically.
 
 Pure numpy/scipy, independent of the package. Run: python tests/data/kotter_explore.py
 It prints, for each formula, the residual as printed and, where it fails, the
@@ -114,7 +114,7 @@ def main():
         print(" printed" if pr else " complementary", np.ptp(H, axis=0))
     hc = integrals(a, l0)
     hp = integrals(a, l0, printed=True)
-    print("== (14) closed form at random s")
+    print("== (15) closed form at random s")
     rng = np.random.default_rng(1)
     for s in rng.normal(size=3) + 1j * rng.normal(size=3):
         sqG = np.prod(
@@ -128,11 +128,11 @@ def main():
         fs = lv @ lv
         for name, h in (("corrected", hc), ("printed", hp)):
             h0, h1, h2, h3 = h
-            print(f"  {name}: |f - (14)| =", abs(fs - (h1 * s * s - h2 * s + h3 + 2 * h0 * sqG)))
+            print(f"  {name}: |f - (15)| =", abs(fs - (h1 * s * s - h2 * s + h3 + 2 * h0 * sqG)))
         # time independence
         fl = [lvec(s, a, x, sqG) @ lvec(s, a, x, sqG) for x in traj]
         print("  f(s) ptp along flow:", np.ptp(np.abs(fl)))
-    print("== (15) Lax pair sign")
+    print("== (16) Lax pair sign")
     s = 0.7 + 0.4j
     sqG = np.sqrt(complex(sq(s, a, 0, 3))) * np.sqrt(complex(sq(s, a, 1, 2)))
     for x in traj[:3]:
@@ -147,7 +147,7 @@ def main():
             np.abs(Ld - (M @ L - L @ M)).max(),
         )
     # scale of M: m(s) vs s-dependent factor
-    print("== (18) F(s) and roots")
+    print("== (19) F(s) and roots")
     Fc = Fcoef(a, hc)
     roots = np.roots(Fc)
     print("  roots", roots)

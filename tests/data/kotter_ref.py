@@ -1,14 +1,14 @@
 # ruff: noqa: E741  (l is the paper's name for the state)
 """Independent numpy reference for the Schottky-Koetter reduction (tests only).
 
-Written from the paper's formulas (12)-(41) and the corrections pinned down in
+Written from the paper's formulas (12)-(42) and the corrections pinned down in
 ``kotter_explore.py`` (see docs/errata-kotter.md); it does not import the
 package. Conventions (the same ones the package documents in docs/kotter.md):
 
 * state l = (l12, l13, l14, l23, l24, l34), m_j = l_kl, n_j = l_j4 (13),
   (j, k, l) cyclic: m = (l23, l31, l12), n = (l14, l24, l34);
-* h0..h3 with the complementary-pair H2, H3 (erratum (7)/(14));
-* F(s) (18) monic; at a root s_p the branch of sqrt(G) is
+* h0..h3 with the complementary-pair H2, H3 (erratum (7)/(15));
+* F(s) (19) monic; at a root s_p the branch of sqrt(G) is
   sigma_p = -(h1 s_p^2 - h2 s_p + h3) / (2 h0) (so that f(s_p) = 0);
 * sqrt(s_j4) principal, sqrt(s_kl) = sigma / sqrt(s_j4), sqrt(F'(s_p)) principal;
 * root order: s1 = non-real root of largest Im, s2 its conjugate, s3 the
@@ -111,19 +111,19 @@ def l_of_s(s, a, l, sqrtG):
 
 
 def m_of_s(s, a, l, sqrtG):
-    """m(s) (16) on the same branch."""
+    """m(s) (17) on the same branch."""
     m, n = mn(l)
     r = np.array([np.sqrt(complex(s_pair(s, a, j, 3))) for (j, k, ll) in CYC])
     return sqrtG / r * m + r * n
 
 
 def skew3(v):
-    """L(s), M(s) of (17)."""
+    """L(s), M(s) of (18)."""
     return np.array([[0, v[2], -v[1]], [-v[2], 0, v[0]], [v[1], -v[0], 0]])
 
 
 def F_coeffs(a, h):
-    """(18): monic quartic, highest power first."""
+    """(19): monic quartic, highest power first."""
     h0, h1, h2, h3 = h
     P = np.array([h1, -h2, h3])
     G = np.poly(a)
@@ -171,7 +171,7 @@ def uv(sp, a, h):
 
 
 def l_p(sp, a, h, l):
-    """(19) l^(p) = l(s_p)/sqrt(F'(s_p))."""
+    """(20) l^(p) = l(s_p)/sqrt(F'(s_p))."""
     m, n = mn(l)
     u, v = uv(sp, a, h)
     return u * m + v * n
@@ -201,7 +201,7 @@ def kotter_constants(a, h, s):
 
 
 def xi_eta(l, a, h, s):
-    """(21)"""
+    """(22)"""
     L1 = l_p(s[0], a, h, l)
     L2 = l_p(s[1], a, h, l)
     return L1 + 1j * L2, L1 - 1j * L2
@@ -240,3 +240,77 @@ def wurzel(d, z1, y1, z2, y2, branch):
                     * (y1 / ((z1 - dd[j]) * (z1 - dd[k])) - y2 / ((z2 - dd[j]) * (z2 - dd[k])))
                 )
     return P, Pjk
+
+
+def h0_form(Kc):
+    """H0 = sum_j m_j n_j by (23) as a quadratic form in xi, eta:
+    sum_j p_j xi_j^2 + q_j xi_j eta_j + r_j eta_j^2, returns (p, q, r)."""
+    al, be, ga, de = Kc["alpha"], Kc["beta"], Kc["gamma"], Kc["delta"]
+    return al * ga, al * de + be * ga, be * de
+
+
+def h0_form_sizes(Kc):
+    """|p_j|, |alpha_j delta_j| + |beta_j gamma_j|, |r_j|: the sizes of the products that
+    enter (p, q, r), against which their rounding is measured (q and p + r can cancel)."""
+    al, be, ga, de = Kc["alpha"], Kc["beta"], Kc["gamma"], Kc["delta"]
+    return np.abs(al * ga), np.abs(al * de) + np.abs(be * ga), np.abs(be * de)
+
+
+def reduce_38_39(d, p, q, r, sizes=None):
+    """Reduce sum p xi^2 + q xi eta + r eta^2 modulo the quadrics (11) to the form (38)
+    A_j (xi_j^2 - eta_j^2) + B_j xi_j eta_j, and read off (39).
+
+    Coefficient equations (lambda Q1 + mu Q2 + nu Q3 added):
+      p_j + lam + nu d_j = A_j,  r_j + lam + nu/d_j = -A_j,  q_j + mu = B_j = delta (d_j + 1/d_j).
+    Times d_j these are values at x = d_j of quadratics in x; with the Lagrange
+    interpolant through d_1, d_2, d_3 (leading coefficient sum_j ct_j y_j, value at 0
+    d4 sum_j ct_j y_j / d_j, linear coefficient -sum_j ct_j (d_k + d_l) y_j):
+      existence:  sum_j c_j q_j = 0 and sum_j c_j (p_j + r_j) = 0   (c_j of (33)),
+      delta = sum ct_j d_j q_j,  nu = -sum ct_j d_j (p_j + r_j),
+      beta = (sum ct_j d_j (p_j - r_j) + nu)/2,  gamma = (d4 sum ct_j (p_j - r_j) - nu)/2,
+      alpha = -sum ct_j (d_k + d_l) d_j (p_j - r_j) / 2.
+    Returns a dict with the two existence sums (and the sizes of their terms, from
+    ``sizes`` = (|p|, |q|, |r|) term by term if given), A, B and (alpha, beta, gamma, delta)."""
+    sp, sq, sr = (np.abs(p), np.abs(q), np.abs(r)) if sizes is None else sizes
+    d = np.asarray(d, complex)
+    ct, c, d4 = curve_c(d)
+    dkl = np.array([d[k] + d[ll] for (j, k, ll) in CYC])
+    nu = -np.sum(ct * d * (p + r))
+    delta = np.sum(ct * d * q)
+    mu = np.sum(ct * dkl * d * q)  # minus the linear coefficient of delta x^2 - mu x + delta
+    beta = 0.5 * (np.sum(ct * d * (p - r)) + nu)
+    gamma = 0.5 * (d4 * np.sum(ct * (p - r)) - nu)
+    alpha = -0.5 * np.sum(ct * dkl * d * (p - r))
+    A = 0.5 * (p - r) + 0.5 * nu * (d - 1 / d)
+    B = q + mu
+    return dict(
+        exist_B=np.sum(c * q),
+        exist_B_size=np.sum(np.abs(c) * sq),
+        exist_A=np.sum(c * (p + r)),
+        exist_A_size=np.sum(np.abs(c) * (sp + sr)),
+        A=A,
+        B=B,
+        abgd=np.array([alpha, beta, gamma, delta]),
+    )
+
+
+def abgd39_from_k_eps(k, eps, d):
+    """(39) from K, eps of the corrected (40): reducing the representative
+    p_j = K eps^2 d_j w_j, q_j = 2 K eps w_j, r_j = K w_j / d4 (w_j = 1/(d_j - d4)) with
+    reduce_38_39 and the residue sums sum_j ct_j d_j^n w_j = d4^n / kappa (n <= 2),
+    sum_j ct_j d_j^3 w_j = 1 + d4^3 / kappa (kappa = prod_m (d_m - d4)):
+      beta = -K/kappa, gamma = eps^2 d4^2 K/kappa, delta = 2 eps d4 K/kappa,
+      alpha = K/(2 kappa) (kappa eps^2 + (e1 - d4)(1 - eps^2 d4^2)), e1 = d1 + d2 + d3."""
+    d = np.asarray(d, complex)
+    d4 = np.prod(d)
+    kap = np.prod(d - d4)
+    e1 = np.sum(d)
+    kk = k / kap
+    return np.array(
+        [
+            0.5 * kk * (kap * eps**2 + (e1 - d4) * (1 - eps**2 * d4**2)),
+            -kk,
+            eps**2 * d4**2 * kk,
+            2 * eps * d4 * kk,
+        ]
+    )
