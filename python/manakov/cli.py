@@ -16,6 +16,7 @@ import sys
 import time
 from collections.abc import Sequence
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -79,7 +80,9 @@ def _parser() -> argparse.ArgumentParser:
 
 def _write(path: Path, tr: Trajectory, a: np.ndarray, b: np.ndarray) -> None:
     if path.suffix == ".npz":
-        np.savez(path, t=tr.t, l=tr.l, a=a, b=b, **{k: v for k, v in tr.integrals.items()})
+        arrays: dict[str, Any] = {"t": tr.t, "l": tr.l, "a": a, "b": b}
+        arrays.update(tr.integrals)
+        np.savez(path, **arrays)
     elif path.suffix == ".csv":
         n = len(a)
         names = [f"l{i + 1}{j + 1}" for i in range(n) for j in range(i + 1, n)]
