@@ -3,7 +3,7 @@
 Reference values come from an independent numpy implementation of (27)-(28)
 *as printed* (written here, not calling the package) and from mpmath at 40
 digits. Each identity of the paper is checked as printed; (29) fails as
-printed and is checked in its corrected form (docs/errata-curve.md).
+printed and is checked in its corrected form (docs/errata.md).
 """
 
 from __future__ import annotations

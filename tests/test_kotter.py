@@ -5,7 +5,7 @@ Reference values come from ``tests/data/kotter_ref.py``, an independent numpy
 implementation written from the paper (it does not import the package), and
 from trajectories of (1) integrated here with scipy's DOP853 on an
 independent right-hand side. Printed forms that fail are kept as tests that
-demonstrate the failure (see docs/errata-kotter.md).
+demonstrate the failure (see docs/errata.md).
 """
 
 from __future__ import annotations

@@ -168,7 +168,7 @@ class KotterCurve:
     ``c~_j = 1/((d_j - d_k)(d_j - d_l))``, ``c_j = (d_j - d_4) c~_j`` (33),
     ``(j, k, l)`` cyclic in ``(1, 2, 3)``, hold for :meth:`wurzel` in every
     branch ``eps``, except that the right-hand side of (29) carries the factor
-    :attr:`kappa` ``= prod_{m=1}^3 (d_m - d_4)`` (see ``docs/errata-curve.md``).
+    :attr:`kappa` ``= prod_{m=1}^3 (d_m - d_4)`` (see ``docs/errata.md``).
     """
 
     __slots__ = ("_d", "_c", "_ct", "_kappa")

@@ -2,7 +2,7 @@
 """Schottky's l(s) and Kötter's reduction: from a state l to the curve (8) and back.
 
 The chain, with the paper's equation numbers (details and every convention in
-``docs/kotter.md``; corrected formulas in ``docs/errata-kotter.md``):
+``docs/kotter.md``; corrected formulas in ``docs/errata.md``):
 
 * Schottky's vector (12) ``l_j(s) = sqrt(s_j4) m_j + sqrt(s_kl) n_j`` with
   ``m_j = l_kl``, ``n_j = l_j4`` (13), and its square (14) with its closed form (15)
@@ -72,7 +72,7 @@ def integrals(a: Any, l: Any) -> np.ndarray:
     ``h0 = l12 l34 + l23 l14 + l31 l24`` (6), ``h1 = sum l_jk^2`` (7), and
     ``h2 = sum_{j<k} (a_l + a_m) l_jk^2``, ``h3 = sum_{j<k} a_l a_m l_jk^2``
     with ``{l, m}`` the complement of ``{j, k}`` (the pairs printed in (7),
-    ``a_j + a_k`` and ``a_j a_k``, do not give (15); see docs/errata-kotter.md).
+    ``a_j + a_k`` and ``a_j a_k``, do not give (15); see docs/errata.md).
 
     Parameters
     ----------
@@ -153,7 +153,7 @@ def lax_pair(
     ``tau = sqrt(s_14) sqrt(s_24) sqrt(s_34) sqrt(G) / ((s - a4) G(s)) = +-1``.
     The printed ``M(s)`` (17)-(18), which does not involve ``b``, is the case
     ``b = a^2`` (``p2 = 1, p3 = 0``) on the branch ``tau = -1``; for a general
-    ``b`` it does not give the flow (see docs/errata-kotter.md).
+    ``b`` it does not give the flow (see docs/errata.md).
 
     Parameters
     ----------

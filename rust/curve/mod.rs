@@ -237,7 +237,7 @@ impl KotterCurve {
     }
 
     /// `κ = Π_{m=1}^{3} (d_m − d_4) = −R'(d_4)/d_4`, the factor missing from
-    /// the right-hand side of (29) as printed (see `docs/errata-curve.md`).
+    /// the right-hand side of (29) as printed (see `docs/errata.md`).
     pub fn kappa(&self) -> Complex64 {
         let d = &self.d;
         (d[1] - d[4]) * (d[2] - d[4]) * (d[3] - d[4])

@@ -10,7 +10,7 @@
 //! * Integrals: `h0 = l12 l34 + l23 l14 + l31 l24` (6), `h1 = Σ l_jk²`, and
 //!   **`h2 = Σ_{j<k} (a_l + a_m) l_jk²`, `h3 = Σ_{j<k} a_l a_m l_jk²`** with
 //!   `{l, m}` the complement of `{j, k}` — the forms for which the closed form
-//!   (15) holds (erratum to (7)/(15), `docs/errata-kotter.md`).
+//!   (15) holds (erratum to (7)/(15), `docs/errata.md`).
 //! * `√s_j4` is the principal root of `s_j4 = (s − a_j)(s − a_4)`, and
 //!   `√s_kl := √G / √s_j4` for a chosen branch `√G` of `G(s) = Π (s − a_j)`,
 //!   so that `√s_j4 √s_kl = √G` for every `j` (the cross term of (15)).
@@ -215,7 +215,7 @@ pub fn branch_sign(a: &[f64; 4], s: C, sqrt_g: C) -> Result<f64> {
 /// (the angular velocity of the top with `b = a³`), `e1 = Σ a_i`,
 /// `e2 = Σ_{i<j} a_i a_j`, and `τ = ±1` the branch sign ([`branch_sign`]).
 /// The printed (17)–(18) is the case `b = a²` on the branch `τ = −1`
-/// (erratum, `docs/errata-kotter.md`; derivation in `docs/kotter.md` §2).
+/// (erratum, `docs/errata.md`; derivation in `docs/kotter.md` §2).
 ///
 /// Errors: those of [`schottky`] and [`branch_sign`]; `s = e1` when
 /// `p3 ≠ 0` (a pole of `M_b`).

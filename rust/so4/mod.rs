@@ -16,7 +16,7 @@
 //! The conserved forms consistent with Schottky's generating function (15) use
 //! the complementary pair `{l, m} = {1,2,3,4} \ {j, k}`:
 //! `H2 = Σ_{j<k} (a_l + a_m) l_jk²`, `H3 = Σ_{j<k} a_l a_m l_jk²`
-//! (see `docs/errata-so4.md`). [`integrals4`] returns the corrected forms.
+//! (see `docs/errata.md`). [`integrals4`] returns the corrected forms.
 
 // Index loops mirror the subscripts of the formulas (i, j stages; k components).
 #![allow(clippy::needless_range_loop)]

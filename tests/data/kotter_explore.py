@@ -3,7 +3,7 @@
 
 Pure numpy/scipy, independent of the package. Run: python tests/data/kotter_explore.py
 It prints, for each formula, the residual as printed and, where it fails, the
-residual of the corrected form pinned down here (see docs/errata-kotter.md).
+residual of the corrected form pinned down here (see docs/errata.md).
 """
 
 import itertools

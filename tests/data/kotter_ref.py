@@ -2,7 +2,7 @@
 """Independent numpy reference for the Schottky-Koetter reduction (tests only).
 
 Written from the paper's formulas (12)-(42) and the corrections pinned down in
-``kotter_explore.py`` (see docs/errata-kotter.md); it does not import the
+``kotter_explore.py`` (see docs/errata.md); it does not import the
 package. Conventions (the same ones the package documents in docs/kotter.md):
 
 * state l = (l12, l13, l14, l23, l24, l34), m_j = l_kl, n_j = l_j4 (13),
