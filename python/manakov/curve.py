@@ -70,6 +70,13 @@ def _scalar_or(a: np.ndarray, scalar: bool) -> Any:
     return a[()] if scalar else _frozen(a)
 
 
+def _finite(values: np.ndarray) -> np.ndarray:
+    """Raise instead of returning an overflowed (inf/NaN) value from finite input."""
+    if not np.all(np.isfinite(values)):
+        raise ValueError("the result overflows (inf or NaN) for this x: |x| is too large")
+    return values
+
+
 def _zd_rows(zd: Any, shape: tuple[int, ...]) -> np.ndarray | None:
     """Offsets of shape (..., 2, 5) broadcast to ``shape`` and flattened to rows of 10."""
     if zd is None:
@@ -230,7 +237,7 @@ class KotterCurve:
         """``R(x) = prod_{j=0}^4 (x - d_j)`` (8), elementwise; scalar in, scalar out."""
         xa = _c(x)
         r, _ = _core.curve_eval(self._d123(), xa.reshape(-1))
-        return _scalar_or(r.reshape(xa.shape), xa.ndim == 0)
+        return _scalar_or(_finite(r).reshape(xa.shape), xa.ndim == 0)
 
     def y(self, x: Any, *, sheet: int = 1) -> Any:
         """A square root of ``R(x)``: ``sheet * prod_{j=0}^4 sqrt(x - d_j)``.
@@ -245,7 +252,7 @@ class KotterCurve:
             raise ValueError(f"sheet must be +1 or -1, got {sheet!r}")
         xa = _c(x)
         _, y = _core.curve_eval(self._d123(), xa.reshape(-1))
-        return _scalar_or(sheet * y.reshape(xa.shape), xa.ndim == 0)
+        return _scalar_or(sheet * _finite(y).reshape(xa.shape), xa.ndim == 0)
 
     def wurzel(
         self, z1: Any, y1: Any, z2: Any, y2: Any, *, eps: Any = None, zd: Any = None

@@ -28,6 +28,8 @@ from typing import Any
 import numpy as np
 
 from . import _core
+from .top import _finite_result, _float_array
+from .top import _states as _top_states
 
 __all__ = [
     "Kotter",
@@ -40,30 +42,21 @@ __all__ = [
 ]
 
 
-def _check_a(a: Any) -> np.ndarray:
-    a = np.array(a, dtype=float)
-    if a.shape != (4,):
-        raise ValueError(f"a must have shape (4,), got {a.shape}")
-    if not np.all(np.isfinite(a)):
-        raise ValueError("a must be finite")
-    return a
+def _check_a(a: Any, what: str = "a") -> np.ndarray:
+    """``a`` (or ``b``) as a real, finite float array of shape (4,)."""
+    arr = _float_array(a, what)
+    if arr.shape != (4,):
+        raise ValueError(f"{what} must have shape (4,), got {arr.shape}")
+    return np.ascontiguousarray(arr)
 
 
 def _check_b(b: Any) -> np.ndarray:
-    b = np.array(b, dtype=float)
-    if b.shape != (4,):
-        raise ValueError(f"b must have shape (4,), got {b.shape}")
-    if not np.all(np.isfinite(b)):
-        raise ValueError("b must be finite")
-    return b
+    return _check_a(b, "b")
 
 
 def _states(l: Any) -> tuple[np.ndarray, tuple[int, ...]]:
-    l = np.array(l, dtype=float)
-    if l.ndim == 0 or l.shape[-1] != 6:
-        raise ValueError(f"l must have shape (..., 6), got {l.shape}")
-    shape = l.shape[:-1]
-    return np.ascontiguousarray(l.reshape(-1, 6)), shape
+    """``l`` as real, finite C-contiguous rows of 6 and its leading shape."""
+    return _top_states(l, 6)
 
 
 def integrals(a: Any, l: Any) -> np.ndarray:
@@ -87,7 +80,7 @@ def integrals(a: Any, l: Any) -> np.ndarray:
     """
     a = _check_a(a)
     flat, shape = _states(l)
-    return np.asarray(_core.kotter_integrals(a, flat)).reshape(shape + (4,))
+    return _finite_result(np.asarray(_core.kotter_integrals(a, flat))).reshape(shape + (4,))
 
 
 def schottky(a: Any, l: Any, s: Any, *, sqrt_g: Any = None) -> tuple[np.ndarray, np.ndarray]:
@@ -113,17 +106,28 @@ def schottky(a: Any, l: Any, s: Any, *, sqrt_g: Any = None) -> tuple[np.ndarray,
     (ndarray, ndarray), each of shape (..., 3), complex
     """
     a = _check_a(a)
-    l = np.asarray(l, dtype=float)
-    s = np.asarray(s, dtype=complex)
-    if sqrt_g is None:
-        sqrt_g = np.sqrt(np.prod(s[..., None] - a, axis=-1))
-    sqrt_g = np.asarray(sqrt_g, dtype=complex)
+    flat, lshape = _states(l)
+    l = flat.reshape(lshape + (6,))
+    s, sqrt_g = _s_and_sqrt_g(a, s, sqrt_g)
     shape = np.broadcast_shapes(l.shape[:-1], s.shape, sqrt_g.shape)
     lb = np.ascontiguousarray(np.broadcast_to(l, shape + (6,)).reshape(-1, 6))
     sb = np.ascontiguousarray(np.broadcast_to(s, shape).reshape(-1))
     gb = np.ascontiguousarray(np.broadcast_to(sqrt_g, shape).reshape(-1))
     lv, mv = _core.kotter_schottky(a, lb, sb, gb)
     return np.asarray(lv).reshape(shape + (3,)), np.asarray(mv).reshape(shape + (3,))
+
+
+def _s_and_sqrt_g(a: np.ndarray, s: Any, sqrt_g: Any) -> tuple[np.ndarray, np.ndarray]:
+    """``s`` and the branch of ``sqrt(G(s))`` (default principal), both finite."""
+    s = np.asarray(s, dtype=complex)
+    if not np.all(np.isfinite(s)):
+        raise ValueError("s must be finite; it contains NaN or infinity")
+    if sqrt_g is None:
+        with np.errstate(over="ignore", invalid="ignore"):
+            sqrt_g = np.sqrt(np.prod(s[..., None] - a, axis=-1))
+        if not np.all(np.isfinite(sqrt_g)):
+            raise ValueError("G(s) = prod_j (s - a_j) overflows (is not finite) for this s")
+    return s, np.asarray(sqrt_g, dtype=complex)
 
 
 def _skew3(v: np.ndarray) -> np.ndarray:
@@ -176,13 +180,9 @@ def lax_pair(
     """
     a = _check_a(a)
     b = _check_b(b)
-    l = np.asarray(l, dtype=float)
-    if l.ndim == 0 or l.shape[-1] != 6:
-        raise ValueError(f"l must have shape (..., 6), got {l.shape}")
-    s = np.asarray(s, dtype=complex)
-    if sqrt_g is None:
-        sqrt_g = np.sqrt(np.prod(s[..., None] - a, axis=-1))
-    sqrt_g = np.asarray(sqrt_g, dtype=complex)
+    flat, lshape = _states(l)
+    l = flat.reshape(lshape + (6,))
+    s, sqrt_g = _s_and_sqrt_g(a, s, sqrt_g)
     lv, _ = schottky(a, l, s, sqrt_g=sqrt_g)
     shape = lv.shape[:-1]
     lb = np.ascontiguousarray(np.broadcast_to(l, shape + (6,)).reshape(-1, 6))
@@ -203,12 +203,9 @@ def quartic(a: Any, h: Any) -> np.ndarray:
         If ``h1^2 = 4 h0^2`` (a self-dual or anti-self-dual state): (19) is not defined.
     """
     a = _check_a(a)
-    h = np.array(h, dtype=float)
-    if h.ndim == 0 or h.shape[-1] != 4:
-        raise ValueError(f"h must have shape (..., 4), got {h.shape}")
-    shape = h.shape[:-1]
-    out = _core.kotter_quartic(a, np.ascontiguousarray(h.reshape(-1, 4)))
-    return np.asarray(out).reshape(shape + (5,))
+    flat, shape = _top_states(h, 4, "h")
+    out = _finite_result(np.asarray(_core.kotter_quartic(a, flat)))
+    return out.reshape(shape + (5,))
 
 
 @dataclass(frozen=True, eq=False)  # fields are arrays: no elementwise __eq__

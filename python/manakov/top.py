@@ -106,7 +106,7 @@ def _out(values: np.ndarray, lead: tuple[int, ...]) -> Any:
 
 def to_matrix(l: Any) -> np.ndarray:
     """The skew matrices of states ``l`` of shape ``(..., n(n-1)/2)``: shape ``(..., n, n)``."""
-    arr = np.asarray(l, dtype=float)
+    arr = _float_array(l, "l")
     if arr.ndim == 0:
         raise ValueError("l must have at least one axis")
     n = _n_from_dim(arr.shape[-1])
@@ -122,7 +122,7 @@ def from_matrix(m: Any, *, check: bool = True) -> np.ndarray:
 
     With ``check``, raise ``ValueError`` unless ``m`` is skew to 8 ulps of its largest entry.
     """
-    arr = np.asarray(m, dtype=float)
+    arr = _float_array(m, "m")
     if arr.ndim < 2 or arr.shape[-1] != arr.shape[-2]:
         raise ValueError(f"m must have shape (..., n, n), got {arr.shape}")
     if check:
@@ -568,7 +568,7 @@ class ManakovTop(FrahmTop):
         ndarray, shape (..., K), ordered as :meth:`manakov_integral_labels`
         """
         flat, lead = _states(l, self.dim)
-        vals = _core.manakov_integrals(self._a, flat)
+        vals = _finite_result(_core.manakov_integrals(self._a, flat))
         return vals.reshape(lead + (vals.shape[1],))
 
     def kotter(self, l: Any) -> Any:

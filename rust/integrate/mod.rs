@@ -266,6 +266,14 @@ fn substeps(span: f64, dt: f64) -> f64 {
     }
 }
 
+/// Whether a Gauss step of size `h` may start from the stages of the previous
+/// step (size `last_h`, 0 before the first step). Only between normal sizes with
+/// a finite ratio: with a subnormal `h` the products `h b_j` underflow, and a
+/// ratio `h / last_h` can overflow; both once made NaN stages.
+fn reuse_stages(last_h: f64, h: f64) -> bool {
+    last_h.is_normal() && h.is_normal() && (h / last_h).is_finite()
+}
+
 /// Checks the sample times: finite, `t0 ≤ t[0] ≤ t[1] ≤ …`.
 pub fn check_sample_times(t0: f64, times: &[f64]) -> Result<()> {
     check_finite("t_eval", times)?;
@@ -417,7 +425,7 @@ impl<const S: usize, const M: usize> Stepper for GaussFixed<S, M> {
         for i in 0..S {
             hb[i] = h * self.b[i];
         }
-        if self.last_h == 0.0 {
+        if !reuse_stages(self.last_h, h) {
             // First step: every stage starts from f(y).
             let mut fbuf = [0.0; M];
             f.eval(y, &mut fbuf);
@@ -429,11 +437,12 @@ impl<const S: usize, const M: usize> Stepper for GaussFixed<S, M> {
             }
         } else if h == self.last_h {
             // Predictor: extrapolate the previous step's collocation polynomial,
-            // f at the new nodes = Σ_j ℓ_j(1 + c_i) f(Y_j), with f(Y_j) = L_j / (h b_j).
+            // f at the new nodes = Σ_j ℓ_j(1 + c_i) f(Y_j), with f(Y_j) = L_j / (h b_j);
+            // h cancels (same h), so L_j / b_j is carried and h b_j never divides.
             for k in 0..M {
                 let mut fj = [0.0; S];
                 for j in 0..S {
-                    fj[j] = self.l[k][j] / hb[j];
+                    fj[j] = self.l[k][j] / self.b[j];
                 }
                 let mut acc = [0.0; S];
                 for j in 0..S {
@@ -442,7 +451,7 @@ impl<const S: usize, const M: usize> Stepper for GaussFixed<S, M> {
                     }
                 }
                 for i in 0..S {
-                    self.l[k][i] = hb[i] * acc[i];
+                    self.l[k][i] = self.b[i] * acc[i];
                 }
             }
         } else {
@@ -554,7 +563,7 @@ impl Stepper for GaussDyn {
 
     fn step<F: VectorField>(&mut self, f: &F, y: &mut [f64], h: f64) -> Result<()> {
         let (s, m) = (self.s, self.m);
-        if self.last_h == 0.0 {
+        if !reuse_stages(self.last_h, h) {
             f.eval(y, &mut self.fbuf);
             self.evals += 1;
             for i in 0..s {

@@ -1,0 +1,61 @@
+"""API contract of the reduction and curve functions under bad input: complex where real
+is expected, overflow, non-finite values, malformed shapes (review findings)."""
+
+# ruff: noqa: E741
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import manakov
+from manakov import reduction
+
+P = manakov.problem("generic")
+L0 = np.asarray(P.l0, dtype=float)
+
+
+@pytest.mark.parametrize(
+    "call",
+    [
+        lambda: manakov.kotter(P.a, P.b, L0 + 1j),
+        lambda: manakov.kotter(np.asarray(P.a) + 1j, P.b, L0),
+        lambda: manakov.kotter(P.a, np.asarray(P.b) + 1j, L0),
+        lambda: reduction.integrals(P.a, L0 + 1j),
+        lambda: reduction.quartic(P.a, np.array([0.1, 1.0, 2.0, 3.0]) + 1j),
+        lambda: reduction.schottky(P.a, L0 + 1j, 0.5),
+    ],
+)
+def test_complex_where_real_expected_is_rejected(call):
+    with pytest.raises(ValueError, match="real"):
+        call()
+
+
+def test_integrals_reject_non_finite_and_overflow():
+    with pytest.raises(ValueError, match="finite"):
+        reduction.integrals(P.a, np.full(6, np.nan))
+    with pytest.raises(ValueError, match="overflow"):
+        reduction.integrals(P.a, L0 * 1e300)
+    with pytest.raises(ValueError, match="overflow"):
+        reduction.quartic(P.a, [1e300, 1.0, 2.0, 3.0])
+
+
+def test_schottky_checks_l_shape_and_s_before_numpy_warns():
+    with pytest.raises(ValueError, match="shape"):
+        reduction.schottky(P.a, 1.0, 0.5)
+    with pytest.raises(ValueError, match="shape"):
+        reduction.schottky(P.a, [1.0, 2.0], 0.5)
+    # Under filterwarnings=error a numpy RuntimeWarning from G(inf) would escape instead.
+    with pytest.raises(ValueError, match="finite"):
+        reduction.schottky(P.a, L0, np.inf)
+    with pytest.raises(ValueError, match="finite"):
+        reduction.schottky(P.a, L0, 1e300)
+    with pytest.raises(ValueError, match="finite"):
+        reduction.lax_pair(P.a, P.b, L0, 1e300)
+
+
+def test_curve_overflow_is_an_error():
+    curve = manakov.KotterCurve(0.5 + 0.2j, 1.5 - 0.1j, 2.3 + 0.4j)
+    with pytest.raises(ValueError, match="overflow"):
+        curve.R(1e300)
+    with pytest.raises(ValueError, match="overflow"):
+        curve.y(1e300)
