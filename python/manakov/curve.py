@@ -100,6 +100,24 @@ def _eps_rows(eps: Any, shape: tuple[int, ...]) -> np.ndarray | None:
     return np.ascontiguousarray(e.reshape(-1, 5), dtype=np.int8)
 
 
+def _point_rows(
+    values: tuple[Any, ...], eps: Any, zd: Any
+) -> tuple[tuple[int, ...], list[np.ndarray], np.ndarray | None, np.ndarray | None]:
+    """Broadcast point data with ``eps`` (..., 5) and ``zd`` (..., 2, 5); flatten to rows.
+
+    Returns the common leading shape, the flattened complex ``values``, and the
+    rows of ``eps`` and ``zd`` (``None`` where not given).
+    """
+    arrs = np.broadcast_arrays(*(_c(v) for v in values))
+    shape = arrs[0].shape
+    if eps is not None:
+        shape = np.broadcast_shapes(shape, np.shape(eps)[:-1])
+    if zd is not None:
+        shape = np.broadcast_shapes(shape, np.shape(zd)[:-2])
+    flat = [np.ascontiguousarray(np.broadcast_to(a, shape).reshape(-1)) for a in arrs]
+    return shape, flat, _eps_rows(eps, shape), _zd_rows(zd, shape)
+
+
 @dataclass(frozen=True)
 class Wurzel:
     """The Wurzelfunktionen of point pairs, (27)-(28).
@@ -294,16 +312,7 @@ class KotterCurve:
             divides by zero, an invalid ``eps``, or offsets ``zd`` of the wrong
             shape or inconsistent with ``z1, z2``.
         """
-        arrs = list(np.broadcast_arrays(_c(z1), _c(y1), _c(z2), _c(y2)))
-        shape = arrs[0].shape
-        if eps is not None:
-            shape = np.broadcast_shapes(shape, np.shape(eps)[:-1])
-        if zd is not None:
-            shape = np.broadcast_shapes(shape, np.shape(zd)[:-2])
-        arrs = [np.broadcast_to(a, shape) for a in arrs]
-        e = _eps_rows(eps, shape)
-        zr = _zd_rows(zd, shape)
-        z1f, y1f, z2f, y2f = (np.ascontiguousarray(a.reshape(-1)) for a in arrs)
+        shape, (z1f, y1f, z2f, y2f), e, zr = _point_rows((z1, y1, z2, y2), eps, zd)
         p, pjk = _core.curve_wurzel(self._d123(), z1f, y1f, z2f, y2f, e, zr)
         return Wurzel(P=_frozen(p.reshape(*shape, 5)), Pjk=_frozen(pjk.reshape(*shape, 5, 5)))
 
@@ -345,16 +354,7 @@ class KotterCurve:
         ValueError
             As :meth:`wurzel`, and a non-finite ``g`` or an invalid ``sqrt_c``.
         """
-        arrs = list(np.broadcast_arrays(_c(z1), _c(y1), _c(z2), _c(y2), _c(g)))
-        shape = arrs[0].shape
-        if eps is not None:
-            shape = np.broadcast_shapes(shape, np.shape(eps)[:-1])
-        if zd is not None:
-            shape = np.broadcast_shapes(shape, np.shape(zd)[:-2])
-        arrs = [np.broadcast_to(a, shape) for a in arrs]
-        e = _eps_rows(eps, shape)
-        zr = _zd_rows(zd, shape)
-        z1f, y1f, z2f, y2f, gf = (np.ascontiguousarray(a.reshape(-1)) for a in arrs)
+        shape, (z1f, y1f, z2f, y2f, gf), e, zr = _point_rows((z1, y1, z2, y2, g), eps, zd)
         sc = None if sqrt_c is None else np.ascontiguousarray(_c(sqrt_c).reshape(-1))
         xi, eta = _core.curve_xi_eta(self._d123(), z1f, y1f, z2f, y2f, gf, e, sc, zr)
         return _frozen(xi.reshape(*shape, 3)), _frozen(eta.reshape(*shape, 3))
