@@ -252,7 +252,21 @@ class KotterCurve:
         return hash(self.d)
 
     def R(self, x: Any) -> Any:
-        """``R(x) = prod_{j=0}^4 (x - d_j)`` (8), elementwise; scalar in, scalar out."""
+        """``R(x) = prod_{j=0}^4 (x - d_j)`` (8), elementwise; scalar in, scalar out.
+
+        Parameters
+        ----------
+        x : complex or array_like
+
+        Returns
+        -------
+        complex or ndarray, complex, shape of ``x``
+
+        Raises
+        ------
+        ValueError
+            Non-finite ``x``, or ``R(x)`` overflows.
+        """
         xa = _c(x)
         r, _ = _core.curve_eval(self._d123(), xa.reshape(-1))
         return _scalar_or(_finite(r).reshape(xa.shape), xa.ndim == 0)
@@ -265,6 +279,15 @@ class KotterCurve:
         x : complex or array_like
         sheet : {1, -1}, keyword-only
             ``+1`` is the canonical sheet (product of principal roots), ``-1`` the other.
+
+        Returns
+        -------
+        complex or ndarray, complex, shape of ``x``
+
+        Raises
+        ------
+        ValueError
+            Non-finite ``x``, ``sheet`` not +-1, or ``y(x)`` overflows.
         """
         if sheet not in (1, -1):
             raise ValueError(f"sheet must be +1 or -1, got {sheet!r}")

@@ -77,6 +77,11 @@ def integrals(a: Any, l: Any) -> np.ndarray:
     Returns
     -------
     ndarray, shape (..., 4)
+
+    Raises
+    ------
+    ValueError
+        Wrong shapes, complex or non-finite input, or a result that overflows.
     """
     a = _check_a(a)
     flat, shape = _states(l)
@@ -104,6 +109,12 @@ def schottky(a: Any, l: Any, s: Any, *, sqrt_g: Any = None) -> tuple[np.ndarray,
     Returns
     -------
     (ndarray, ndarray), each of shape (..., 3), complex
+
+    Raises
+    ------
+    ValueError
+        Wrong shapes, complex or non-finite ``a``, ``l``, non-finite ``s``
+        or ``sqrt_g``, ``G(s)`` overflowing, or ``s = a_j``.
     """
     a = _check_a(a)
     flat, lshape = _states(l)
@@ -195,12 +206,26 @@ def lax_pair(
 def quartic(a: Any, h: Any) -> np.ndarray:
     """Coefficients of ``F(s)`` (19), monic, highest power first.
 
-    ``F(s) = [(h1 s^2 - h2 s + h3)^2 - 4 h0^2 G(s)] / (h1^2 - 4 h0^2)``.
+    ``F(s) = [(h1 s^2 - h2 s + h3)^2 - 4 h0^2 G(s)] / (h1^2 - 4 h0^2)``,
+    ``G(s) = prod_j (s - a_j)``.
+
+    Parameters
+    ----------
+    a : array_like, shape (4,)
+        Manakov parameters ``a_i`` (2).
+    h : array_like, shape (..., 4)
+        Integrals ``(h0, h1, h2, h3)`` as returned by :func:`integrals`.
+
+    Returns
+    -------
+    ndarray, shape (..., 5)
+        Coefficients of ``s^4, s^3, ..., s^0``.
 
     Raises
     ------
     ValueError
-        If ``h1^2 = 4 h0^2`` (a self-dual or anti-self-dual state): (19) is not defined.
+        If ``h1^2 = 4 h0^2`` (a self-dual or anti-self-dual state): (19) is not
+        defined; wrong shapes, complex or non-finite input, or an overflow.
     """
     a = _check_a(a)
     flat, shape = _top_states(h, 4, "h")
@@ -402,6 +427,13 @@ def from_kotter(a: Any, b: Any, k: Kotter) -> np.ndarray:
     (with the level set's constants ``d_j`` and ``alpha_j .. delta_j``):
     ``xi_j = sqrt(c_j) g P_kl``, ``eta_j = sqrt(c_j) g P_j4`` (37), then (23)
     ``m_j = alpha_j xi_j + beta_j eta_j``, ``n_j = gamma_j xi_j + delta_j eta_j``.
+
+    Parameters
+    ----------
+    a, b : array_like, shape (4,)
+        Manakov parameters (2) (checked; the map uses the constants stored in ``k``).
+    k : Kotter
+        As returned by :func:`kotter`, possibly with other points, ``g`` or branch.
 
     Returns
     -------

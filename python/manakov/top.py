@@ -58,7 +58,16 @@ DEFAULT_SAMPLES = 1001
 
 
 def state_dim(n: int) -> int:
-    """Length ``n(n-1)/2`` of the so(n) state vector."""
+    """Length ``n(n-1)/2`` of the so(n) state vector (the strict upper triangle of l).
+
+    Parameters
+    ----------
+    n : int
+
+    Returns
+    -------
+    int
+    """
     return n * (n - 1) // 2
 
 
@@ -105,7 +114,22 @@ def _out(values: np.ndarray, lead: tuple[int, ...]) -> Any:
 
 
 def to_matrix(l: Any) -> np.ndarray:
-    """The skew matrices of states ``l`` of shape ``(..., n(n-1)/2)``: shape ``(..., n, n)``."""
+    """The skew matrices of states ``l``: ``L_ij = l_ij``, ``L_ji = -l_ij`` (``i < j``).
+
+    Parameters
+    ----------
+    l : array_like, real, shape (..., n(n-1)/2)
+        Strict upper triangles, row by row.
+
+    Returns
+    -------
+    ndarray, shape (..., n, n)
+
+    Raises
+    ------
+    ValueError
+        A last axis that is not ``n(n-1)/2``, complex or non-finite values.
+    """
     arr = _float_array(l, "l")
     if arr.ndim == 0:
         raise ValueError("l must have at least one axis")
@@ -118,9 +142,22 @@ def to_matrix(l: Any) -> np.ndarray:
 
 
 def from_matrix(m: Any, *, check: bool = True) -> np.ndarray:
-    """The state vectors (strict upper triangles) of skew matrices ``m`` of shape ``(..., n, n)``.
+    """The state vectors ``l_ij = m_ij`` (``i < j``, row by row) of skew matrices ``m``.
 
-    With ``check``, raise ``ValueError`` unless ``m`` is skew to 8 ulps of its largest entry.
+    Parameters
+    ----------
+    m : array_like, real, shape (..., n, n)
+    check : bool, keyword-only
+        Require ``m`` to be skew, ``m_ji = -m_ij``, to 8 ulps of its largest entry.
+
+    Returns
+    -------
+    ndarray, shape (..., n(n-1)/2)
+
+    Raises
+    ------
+    ValueError
+        Not square, complex or non-finite values, or (with ``check``) not skew.
     """
     arr = _float_array(m, "m")
     if arr.ndim < 2 or arr.shape[-1] != arr.shape[-2]:
@@ -149,6 +186,11 @@ def poisson_tensor(l: Any) -> np.ndarray:
     Returns
     -------
     ndarray, shape (..., n(n-1)/2, n(n-1)/2)
+
+    Raises
+    ------
+    ValueError
+        A last axis that is not ``n(n-1)/2`` (n >= 2), complex or non-finite values.
     """
     arr = _float_array(l, "l")
     if arr.ndim == 0:
@@ -187,7 +229,12 @@ class Trajectory:
     evals: int
 
     def relative_drift(self) -> dict[str, np.ndarray]:
-        """``|I(t) - I(t0)| / |I(t0)|`` for each integral (absolute if ``I(t0) = 0``)."""
+        """``|I(t) - I(t0)| / |I(t0)|`` for each integral (absolute if ``I(t0) = 0``).
+
+        Returns
+        -------
+        dict of str to ndarray, shape (S,)
+        """
         out = {}
         for name, v in self.integrals.items():
             ref = abs(v[0]) if v[0] != 0 else 1.0
@@ -195,7 +242,12 @@ class Trajectory:
         return out
 
     def max_drift(self) -> dict[str, float]:
-        """The largest relative drift of each integral over the samples."""
+        """The largest relative drift ``max_t |I(t) - I(t0)| / |I(t0)|`` of each integral.
+
+        Returns
+        -------
+        dict of str to float
+        """
         return {k: float(np.max(v, initial=0.0)) for k, v in self.relative_drift().items()}
 
 
@@ -250,20 +302,53 @@ class FrahmTop:
         Returns
         -------
         ndarray, same shape as ``l``
+
+        Raises
+        ------
+        ValueError
+            Wrong last axis, complex or non-finite ``l``, or a result that overflows.
         """
         flat, lead = _states(l, self.dim)
         return _finite_result(_core.vector_field(self._c, flat)).reshape(lead + (self.dim,))
 
     def hamiltonian(self, l: Any) -> Any:
-        """The energy (4), ``H = ½ Σ_{j<k} c_jk l_jk²``; shape ``l.shape[:-1]``."""
+        """The energy (4), ``H = ½ Σ_{j<k} c_jk l_jk²``.
+
+        Parameters
+        ----------
+        l : array_like, shape (..., n(n-1)/2)
+
+        Returns
+        -------
+        float or ndarray, shape ``l.shape[:-1]``
+
+        Raises
+        ------
+        ValueError
+            Wrong last axis, complex or non-finite ``l``, or a result that overflows.
+        """
         flat, lead = _states(l, self.dim)
         return _out(_core.hamiltonian(self._c, flat), lead)
 
     def integrals(self, l: Any) -> dict[str, Any]:
         """Conserved quantities of (1) for any symmetric ``c``.
 
-        ``H1 = Σ_{j<k} l_jk²`` (the Casimir ``-½ tr l²``), ``H`` (4), and for
+        ``H1 = Σ_{j<k} l_jk²`` (7) (the Casimir ``-½ tr l²``), ``H`` (4), and for
         n = 4 also the Casimir ``H0 = l12 l34 + l23 l14 + l31 l24`` (6).
+
+        Parameters
+        ----------
+        l : array_like, shape (..., n(n-1)/2)
+
+        Returns
+        -------
+        dict of str to float or ndarray
+            Keys ``"H0"`` (n = 4 only), ``"H1"``, ``"H"``; values of shape ``l.shape[:-1]``.
+
+        Raises
+        ------
+        ValueError
+            Wrong last axis, complex or non-finite ``l``, or a result that overflows.
         """
         flat, lead = _states(l, self.dim)
         out: dict[str, Any] = {}
@@ -283,6 +368,20 @@ class FrahmTop:
         """``1/Ω``, ``Ω = (max_{i≠j} c_ij - min_{i≠j} c_ij) · ‖l0‖₂``; ``inf`` if Ω = 0.
 
         ``Ω`` bounds ``|c_kj - c_ik| · ‖l‖``, the Lipschitz constant of (1) on the orbit.
+
+        Parameters
+        ----------
+        l0 : array_like, real
+            A state (any shape; only its norm enters).
+
+        Returns
+        -------
+        float
+
+        Raises
+        ------
+        ValueError
+            Complex or non-finite ``l0``.
         """
         l0a = _float_array(l0, "l0")
         n, c = self.n, self._c
@@ -296,7 +395,25 @@ class FrahmTop:
         return math.inf if omega == 0 else 1.0 / omega
 
     def default_dt(self, l0: Any, method: str = "gauss16") -> float:
-        """The default step of ``method`` for this top from ``l0`` (0 for explicit: automatic)."""
+        """The default step of ``method`` for this top from ``l0``: ``DT_SCALE[method] / Ω``.
+
+        ``Ω`` as in :meth:`time_scale`; 1 if ``Ω = 0``; 0 (automatic) for explicit methods.
+
+        Parameters
+        ----------
+        l0 : array_like, real
+        method : str
+            One of :data:`METHODS`.
+
+        Returns
+        -------
+        float
+
+        Raises
+        ------
+        ValueError
+            Unknown ``method``, complex or non-finite ``l0``, or a step that underflows.
+        """
         if method not in METHODS:
             raise ValueError(f"unknown method {method!r}; known: {', '.join(METHODS)}")
         if method in _EXPLICIT:
@@ -457,6 +574,13 @@ class FrahmTop:
         -------
         t : ndarray, shape (S,)
         l : ndarray, shape (..., S, n(n-1)/2)
+
+        Raises
+        ------
+        ValueError
+            As :meth:`integrate`.
+        manakov.ConvergenceError
+            As :meth:`integrate`.
         """
         flat, lead = _states(l0s, self.dim, "l0s")
         times = self._sample_times(t_end, t_eval, sample_every)
@@ -537,6 +661,20 @@ class ManakovTop(FrahmTop):
         ``H2 = Σ (a_l + a_m) l_jk²``, ``H3 = Σ a_l a_m l_jk²``), and ``H`` (4).
         For n ≠ 4: ``H1``, ``H`` and Manakov's integrals ``"I{k}_{j}"``, the
         coefficient of ``λ^j`` in ``tr (l + λ diag(a))^k``.
+
+        Parameters
+        ----------
+        l : array_like, shape (..., n(n-1)/2)
+
+        Returns
+        -------
+        dict of str to float or ndarray
+            Values of shape ``l.shape[:-1]``.
+
+        Raises
+        ------
+        ValueError
+            Wrong last axis, complex or non-finite ``l``, or a result that overflows.
         """
         flat, lead = _states(l, self.dim)
         if self.n == 4:
@@ -554,6 +692,10 @@ class ManakovTop(FrahmTop):
         """Labels ``(k, j)`` of :meth:`manakov_integrals`.
 
         ``k = 2..n``, ``j <= k - 2``, ``k - j`` even (the others vanish or are constant).
+
+        Returns
+        -------
+        list of (int, int)
         """
         return [tuple(x) for x in _core.manakov_integral_labels(self.n)]  # type: ignore[misc]
 
@@ -563,9 +705,18 @@ class ManakovTop(FrahmTop):
         Conserved by (1)–(2) for every n because (1) is the Lax equation
         ``d/dt (l + λA) = [l + λA, ω + λB]``, ``B = diag(b)`` [Ma 1977].
 
+        Parameters
+        ----------
+        l : array_like, shape (..., n(n-1)/2)
+
         Returns
         -------
         ndarray, shape (..., K), ordered as :meth:`manakov_integral_labels`
+
+        Raises
+        ------
+        ValueError
+            Wrong last axis, complex or non-finite ``l``, or a result that overflows.
         """
         flat, lead = _states(l, self.dim)
         vals = _finite_result(_core.manakov_integrals(self._a, flat))
@@ -579,9 +730,18 @@ class ManakovTop(FrahmTop):
         points of the curve (8) with g, such that ξ_j = √c_j g P_kl, η_j = √c_j g P_j4
         (37), (42). See ``docs/kotter.md``.
 
+        Parameters
+        ----------
+        l : array_like, shape (..., 6)
+
         Returns
         -------
         manakov.Kotter
+
+        Raises
+        ------
+        ValueError
+            ``n != 4``, and as :func:`manakov.kotter`.
         """
         from .reduction import kotter
 
@@ -594,9 +754,19 @@ class ManakovTop(FrahmTop):
         Shorthand for :func:`manakov.from_kotter` ``(self.a, self.b, k)``: rebuilds
         ξ, η from the curve points and g by (37) and inverts (23).
 
+        Parameters
+        ----------
+        k : manakov.Kotter
+            As returned by :meth:`kotter`.
+
         Returns
         -------
         ndarray, shape (..., 6)
+
+        Raises
+        ------
+        ValueError
+            ``n != 4``, and as :func:`manakov.from_kotter`.
         """
         from .reduction import from_kotter
 
