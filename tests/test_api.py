@@ -148,13 +148,14 @@ def test_no_panic_reaches_python_from_the_core():
         lambda: _core.so4_integrals(np.ones(3), np.ones((1, 6))),
         lambda: _core.manakov_integrals(np.arange(4.0), np.ones((1, 5))),
         lambda: _core.poisson_tensor(np.ones((1, 4))),
-        lambda: _core.integrate(cm, np.ones(5), 0.0, np.array([1.0]), "gauss6", 0.1, 0, 0),
-        lambda: _core.integrate(cm, np.ones(6), 0.0, np.array([1.0]), "nope", 0.1, 0, 0),
-        lambda: _core.integrate(cm, np.ones(6), 0.0, np.array([np.nan]), "gauss6", 0.1, 0, 0),
-        lambda: _core.integrate(cm, np.ones(6), np.inf, np.array([1.0]), "gauss6", 0.1, 0, 0),
+        lambda: _core.integrate(cm, np.ones(5), 0.0, np.array([1.0]), "gauss6", 0.1, 0, 0, 1000),
+        lambda: _core.integrate(cm, np.ones(6), 0.0, np.array([1.0]), "nope", 0.1, 0, 0, 1000),
+        lambda: _core.integrate(cm, np.ones(6), 0.0, np.array([np.nan]), "gauss6", 0.1, 0, 0, 1000),
+        lambda: _core.integrate(cm, np.ones(6), np.inf, np.array([1.0]), "gauss6", 0.1, 0, 0, 1000),
         lambda: _core.integrate_many(
-            cm, np.ones((2, 5)), 0.0, np.array([1.0]), "gauss6", 0.1, 0, 0, True
+            cm, np.ones((2, 5)), 0.0, np.array([1.0]), "gauss6", 0.1, 0, 0, 1000, True
         ),
+        lambda: _core.integrate(cm, np.ones(6), 0.0, np.array([1.0]), "gauss6", 0.1, 0, 0, 0),
         lambda: _core.gauss_tableau("dopri5"),
         lambda: _core.manakov_c(np.ones(3), np.ones(3)),
     ]
@@ -218,3 +219,33 @@ def test_so_n_integrate_subnormal_step():
     top3 = manakov.ManakovTop([1.0, 2.0, 3.0], [3.0, 1.0, 2.0])
     tr = top3.integrate([1.0, 2.0, 3.0], 1.0, t_eval=[1e-320, 1.0], method="gauss6")
     assert np.all(np.isfinite(tr.l))
+
+
+@pytest.mark.parametrize("method", ["gauss16", "gauss4", "dop853", "dopri5"])
+def test_step_budget_bounds_every_method(top, method):
+    """A huge t_end once ran for hours (up to 1e11 steps, GIL released, no Ctrl-C)."""
+    l0 = manakov.problem("generic").l0
+    with pytest.raises(ValueError, match="max_steps"):
+        top.integrate(l0, 1e12, t_eval=[0.0, 1e12], method=method, max_steps=1000)
+    with pytest.raises(ValueError, match="max_steps"):
+        top.integrate_many(np.array([l0]), 1e12, t_eval=[0.0, 1e12], method=method, max_steps=1000)
+    # Samples do not reset the budget: 100 samples of ~30 steps each exceed 1000.
+    with pytest.raises(ValueError, match="max_steps"):
+        top.integrate(l0, 1e4, sample_every=100.0, method=method, max_steps=1000)
+    # ... nor do chunks of the Python loop.
+    with pytest.raises(ValueError, match="max_steps"):
+        top.integrate(l0, 1e4, method=method, max_steps=1000, chunks=50)
+
+
+def test_default_step_budget_stops_a_huge_gauss_run_at_once(top):
+    l0 = manakov.problem("generic").l0
+    # ~3e9 default gauss16 steps: refused before any step is taken.
+    with pytest.raises(ValueError, match="max_steps"):
+        top.integrate(l0, 1e9, t_eval=[0.0, 1e9])
+    assert manakov.top.DEFAULT_MAX_STEPS <= 10**8
+
+
+@pytest.mark.parametrize("bad", [0, -1, 1.5, 10**12, "many"])
+def test_max_steps_must_be_a_positive_integer(top, bad):
+    with pytest.raises(ValueError, match="max_steps"):
+        top.integrate(manakov.problem("generic").l0, 1.0, max_steps=bad)

@@ -198,11 +198,22 @@ pub struct Options {
     pub rtol: f64,
     /// `dopri5` absolute tolerance.
     pub atol: f64,
+    /// The largest number of steps one call may take, over all sample times
+    /// (at most [`MAX_STEPS`]). Gauss methods check it before the first step,
+    /// explicit methods while stepping; either way the call fails with
+    /// `InvalidArgument` instead of running for hours.
+    pub max_steps: u64,
 }
 
 impl Options {
-    /// Checks `dt`, `rtol`, `atol`.
+    /// Checks `dt`, `rtol`, `atol`, `max_steps`.
     pub fn validate(&self) -> Result<()> {
+        if self.max_steps == 0 || self.max_steps as f64 > MAX_STEPS {
+            return Err(Error::InvalidArgument {
+                what: "max_steps",
+                reason: format!("must be in [1, {MAX_STEPS:e}], got {}", self.max_steps),
+            });
+        }
         let gauss = self.method.stages().is_some();
         if !self.dt.is_finite() || self.dt < 0.0 || (gauss && self.dt == 0.0) {
             return Err(Error::InvalidArgument {
@@ -241,8 +252,8 @@ pub struct Trajectory {
     pub evals: u64,
 }
 
-/// Hard cap on the number of steps of one call, so that a tiny `dt` is an
-/// error rather than an apparent hang (10^11 steps is ~a day of computing).
+/// Hard cap on [`Options::max_steps`] (10^11 steps is ~a day of computing);
+/// below 2^53, so step counts held in f64 are exact.
 pub const MAX_STEPS: f64 = 1e11;
 
 /// Fixed-point iterations allowed per Gauss step. Convergence is linear with
@@ -272,6 +283,17 @@ fn substeps(span: f64, dt: f64) -> f64 {
 /// ratio `h / last_h` can overflow; both once made NaN stages.
 fn reuse_stages(last_h: f64, h: f64) -> bool {
     last_h.is_normal() && h.is_normal() && (h / last_h).is_finite()
+}
+
+/// The error of an explicit method that needs more than its step budget.
+fn too_many_steps(budget: u64) -> Error {
+    Error::InvalidArgument {
+        what: "rtol/atol",
+        reason: format!(
+            "more steps needed than the remaining budget of {budget} (max_steps); \
+             loosen rtol/atol, shorten t_end or raise max_steps"
+        ),
+    }
 }
 
 /// Checks the sample times: finite, `t0 ≤ t[0] ≤ t[1] ≤ …`.
@@ -723,13 +745,15 @@ impl Dopri5 {
         }
     }
 
-    /// Advances `y` from `t` to exactly `t_target` with adaptive steps; returns the number of steps.
+    /// Advances `y` from `t` to exactly `t_target` with adaptive steps; returns the number
+    /// of steps, failing once more than `budget` are needed.
     fn advance<F: VectorField>(
         &mut self,
         f: &F,
         y: &mut [f64],
         t: &mut f64,
         t_target: f64,
+        budget: u64,
     ) -> Result<u64> {
         let m = self.m;
         let mut steps = 0u64;
@@ -811,11 +835,8 @@ impl Dopri5 {
             } else {
                 self.h = h * fac.min(1.0);
             }
-            if steps as f64 > MAX_STEPS {
-                return Err(Error::InvalidArgument {
-                    what: "rtol/atol",
-                    reason: format!("more than {MAX_STEPS:e} steps needed"),
-                });
+            if steps > budget {
+                return Err(too_many_steps(budget));
             }
         }
         Ok(steps)
@@ -888,11 +909,12 @@ fn integrate_into<F: VectorField>(
                 (tk, n + substeps(tk - prev, opts.dt))
             })
             .1;
-        if total > MAX_STEPS {
+        if total > opts.max_steps as f64 {
             return Err(Error::InvalidArgument {
                 what: "dt",
                 reason: format!(
-                    "{total:e} steps would be needed (limit {MAX_STEPS:e}); increase dt"
+                    "{total:e} steps would be needed (max_steps = {}); increase dt or max_steps",
+                    opts.max_steps
                 ),
             });
         }
@@ -938,17 +960,21 @@ fn integrate_into<F: VectorField>(
         };
     } else if opts.method == Method::Dop853 {
         let mut d = dop853::Dop853::new(m, opts.dt, opts.rtol, opts.atol);
+        let mut taken = 0u64;
         for &tk in times {
-            *steps += d.advance(f, &mut y, &mut t, tk)?;
+            taken += d.advance(f, &mut y, &mut t, tk, opts.max_steps - taken)?;
             ys.extend_from_slice(&y);
         }
+        *steps += taken;
         *evals += d.evals;
     } else {
         let mut d = Dopri5::new(m, opts);
+        let mut taken = 0u64;
         for &tk in times {
-            *steps += d.advance(f, &mut y, &mut t, tk)?;
+            taken += d.advance(f, &mut y, &mut t, tk, opts.max_steps - taken)?;
             ys.extend_from_slice(&y);
         }
+        *steps += taken;
         *evals += d.evals;
     }
     Ok(())
@@ -1058,6 +1084,7 @@ mod tests {
             dt,
             rtol: 1e-10,
             atol: 1e-10,
+            max_steps: MAX_STEPS as u64,
         }
     }
 
@@ -1139,6 +1166,7 @@ mod tests {
                 dt: h,
                 rtol: 1e3,
                 atol: 1e3,
+                max_steps: MAX_STEPS as u64,
             };
             let tr = integrate(&Osc, &[1.0, 0.0], 0.0, &times, &o).unwrap();
             let n = tr.y.len();

@@ -190,12 +190,13 @@ fn poisson_tensor_py<'py>(
         .into_pyarray(py))
 }
 
-fn options(method: &str, dt: f64, rtol: f64, atol: f64) -> Result<Options, Error> {
+fn options(method: &str, dt: f64, rtol: f64, atol: f64, max_steps: u64) -> Result<Options, Error> {
     let o = Options {
         method: Method::from_name(method)?,
         dt,
         rtol,
         atol,
+        max_steps,
     };
     o.validate()?;
     Ok(o)
@@ -203,7 +204,7 @@ fn options(method: &str, dt: f64, rtol: f64, atol: f64) -> Result<Options, Error
 
 /// Integrates (1) from l0 at t0, sampling at `times`; returns (l (S, m), steps, evals).
 #[pyfunction(name = "integrate")]
-#[pyo3(signature = (c, l0, t0, times, method, dt, rtol, atol))]
+#[pyo3(signature = (c, l0, t0, times, method, dt, rtol, atol, max_steps))]
 #[allow(clippy::too_many_arguments)]
 fn integrate_py<'py>(
     py: Python<'py>,
@@ -215,10 +216,11 @@ fn integrate_py<'py>(
     dt: f64,
     rtol: f64,
     atol: f64,
+    max_steps: u64,
 ) -> PyResult<(Bound<'py, PyArray2<f64>>, u64, u64)> {
     let top = top_from_c(&c)?;
     let (l0, times) = (vec1(&l0), vec1(&times));
-    let opts = options(method, dt, rtol, atol)?;
+    let opts = options(method, dt, rtol, atol, max_steps)?;
     let tr = py.detach(|| integrate::integrate(&top, &l0, t0, &times, &opts))?;
     let m = top.dim();
     let y = Array2::from_shape_vec((tr.t.len(), m), tr.y)
@@ -229,7 +231,7 @@ fn integrate_py<'py>(
 
 /// Integrates a batch (B, m) of initial states; returns (l (B, S, m), steps).
 #[pyfunction(name = "integrate_many")]
-#[pyo3(signature = (c, l0s, t0, times, method, dt, rtol, atol, parallel))]
+#[pyo3(signature = (c, l0s, t0, times, method, dt, rtol, atol, max_steps, parallel))]
 #[allow(clippy::too_many_arguments)]
 fn integrate_many_py<'py>(
     py: Python<'py>,
@@ -241,13 +243,14 @@ fn integrate_many_py<'py>(
     dt: f64,
     rtol: f64,
     atol: f64,
+    max_steps: u64,
     parallel: bool,
 ) -> PyResult<(Bound<'py, PyArray3<f64>>, u64)> {
     let top = top_from_c(&c)?;
     let (l0s, rows, cols) = vec2(&l0s);
     check_states("l0s", cols, top.dim())?;
     let times = vec1(&times);
-    let opts = options(method, dt, rtol, atol)?;
+    let opts = options(method, dt, rtol, atol, max_steps)?;
     let (ys, steps) =
         py.detach(|| integrate::integrate_many(&top, &l0s, t0, &times, &opts, parallel))?;
     let y = Array3::from_shape_vec((rows, times.len(), cols), ys)
