@@ -117,7 +117,8 @@ def test_frahm_top_rejects_bad_c(c, match):
 
 def test_frahm_top_accepts_roundoff_asymmetry():
     c = np.array([[0, 1, 2], [1 + 2e-16, 0, 3], [2, 3, 0]])
-    manakov.FrahmTop(c)
+    top = manakov.FrahmTop(c)  # 2e-16 is 1 ulp of 1 < the 8-ulp symmetry tolerance
+    np.testing.assert_array_equal(top.c, c)
 
 
 @pytest.mark.parametrize(

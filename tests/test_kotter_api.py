@@ -59,3 +59,32 @@ def test_curve_overflow_is_an_error():
         curve.R(1e300)
     with pytest.raises(ValueError, match="overflow"):
         curve.y(1e300)
+
+
+def test_inputs_are_not_modified_and_strided_read_only_inputs_work():
+    top = manakov.ManakovTop(P.a, P.b)
+    base = np.tile(L0, (3, 2))
+    view = base[:, ::2]  # non-contiguous, shape (3, 6)
+    before = base.copy()
+    a = np.array(P.a, dtype=float)
+    a_before = a.copy()
+    k = manakov.kotter(a, P.b, view)
+    reduction.integrals(a, view)
+    reduction.schottky(a, view, 0.3 + 0.1j)
+    reduction.lax_pair(a, P.b, view, 0.3 + 0.1j)
+    ro = np.asfortranarray(view)
+    ro.setflags(write=False)
+    k_ro = top.kotter(ro)
+    np.testing.assert_array_equal(k_ro.z1, k.z1)
+    np.testing.assert_array_equal(base, before)
+    np.testing.assert_array_equal(a, a_before)
+    curve = k.curve[0]
+    z1 = np.array(k.z1)
+    z1_before = z1.copy()
+    xi = np.array(k.xi)
+    xi_before = xi.copy()
+    curve.wurzel(z1[0], k.y1[0], k.z2[0], k.y2[0])
+    curve.points_from_wurzel(xi[0], k.eta[0])
+    top.from_kotter(k)
+    np.testing.assert_array_equal(z1, z1_before)
+    np.testing.assert_array_equal(xi, xi_before)
