@@ -88,3 +88,20 @@ def test_inputs_are_not_modified_and_strided_read_only_inputs_work():
     top.from_kotter(k)
     np.testing.assert_array_equal(z1, z1_before)
     np.testing.assert_array_equal(xi, xi_before)
+
+
+@pytest.mark.parametrize("scale", [1e-100, 1e-80, 1e77, 1e150])
+def test_kotter_out_of_range_state_names_the_cause(scale):
+    """Out of range, h ~ |l|^2 and F's coefficients ~ |l|^4 under/overflow; the errors
+    once blamed a self-dual state (1e-100) or the form (38)/(40) (1e-80)."""
+    with pytest.raises(ValueError, match="rescale l"):
+        manakov.kotter(P.a, P.b, L0 * scale)
+
+
+@pytest.mark.parametrize("scale", [1e-50, 1e50])
+def test_kotter_inside_the_range_round_trips(scale):
+    top = manakov.ManakovTop(P.a, P.b)
+    l = L0 * scale
+    back = top.from_kotter(top.kotter(l))
+    # The round-trip claim of issue 4 (1e-12, relative to |l|), at any scale in range.
+    np.testing.assert_allclose(back, l, rtol=0, atol=1e-12 * np.max(np.abs(l)))

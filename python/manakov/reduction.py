@@ -42,6 +42,12 @@ __all__ = [
 ]
 
 
+#: Range of ``max |l_ij|`` accepted by :func:`kotter`. The coefficients of F (19)
+#: are quartic in l, so they overflow near 1e77 and underflow (to a spurious
+#: self-dual state) near 1e-77; 1e-60 .. 1e60 keeps ~1e17 of headroom either side.
+STATE_RANGE = (1e-60, 1e60)
+
+
 def _check_a(a: Any, what: str = "a") -> np.ndarray:
     """``a`` (or ``b``) as a real, finite float array of shape (4,)."""
     arr = _float_array(a, what)
@@ -393,7 +399,8 @@ def kotter(a: Any, b: Any, l: Any) -> Kotter:
     Raises
     ------
     ValueError
-        Non-finite input; repeated ``a_i``; ``h0 = 0`` or ``h1^2 = 4 h0^2``
+        Non-finite input; ``max |l_ij|`` outside :data:`STATE_RANGE` (rescale
+        l); repeated ``a_i``; ``h0 = 0`` or ``h1^2 = 4 h0^2``
         (``F`` (19) undefined or with double roots); repeated roots of ``F``;
         a root of ``F`` at some ``a_j``; coinciding branch points ``d_j`` of
         the curve (its genus drops); ``z1 = z2``; ``1 - eps P_0 = 0``.
@@ -401,6 +408,14 @@ def kotter(a: Any, b: Any, l: Any) -> Kotter:
     a = _check_a(a)
     _check_b(b)
     flat, shape = _states(l)
+    size = np.max(np.abs(flat), axis=1, initial=0.0)
+    bad = (size > 0) & ((size < STATE_RANGE[0]) | (size > STATE_RANGE[1]))
+    if np.any(bad):
+        raise ValueError(
+            f"l has max |l_ij| = {size[bad][0]:e}, outside [{STATE_RANGE[0]:e}, "
+            f"{STATE_RANGE[1]:e}] where the integrals (~|l|^2) and the coefficients of "
+            "F (19) (~|l|^4) neither overflow nor underflow: rescale l"
+        )
     raw = _core.kotter_batch(a, flat)
     fields: dict[str, Any] = {}
     for name, fshape in _FIELD_SHAPES.items():
