@@ -105,3 +105,15 @@ def test_kotter_inside_the_range_round_trips(scale):
     back = top.from_kotter(top.kotter(l))
     # The round-trip claim of issue 4 (1e-12, relative to |l|), at any scale in range.
     np.testing.assert_allclose(back, l, rtol=0, atol=1e-12 * np.max(np.abs(l)))
+
+
+def test_from_kotter_rejects_g_zero_and_non_kotter():
+    import dataclasses
+
+    top = manakov.ManakovTop(P.a, P.b)
+    k = top.kotter(L0)
+    # g = 1/(1 - eps P_0) (42) is never 0; g = 0 once gave l = 0 silently.
+    with pytest.raises(ValueError, match="g"):
+        top.from_kotter(dataclasses.replace(k, g=0.0))
+    with pytest.raises(TypeError, match="Kotter"):
+        top.from_kotter(5)

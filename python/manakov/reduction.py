@@ -458,10 +458,16 @@ def from_kotter(a: Any, b: Any, k: Kotter) -> np.ndarray:
     ------
     ValueError
         Points off the curve, offsets ``zd`` inconsistent with ``z1, z2``,
-        ``z1 = z2``, a bad branch, or data that give a complex state.
+        ``z1 = z2``, ``g = 0``, a bad branch, or data that give a complex state.
+    TypeError
+        ``k`` is not a :class:`Kotter`.
     """
     _check_a(a)
     _check_b(b)
+    if not isinstance(k, Kotter):
+        raise TypeError(f"k must be a manakov.Kotter, got {type(k).__name__}")
+    if np.any(np.asarray(k.g) == 0):
+        raise ValueError("g = 0: g = 1/(1 - eps P_0) (42) never vanishes")
     z1 = np.asarray(k.z1, dtype=complex)
     shape = z1.shape
 
