@@ -250,3 +250,11 @@ def test_default_step_budget_stops_a_huge_gauss_run_at_once(top):
 def test_max_steps_must_be_a_positive_integer(top, bad):
     with pytest.raises(ValueError, match="max_steps"):
         top.integrate(manakov.problem("generic").l0, 1.0, max_steps=bad)
+
+
+def test_empty_trajectory_has_empty_drifts(top):
+    """A run with no samples once raised IndexError in relative_drift."""
+    tr = top.integrate(manakov.problem("generic").l0, 1.0, t_eval=[])
+    assert tr.l.shape == (0, 6)
+    assert all(v.shape == (0,) for v in tr.relative_drift().values())
+    assert all(v == 0.0 for v in tr.max_drift().values())

@@ -247,6 +247,9 @@ class Trajectory:
         """
         out = {}
         for name, v in self.integrals.items():
+            if v.size == 0:
+                out[name] = np.zeros(0)
+                continue
             ref = abs(v[0]) if v[0] != 0 else 1.0
             out[name] = np.abs(v - v[0]) / ref
         return out
