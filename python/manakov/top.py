@@ -427,8 +427,7 @@ class FrahmTop:
         ValueError
             Unknown ``method``, complex or non-finite ``l0``, or a step that underflows.
         """
-        if method not in METHODS:
-            raise ValueError(f"unknown method {method!r}; known: {', '.join(METHODS)}")
+        _check_method(method)
         if method in _EXPLICIT:
             return 0.0
         ts = self.time_scale(l0)
@@ -475,8 +474,7 @@ class FrahmTop:
         return int(max_steps)
 
     def _options(self, l0: Any, method: str, dt: Any) -> float:
-        if method not in METHODS:
-            raise ValueError(f"unknown method {method!r}; known: {', '.join(METHODS)}")
+        _check_method(method)
         if dt is None:
             return self.default_dt(l0, method)
         dtf = _scalar(dt, "dt")
@@ -619,8 +617,7 @@ class FrahmTop:
         """
         flat, lead = _states(l0s, self.dim, "l0s")
         times = self._sample_times(t_end, t_eval, sample_every)
-        if method not in METHODS:
-            raise ValueError(f"unknown method {method!r}; known: {', '.join(METHODS)}")
+        _check_method(method)
         if dt is None:
             # One step for the whole batch: the smallest default over its members.
             dtf = min((self.default_dt(x, method) for x in flat), default=1.0)
@@ -815,6 +812,11 @@ class ManakovTop(FrahmTop):
 
     def __repr__(self) -> str:
         return f"ManakovTop(a={self._a.tolist()}, b={self._b.tolist()})"
+
+
+def _check_method(method: Any) -> None:
+    if not isinstance(method, str) or method not in METHODS:
+        raise ValueError(f"unknown method {method!r}; known: {', '.join(METHODS)}")
 
 
 def _scalar(x: Any, what: str) -> float:
