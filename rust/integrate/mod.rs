@@ -1228,4 +1228,48 @@ mod tests {
             }
         }
     }
+
+    #[test]
+    fn subnormal_steps_restart_the_stages() {
+        // A subnormal h once made 0/0 (h b_j) in the predictor and an infinite
+        // ratio h / last_h on the next normal step.
+        let top = FrahmTop::manakov(&A, &B).unwrap();
+        let times = [1e-320, 2e-320, 1.0];
+        for m in [Method::Gauss4, Method::Gauss16] {
+            let tr = integrate(&top, &L0, 0.0, &times, &opts(m, 0.05)).unwrap();
+            assert_eq!(&tr.y[..6], &L0[..], "a subnormal step cannot move l");
+            let direct = integrate(&top, &L0, 0.0, &[1.0], &opts(m, 0.05)).unwrap();
+            for k in 0..6 {
+                // Same step on [0, 1]; only the restart of the stage guess differs.
+                assert!((tr.y[12 + k] - direct.y[k]).abs() < 1e-14);
+            }
+        }
+        let osc = integrate(
+            &Osc,
+            &[1.0, 0.0],
+            0.0,
+            &[5e-324, 1.0],
+            &opts(Method::Gauss6, 0.1),
+        );
+        assert!(osc.unwrap().y.iter().all(|v| v.is_finite()));
+    }
+
+    #[test]
+    fn step_budget_counts_every_sample_of_a_call() {
+        let top = FrahmTop::manakov(&A, &B).unwrap();
+        let times: Vec<f64> = (1..=100).map(f64::from).collect();
+        for m in [Method::Dopri5, Method::Dop853, Method::Gauss6] {
+            let mut o = opts(m, if m == Method::Gauss6 { 0.1 } else { 0.0 });
+            let full = integrate(&top, &L0, 0.0, &times, &o).unwrap();
+            // Each sample interval needs fewer steps than the budget, the call more.
+            o.max_steps = full.steps / 2;
+            let err = integrate(&top, &L0, 0.0, &times, &o).unwrap_err();
+            assert!(err.to_string().contains("max_steps"), "{err}");
+            o.max_steps = full.steps;
+            assert_eq!(integrate(&top, &L0, 0.0, &times, &o).unwrap().y, full.y);
+        }
+        let mut o = opts(Method::Gauss6, 0.1);
+        o.max_steps = 0;
+        assert!(o.validate().is_err());
+    }
 }
