@@ -5,7 +5,7 @@
 //! and report time per element = per step.
 
 use criterion::{black_box, criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
-use manakov::integrate::{integrate, Method, Options};
+use manakov::integrate::{integrate, Method, Options, MAX_STEPS};
 use manakov::so4::{vector_field4_lanes, FrahmTop};
 
 const A: [f64; 4] = [0.3, 1.1, 2.0, 3.7];
@@ -85,6 +85,7 @@ fn steps(c: &mut Criterion) {
             dt,
             rtol: 0.0,
             atol: 0.0,
+            max_steps: MAX_STEPS as u64,
         };
         let t_end = [STEPS as f64 * dt];
         g.bench_function(BenchmarkId::new("gauss", method.name()), |bch| {
@@ -98,6 +99,7 @@ fn steps(c: &mut Criterion) {
             dt: 0.0,
             rtol: 1e-12,
             atol: 1e-12,
+            max_steps: MAX_STEPS as u64,
         };
         let probe = integrate(&top, &L0, 0.0, &[10.0], &opts).unwrap();
         let t_end = 10.0 * STEPS as f64 / probe.steps as f64;

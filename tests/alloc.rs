@@ -10,7 +10,7 @@
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::cell::Cell;
 
-use manakov::integrate::{integrate, Method, Options};
+use manakov::integrate::{integrate, Method, Options, MAX_STEPS};
 use manakov::so4::FrahmTop;
 
 struct Counting;
@@ -54,6 +54,7 @@ fn count(method: Method, steps: usize, samples: usize) -> (usize, usize) {
         dt,
         rtol: 1e-10,
         atol: 1e-10,
+        max_steps: MAX_STEPS as u64,
     };
     let (c0, b0) = (COUNT.with(Cell::get), BYTES.with(Cell::get));
     let tr = integrate(&top, &L0, 0.0, &times, &opts).unwrap();

@@ -117,7 +117,8 @@ def test_frahm_top_rejects_bad_c(c, match):
 
 def test_frahm_top_accepts_roundoff_asymmetry():
     c = np.array([[0, 1, 2], [1 + 2e-16, 0, 3], [2, 3, 0]])
-    manakov.FrahmTop(c)
+    top = manakov.FrahmTop(c)  # 2e-16 is 1 ulp of 1 < the 8-ulp symmetry tolerance
+    np.testing.assert_array_equal(top.c, c)
 
 
 @pytest.mark.parametrize(
@@ -148,13 +149,14 @@ def test_no_panic_reaches_python_from_the_core():
         lambda: _core.so4_integrals(np.ones(3), np.ones((1, 6))),
         lambda: _core.manakov_integrals(np.arange(4.0), np.ones((1, 5))),
         lambda: _core.poisson_tensor(np.ones((1, 4))),
-        lambda: _core.integrate(cm, np.ones(5), 0.0, np.array([1.0]), "gauss6", 0.1, 0, 0),
-        lambda: _core.integrate(cm, np.ones(6), 0.0, np.array([1.0]), "nope", 0.1, 0, 0),
-        lambda: _core.integrate(cm, np.ones(6), 0.0, np.array([np.nan]), "gauss6", 0.1, 0, 0),
-        lambda: _core.integrate(cm, np.ones(6), np.inf, np.array([1.0]), "gauss6", 0.1, 0, 0),
+        lambda: _core.integrate(cm, np.ones(5), 0.0, np.array([1.0]), "gauss6", 0.1, 0, 0, 1000),
+        lambda: _core.integrate(cm, np.ones(6), 0.0, np.array([1.0]), "nope", 0.1, 0, 0, 1000),
+        lambda: _core.integrate(cm, np.ones(6), 0.0, np.array([np.nan]), "gauss6", 0.1, 0, 0, 1000),
+        lambda: _core.integrate(cm, np.ones(6), np.inf, np.array([1.0]), "gauss6", 0.1, 0, 0, 1000),
         lambda: _core.integrate_many(
-            cm, np.ones((2, 5)), 0.0, np.array([1.0]), "gauss6", 0.1, 0, 0, True
+            cm, np.ones((2, 5)), 0.0, np.array([1.0]), "gauss6", 0.1, 0, 0, 1000, True
         ),
+        lambda: _core.integrate(cm, np.ones(6), 0.0, np.array([1.0]), "gauss6", 0.1, 0, 0, 0),
         lambda: _core.gauss_tableau("dopri5"),
         lambda: _core.manakov_c(np.ones(3), np.ones(3)),
     ]
@@ -177,3 +179,82 @@ def test_overflow_is_an_error_not_a_silent_nan(top):
     for method in ("gauss16", "gauss4", "dop853", "dopri5"):
         with pytest.raises(manakov.ConvergenceError):
             top.integrate(huge, 1.0, dt=0.1, method=method)
+
+
+# --- Review findings: each input below once gave a silent NaN/inf, a discarded imaginary
+# part, a numpy warning instead of ValueError, or a spurious ConvergenceError.
+
+
+def test_manakov_integrals_overflow_is_an_error():
+    top5 = manakov.ManakovTop([1.0, 2.0, 3.0, 4.0, 5.0], [3.0, 1.0, 2.0, 0.0, 4.0])
+    with pytest.raises(ValueError, match="overflow"):
+        top5.manakov_integrals(np.full(10, 1e100))
+
+
+def test_matrix_helpers_reject_complex_and_non_finite():
+    l = np.array([0.3, -0.5, 0.7, 0.2, 0.9, -0.4])
+    with pytest.raises(ValueError, match="real"):
+        manakov.to_matrix(l + 1j)
+    with pytest.raises(ValueError, match="finite"):
+        manakov.to_matrix(np.full(6, np.nan))
+    with pytest.raises(ValueError, match="real"):
+        manakov.from_matrix(manakov.to_matrix(l) + 0j)
+    with pytest.raises(ValueError, match="finite"):
+        manakov.from_matrix(np.full((3, 3), np.nan))
+
+
+@pytest.mark.parametrize("t_eval", [[1e-320], [1e-320, 1.0], [0.0, 5e-324, 1.0]])
+@pytest.mark.parametrize("method", ["gauss4", "gauss6", "gauss16"])
+def test_subnormal_sample_spacing_integrates(top, t_eval, method):
+    """Steps with a subnormal size once made 0/0 in the stage predictor."""
+    l0 = manakov.problem("generic").l0
+    tr = top.integrate(l0, t_eval[-1], t_eval=t_eval, method=method)
+    np.testing.assert_array_equal(tr.l[0], l0)  # a subnormal step cannot move l
+    ref = top.integrate(l0, t_eval[-1], t_eval=[t_eval[-1]], method=method)
+    # Both end at the same t with the same method and step: equal to roundoff
+    # accumulated over ~t_end/dt steps (1e-13 is ~500 ulps of |l| ~ 1).
+    np.testing.assert_allclose(tr.l[-1], ref.l[-1], rtol=0, atol=1e-13)
+
+
+def test_so_n_integrate_subnormal_step():
+    top3 = manakov.ManakovTop([1.0, 2.0, 3.0], [3.0, 1.0, 2.0])
+    tr = top3.integrate([1.0, 2.0, 3.0], 1.0, t_eval=[1e-320, 1.0], method="gauss6")
+    assert np.all(np.isfinite(tr.l))
+
+
+@pytest.mark.parametrize("method", ["gauss16", "gauss4", "dop853", "dopri5"])
+def test_step_budget_bounds_every_method(top, method):
+    """A huge t_end once ran for hours (up to 1e11 steps, GIL released, no Ctrl-C)."""
+    l0 = manakov.problem("generic").l0
+    with pytest.raises(ValueError, match="max_steps"):
+        top.integrate(l0, 1e12, t_eval=[0.0, 1e12], method=method, max_steps=1000)
+    with pytest.raises(ValueError, match="max_steps"):
+        top.integrate_many(np.array([l0]), 1e12, t_eval=[0.0, 1e12], method=method, max_steps=1000)
+    # Samples do not reset the budget: 100 samples of ~30 steps each exceed 1000.
+    with pytest.raises(ValueError, match="max_steps"):
+        top.integrate(l0, 1e4, sample_every=100.0, method=method, max_steps=1000)
+    # ... nor do chunks of the Python loop.
+    with pytest.raises(ValueError, match="max_steps"):
+        top.integrate(l0, 1e4, method=method, max_steps=1000, chunks=50)
+
+
+def test_default_step_budget_stops_a_huge_gauss_run_at_once(top):
+    l0 = manakov.problem("generic").l0
+    # ~3e9 default gauss16 steps: refused before any step is taken.
+    with pytest.raises(ValueError, match="max_steps"):
+        top.integrate(l0, 1e9, t_eval=[0.0, 1e9])
+    assert manakov.top.DEFAULT_MAX_STEPS <= 10**8
+
+
+@pytest.mark.parametrize("bad", [0, -1, 1.5, 10**12, "many"])
+def test_max_steps_must_be_a_positive_integer(top, bad):
+    with pytest.raises(ValueError, match="max_steps"):
+        top.integrate(manakov.problem("generic").l0, 1.0, max_steps=bad)
+
+
+def test_empty_trajectory_has_empty_drifts(top):
+    """A run with no samples once raised IndexError in relative_drift."""
+    tr = top.integrate(manakov.problem("generic").l0, 1.0, t_eval=[])
+    assert tr.l.shape == (0, 6)
+    assert all(v.shape == (0,) for v in tr.relative_drift().values())
+    assert all(v == 0.0 for v in tr.max_drift().values())

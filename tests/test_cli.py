@@ -74,6 +74,11 @@ def test_simulate_custom_top_writes_csv(tmp_path):
         ["simulate", "generic", "--t-end", "nan"],
         ["simulate", "generic", "--dt", "0"],
         ["simulate", "generic", "-o", "x.txt"],
+        # Review findings: an unwritable output once ended in a traceback (after the
+        # whole run), no samples in an IndexError, and a huge run had no step budget.
+        ["simulate", "generic", "--t-end", "1", "-o", "no/such/dir/x.npz"],
+        ["simulate", "generic", "--t-end", "1", "--samples", "0"],
+        ["simulate", "generic", "--t-end", "1e4", "--max-steps", "100"],
     ],
 )
 def test_bad_arguments_exit_with_status_2(argv, tmp_path, monkeypatch, capsys):

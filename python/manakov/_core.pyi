@@ -101,6 +101,7 @@ def integrate(
     dt: float,
     rtol: float,
     atol: float,
+    max_steps: int,
 ) -> tuple[NDArray[np.float64], int, int]: ...
 def integrate_many(
     c: NDArray[np.float64],
@@ -111,6 +112,7 @@ def integrate_many(
     dt: float,
     rtol: float,
     atol: float,
+    max_steps: int,
     parallel: bool,
 ) -> tuple[NDArray[np.float64], int]: ...
 def gauss_tableau(

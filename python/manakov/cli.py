@@ -22,7 +22,7 @@ import numpy as np
 
 from . import problem, problem_names
 from ._progress import ProgressBar
-from .top import METHODS, ManakovTop, Trajectory, state_dim
+from .top import DEFAULT_MAX_STEPS, METHODS, ManakovTop, Trajectory, state_dim
 
 #: Default t_end of ``manakov simulate``: 1000 time units of 'generic' run in
 #: about 10 ms of integration.
@@ -62,6 +62,12 @@ def _parser() -> argparse.ArgumentParser:
     )
     sim.add_argument("--dt", type=float, default=None, help="step (default: the method's default)")
     sim.add_argument("--method", choices=METHODS, default="gauss16")
+    sim.add_argument(
+        "--max-steps",
+        type=int,
+        default=DEFAULT_MAX_STEPS,
+        help="step budget of the run (default %(default)s)",
+    )
     sim.add_argument(
         "--samples", type=int, default=20001, help="number of samples (default %(default)s)"
     )
@@ -156,6 +162,10 @@ def simulate(args: argparse.Namespace) -> int:
     bar = ProgressBar(f"simulate {name}", force=args.progress and not args.quiet)
     if args.quiet:
         bar.enabled = False
+    out = args.output if args.output is not None else Path(f"{name}.npz")
+    # Fail before a long run, not after it.
+    if not out.parent.is_dir():
+        raise ValueError(f"cannot write {out}: {out.parent} is not a directory")
     start = time.perf_counter()
     tr = top.integrate(
         l0,
@@ -165,10 +175,10 @@ def simulate(args: argparse.Namespace) -> int:
         method=args.method,
         chunks=PROGRESS_CHUNKS if long_run else 1,
         progress=bar.update if long_run else None,
+        max_steps=args.max_steps,
     )
     elapsed = time.perf_counter() - start
     bar.close()
-    out = args.output if args.output is not None else Path(f"{name}.npz")
     _write(out, tr, a, b)
     png = out.with_suffix(".png")
     plotted = (
@@ -195,7 +205,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     try:
         if args.command == "simulate":
             return simulate(args)
-    except (ValueError, RuntimeError) as e:
+    except (ValueError, RuntimeError, OSError) as e:
         print(f"manakov: error: {e}", file=sys.stderr)
         return 2
     ap.error(f"unknown command {args.command!r}")

@@ -70,6 +70,13 @@ def _scalar_or(a: np.ndarray, scalar: bool) -> Any:
     return a[()] if scalar else _frozen(a)
 
 
+def _finite(values: np.ndarray) -> np.ndarray:
+    """Raise instead of returning an overflowed (inf/NaN) value from finite input."""
+    if not np.all(np.isfinite(values)):
+        raise ValueError("the result overflows (inf or NaN) for this x: |x| is too large")
+    return values
+
+
 def _zd_rows(zd: Any, shape: tuple[int, ...]) -> np.ndarray | None:
     """Offsets of shape (..., 2, 5) broadcast to ``shape`` and flattened to rows of 10."""
     if zd is None:
@@ -91,6 +98,24 @@ def _eps_rows(eps: Any, shape: tuple[int, ...]) -> np.ndarray | None:
         raise ValueError("eps entries must be +1 or -1")
     e = np.broadcast_to(e, (*shape, 5))
     return np.ascontiguousarray(e.reshape(-1, 5), dtype=np.int8)
+
+
+def _point_rows(
+    values: tuple[Any, ...], eps: Any, zd: Any
+) -> tuple[tuple[int, ...], list[np.ndarray], np.ndarray | None, np.ndarray | None]:
+    """Broadcast point data with ``eps`` (..., 5) and ``zd`` (..., 2, 5); flatten to rows.
+
+    Returns the common leading shape, the flattened complex ``values``, and the
+    rows of ``eps`` and ``zd`` (``None`` where not given).
+    """
+    arrs = np.broadcast_arrays(*(_c(v) for v in values))
+    shape = arrs[0].shape
+    if eps is not None:
+        shape = np.broadcast_shapes(shape, np.shape(eps)[:-1])
+    if zd is not None:
+        shape = np.broadcast_shapes(shape, np.shape(zd)[:-2])
+    flat = [np.ascontiguousarray(np.broadcast_to(a, shape).reshape(-1)) for a in arrs]
+    return shape, flat, _eps_rows(eps, shape), _zd_rows(zd, shape)
 
 
 @dataclass(frozen=True)
@@ -227,10 +252,24 @@ class KotterCurve:
         return hash(self.d)
 
     def R(self, x: Any) -> Any:
-        """``R(x) = prod_{j=0}^4 (x - d_j)`` (8), elementwise; scalar in, scalar out."""
+        """``R(x) = prod_{j=0}^4 (x - d_j)`` (8), elementwise; scalar in, scalar out.
+
+        Parameters
+        ----------
+        x : complex or array_like
+
+        Returns
+        -------
+        complex or ndarray, complex, shape of ``x``
+
+        Raises
+        ------
+        ValueError
+            Non-finite ``x``, or ``R(x)`` overflows.
+        """
         xa = _c(x)
         r, _ = _core.curve_eval(self._d123(), xa.reshape(-1))
-        return _scalar_or(r.reshape(xa.shape), xa.ndim == 0)
+        return _scalar_or(_finite(r).reshape(xa.shape), xa.ndim == 0)
 
     def y(self, x: Any, *, sheet: int = 1) -> Any:
         """A square root of ``R(x)``: ``sheet * prod_{j=0}^4 sqrt(x - d_j)``.
@@ -240,12 +279,21 @@ class KotterCurve:
         x : complex or array_like
         sheet : {1, -1}, keyword-only
             ``+1`` is the canonical sheet (product of principal roots), ``-1`` the other.
+
+        Returns
+        -------
+        complex or ndarray, complex, shape of ``x``
+
+        Raises
+        ------
+        ValueError
+            Non-finite ``x``, ``sheet`` not +-1, or ``y(x)`` overflows.
         """
         if sheet not in (1, -1):
             raise ValueError(f"sheet must be +1 or -1, got {sheet!r}")
         xa = _c(x)
         _, y = _core.curve_eval(self._d123(), xa.reshape(-1))
-        return _scalar_or(sheet * y.reshape(xa.shape), xa.ndim == 0)
+        return _scalar_or(sheet * _finite(y).reshape(xa.shape), xa.ndim == 0)
 
     def wurzel(
         self, z1: Any, y1: Any, z2: Any, y2: Any, *, eps: Any = None, zd: Any = None
@@ -287,16 +335,7 @@ class KotterCurve:
             divides by zero, an invalid ``eps``, or offsets ``zd`` of the wrong
             shape or inconsistent with ``z1, z2``.
         """
-        arrs = list(np.broadcast_arrays(_c(z1), _c(y1), _c(z2), _c(y2)))
-        shape = arrs[0].shape
-        if eps is not None:
-            shape = np.broadcast_shapes(shape, np.shape(eps)[:-1])
-        if zd is not None:
-            shape = np.broadcast_shapes(shape, np.shape(zd)[:-2])
-        arrs = [np.broadcast_to(a, shape) for a in arrs]
-        e = _eps_rows(eps, shape)
-        zr = _zd_rows(zd, shape)
-        z1f, y1f, z2f, y2f = (np.ascontiguousarray(a.reshape(-1)) for a in arrs)
+        shape, (z1f, y1f, z2f, y2f), e, zr = _point_rows((z1, y1, z2, y2), eps, zd)
         p, pjk = _core.curve_wurzel(self._d123(), z1f, y1f, z2f, y2f, e, zr)
         return Wurzel(P=_frozen(p.reshape(*shape, 5)), Pjk=_frozen(pjk.reshape(*shape, 5, 5)))
 
@@ -338,16 +377,7 @@ class KotterCurve:
         ValueError
             As :meth:`wurzel`, and a non-finite ``g`` or an invalid ``sqrt_c``.
         """
-        arrs = list(np.broadcast_arrays(_c(z1), _c(y1), _c(z2), _c(y2), _c(g)))
-        shape = arrs[0].shape
-        if eps is not None:
-            shape = np.broadcast_shapes(shape, np.shape(eps)[:-1])
-        if zd is not None:
-            shape = np.broadcast_shapes(shape, np.shape(zd)[:-2])
-        arrs = [np.broadcast_to(a, shape) for a in arrs]
-        e = _eps_rows(eps, shape)
-        zr = _zd_rows(zd, shape)
-        z1f, y1f, z2f, y2f, gf = (np.ascontiguousarray(a.reshape(-1)) for a in arrs)
+        shape, (z1f, y1f, z2f, y2f, gf), e, zr = _point_rows((z1, y1, z2, y2, g), eps, zd)
         sc = None if sqrt_c is None else np.ascontiguousarray(_c(sqrt_c).reshape(-1))
         xi, eta = _core.curve_xi_eta(self._d123(), z1f, y1f, z2f, y2f, gf, e, sc, zr)
         return _frozen(xi.reshape(*shape, 3)), _frozen(eta.reshape(*shape, 3))

@@ -35,12 +35,28 @@ def _data() -> dict[str, Any]:
 
 
 def problem_names() -> list[str]:
-    """Names of the built-in reference tops."""
+    """Names of the built-in reference tops.
+
+    Returns
+    -------
+    list of str
+        ``["generic", "physical", "wide", "near_degenerate"]`` in file order.
+    """
     return list(_data()["tops"])
 
 
 def problem(name: str) -> Problem:
     """Return the built-in reference top ``name`` (see :func:`problem_names`).
+
+    Parameters
+    ----------
+    name : str
+
+    Returns
+    -------
+    Problem
+        ``(name, a, b, l0, note)``; ``a``, ``b`` of shape (4,) define ``c_ij`` by (2),
+        ``l0`` of shape (6,) is ordered ``(l12, l13, l14, l23, l24, l34)``.
 
     Raises
     ------
@@ -61,7 +77,22 @@ def problem(name: str) -> Problem:
 
 
 def benchmark_setup(name: str) -> dict[str, Any]:
-    """The benchmark set-up ``name`` (``"integration"`` or ``"theta"``) as a dict."""
+    """The benchmark set-up ``name`` (``"integration"`` or ``"theta"``) as a dict.
+
+    Parameters
+    ----------
+    name : str
+
+    Returns
+    -------
+    dict
+        A copy of the set-up's entry in ``data/problems.json``.
+
+    Raises
+    ------
+    ValueError
+        If there is no set-up of that name.
+    """
     bench = _data()["benchmark"]
     if name not in bench:
         raise ValueError(f"unknown benchmark {name!r}; known: {', '.join(bench)}")

@@ -28,6 +28,8 @@ from typing import Any
 import numpy as np
 
 from . import _core
+from .top import _finite_result, _float_array
+from .top import _states as _top_states
 
 __all__ = [
     "Kotter",
@@ -40,30 +42,27 @@ __all__ = [
 ]
 
 
-def _check_a(a: Any) -> np.ndarray:
-    a = np.array(a, dtype=float)
-    if a.shape != (4,):
-        raise ValueError(f"a must have shape (4,), got {a.shape}")
-    if not np.all(np.isfinite(a)):
-        raise ValueError("a must be finite")
-    return a
+#: Range of ``max |l_ij|`` accepted by :func:`kotter`. The coefficients of F (19)
+#: are quartic in l, so they overflow near 1e77 and underflow (to a spurious
+#: self-dual state) near 1e-77; 1e-60 .. 1e60 keeps ~1e17 of headroom either side.
+STATE_RANGE = (1e-60, 1e60)
+
+
+def _check_a(a: Any, what: str = "a") -> np.ndarray:
+    """``a`` (or ``b``) as a real, finite float array of shape (4,)."""
+    arr = _float_array(a, what)
+    if arr.shape != (4,):
+        raise ValueError(f"{what} must have shape (4,), got {arr.shape}")
+    return np.ascontiguousarray(arr)
 
 
 def _check_b(b: Any) -> np.ndarray:
-    b = np.array(b, dtype=float)
-    if b.shape != (4,):
-        raise ValueError(f"b must have shape (4,), got {b.shape}")
-    if not np.all(np.isfinite(b)):
-        raise ValueError("b must be finite")
-    return b
+    return _check_a(b, "b")
 
 
 def _states(l: Any) -> tuple[np.ndarray, tuple[int, ...]]:
-    l = np.array(l, dtype=float)
-    if l.ndim == 0 or l.shape[-1] != 6:
-        raise ValueError(f"l must have shape (..., 6), got {l.shape}")
-    shape = l.shape[:-1]
-    return np.ascontiguousarray(l.reshape(-1, 6)), shape
+    """``l`` as real, finite C-contiguous rows of 6 and its leading shape."""
+    return _top_states(l, 6)
 
 
 def integrals(a: Any, l: Any) -> np.ndarray:
@@ -84,10 +83,15 @@ def integrals(a: Any, l: Any) -> np.ndarray:
     Returns
     -------
     ndarray, shape (..., 4)
+
+    Raises
+    ------
+    ValueError
+        Wrong shapes, complex or non-finite input, or a result that overflows.
     """
     a = _check_a(a)
     flat, shape = _states(l)
-    return np.asarray(_core.kotter_integrals(a, flat)).reshape(shape + (4,))
+    return _finite_result(np.asarray(_core.kotter_integrals(a, flat))).reshape(shape + (4,))
 
 
 def schottky(a: Any, l: Any, s: Any, *, sqrt_g: Any = None) -> tuple[np.ndarray, np.ndarray]:
@@ -111,19 +115,36 @@ def schottky(a: Any, l: Any, s: Any, *, sqrt_g: Any = None) -> tuple[np.ndarray,
     Returns
     -------
     (ndarray, ndarray), each of shape (..., 3), complex
+
+    Raises
+    ------
+    ValueError
+        Wrong shapes, complex or non-finite ``a``, ``l``, non-finite ``s``
+        or ``sqrt_g``, ``G(s)`` overflowing, or ``s = a_j``.
     """
     a = _check_a(a)
-    l = np.asarray(l, dtype=float)
-    s = np.asarray(s, dtype=complex)
-    if sqrt_g is None:
-        sqrt_g = np.sqrt(np.prod(s[..., None] - a, axis=-1))
-    sqrt_g = np.asarray(sqrt_g, dtype=complex)
+    flat, lshape = _states(l)
+    l = flat.reshape(lshape + (6,))
+    s, sqrt_g = _s_and_sqrt_g(a, s, sqrt_g)
     shape = np.broadcast_shapes(l.shape[:-1], s.shape, sqrt_g.shape)
     lb = np.ascontiguousarray(np.broadcast_to(l, shape + (6,)).reshape(-1, 6))
     sb = np.ascontiguousarray(np.broadcast_to(s, shape).reshape(-1))
     gb = np.ascontiguousarray(np.broadcast_to(sqrt_g, shape).reshape(-1))
     lv, mv = _core.kotter_schottky(a, lb, sb, gb)
     return np.asarray(lv).reshape(shape + (3,)), np.asarray(mv).reshape(shape + (3,))
+
+
+def _s_and_sqrt_g(a: np.ndarray, s: Any, sqrt_g: Any) -> tuple[np.ndarray, np.ndarray]:
+    """``s`` and the branch of ``sqrt(G(s))`` (default principal), both finite."""
+    s = np.asarray(s, dtype=complex)
+    if not np.all(np.isfinite(s)):
+        raise ValueError("s must be finite; it contains NaN or infinity")
+    if sqrt_g is None:
+        with np.errstate(over="ignore", invalid="ignore"):
+            sqrt_g = np.sqrt(np.prod(s[..., None] - a, axis=-1))
+        if not np.all(np.isfinite(sqrt_g)):
+            raise ValueError("G(s) = prod_j (s - a_j) overflows (is not finite) for this s")
+    return s, np.asarray(sqrt_g, dtype=complex)
 
 
 def _skew3(v: np.ndarray) -> np.ndarray:
@@ -176,13 +197,9 @@ def lax_pair(
     """
     a = _check_a(a)
     b = _check_b(b)
-    l = np.asarray(l, dtype=float)
-    if l.ndim == 0 or l.shape[-1] != 6:
-        raise ValueError(f"l must have shape (..., 6), got {l.shape}")
-    s = np.asarray(s, dtype=complex)
-    if sqrt_g is None:
-        sqrt_g = np.sqrt(np.prod(s[..., None] - a, axis=-1))
-    sqrt_g = np.asarray(sqrt_g, dtype=complex)
+    flat, lshape = _states(l)
+    l = flat.reshape(lshape + (6,))
+    s, sqrt_g = _s_and_sqrt_g(a, s, sqrt_g)
     lv, _ = schottky(a, l, s, sqrt_g=sqrt_g)
     shape = lv.shape[:-1]
     lb = np.ascontiguousarray(np.broadcast_to(l, shape + (6,)).reshape(-1, 6))
@@ -195,20 +212,31 @@ def lax_pair(
 def quartic(a: Any, h: Any) -> np.ndarray:
     """Coefficients of ``F(s)`` (19), monic, highest power first.
 
-    ``F(s) = [(h1 s^2 - h2 s + h3)^2 - 4 h0^2 G(s)] / (h1^2 - 4 h0^2)``.
+    ``F(s) = [(h1 s^2 - h2 s + h3)^2 - 4 h0^2 G(s)] / (h1^2 - 4 h0^2)``,
+    ``G(s) = prod_j (s - a_j)``.
+
+    Parameters
+    ----------
+    a : array_like, shape (4,)
+        Manakov parameters ``a_i`` (2).
+    h : array_like, shape (..., 4)
+        Integrals ``(h0, h1, h2, h3)`` as returned by :func:`integrals`.
+
+    Returns
+    -------
+    ndarray, shape (..., 5)
+        Coefficients of ``s^4, s^3, ..., s^0``.
 
     Raises
     ------
     ValueError
-        If ``h1^2 = 4 h0^2`` (a self-dual or anti-self-dual state): (19) is not defined.
+        If ``h1^2 = 4 h0^2`` (a self-dual or anti-self-dual state): (19) is not
+        defined; wrong shapes, complex or non-finite input, or an overflow.
     """
     a = _check_a(a)
-    h = np.array(h, dtype=float)
-    if h.ndim == 0 or h.shape[-1] != 4:
-        raise ValueError(f"h must have shape (..., 4), got {h.shape}")
-    shape = h.shape[:-1]
-    out = _core.kotter_quartic(a, np.ascontiguousarray(h.reshape(-1, 4)))
-    return np.asarray(out).reshape(shape + (5,))
+    flat, shape = _top_states(h, 4, "h")
+    out = _finite_result(np.asarray(_core.kotter_quartic(a, flat)))
+    return out.reshape(shape + (5,))
 
 
 @dataclass(frozen=True, eq=False)  # fields are arrays: no elementwise __eq__
@@ -371,7 +399,8 @@ def kotter(a: Any, b: Any, l: Any) -> Kotter:
     Raises
     ------
     ValueError
-        Non-finite input; repeated ``a_i``; ``h0 = 0`` or ``h1^2 = 4 h0^2``
+        Non-finite input; ``max |l_ij|`` outside :data:`STATE_RANGE` (rescale
+        l); repeated ``a_i``; ``h0 = 0`` or ``h1^2 = 4 h0^2``
         (``F`` (19) undefined or with double roots); repeated roots of ``F``;
         a root of ``F`` at some ``a_j``; coinciding branch points ``d_j`` of
         the curve (its genus drops); ``z1 = z2``; ``1 - eps P_0 = 0``.
@@ -379,6 +408,14 @@ def kotter(a: Any, b: Any, l: Any) -> Kotter:
     a = _check_a(a)
     _check_b(b)
     flat, shape = _states(l)
+    size = np.max(np.abs(flat), axis=1, initial=0.0)
+    bad = (size > 0) & ((size < STATE_RANGE[0]) | (size > STATE_RANGE[1]))
+    if np.any(bad):
+        raise ValueError(
+            f"l has max |l_ij| = {size[bad][0]:e}, outside [{STATE_RANGE[0]:e}, "
+            f"{STATE_RANGE[1]:e}] where the integrals (~|l|^2) and the coefficients of "
+            "F (19) (~|l|^4) neither overflow nor underflow: rescale l"
+        )
     raw = _core.kotter_batch(a, flat)
     fields: dict[str, Any] = {}
     for name, fshape in _FIELD_SHAPES.items():
@@ -406,6 +443,13 @@ def from_kotter(a: Any, b: Any, k: Kotter) -> np.ndarray:
     ``xi_j = sqrt(c_j) g P_kl``, ``eta_j = sqrt(c_j) g P_j4`` (37), then (23)
     ``m_j = alpha_j xi_j + beta_j eta_j``, ``n_j = gamma_j xi_j + delta_j eta_j``.
 
+    Parameters
+    ----------
+    a, b : array_like, shape (4,)
+        Manakov parameters (2) (checked; the map uses the constants stored in ``k``).
+    k : Kotter
+        As returned by :func:`kotter`, possibly with other points, ``g`` or branch.
+
     Returns
     -------
     ndarray, shape (..., 6)
@@ -414,10 +458,16 @@ def from_kotter(a: Any, b: Any, k: Kotter) -> np.ndarray:
     ------
     ValueError
         Points off the curve, offsets ``zd`` inconsistent with ``z1, z2``,
-        ``z1 = z2``, a bad branch, or data that give a complex state.
+        ``z1 = z2``, ``g = 0``, a bad branch, or data that give a complex state.
+    TypeError
+        ``k`` is not a :class:`Kotter`.
     """
     _check_a(a)
     _check_b(b)
+    if not isinstance(k, Kotter):
+        raise TypeError(f"k must be a manakov.Kotter, got {type(k).__name__}")
+    if np.any(np.asarray(k.g) == 0):
+        raise ValueError("g = 0: g = 1/(1 - eps P_0) (42) never vanishes")
     z1 = np.asarray(k.z1, dtype=complex)
     shape = z1.shape
 

@@ -249,13 +249,15 @@ impl Dop853 {
         }
     }
 
-    /// Advances `y` from `t` to exactly `t_target`; returns the number of accepted steps.
+    /// Advances `y` from `t` to exactly `t_target`; returns the number of accepted steps,
+    /// failing once more than `budget` are needed.
     pub(super) fn advance<F: VectorField>(
         &mut self,
         f: &F,
         y: &mut [f64],
         t: &mut f64,
         t_target: f64,
+        budget: u64,
     ) -> Result<u64> {
         let m = self.m;
         let mut steps = 0u64;
@@ -349,11 +351,8 @@ impl Dop853 {
             } else {
                 self.h = h / fac.max(1.0);
             }
-            if steps as f64 > super::MAX_STEPS {
-                return Err(Error::InvalidArgument {
-                    what: "rtol/atol",
-                    reason: format!("more than {:e} steps needed", super::MAX_STEPS),
-                });
+            if steps > budget {
+                return Err(super::too_many_steps(budget));
             }
         }
         Ok(steps)

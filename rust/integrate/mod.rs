@@ -198,11 +198,22 @@ pub struct Options {
     pub rtol: f64,
     /// `dopri5` absolute tolerance.
     pub atol: f64,
+    /// The largest number of steps one call may take, over all sample times
+    /// (at most [`MAX_STEPS`]). Gauss methods check it before the first step,
+    /// explicit methods while stepping; either way the call fails with
+    /// `InvalidArgument` instead of running for hours.
+    pub max_steps: u64,
 }
 
 impl Options {
-    /// Checks `dt`, `rtol`, `atol`.
+    /// Checks `dt`, `rtol`, `atol`, `max_steps`.
     pub fn validate(&self) -> Result<()> {
+        if self.max_steps == 0 || self.max_steps as f64 > MAX_STEPS {
+            return Err(Error::InvalidArgument {
+                what: "max_steps",
+                reason: format!("must be in [1, {MAX_STEPS:e}], got {}", self.max_steps),
+            });
+        }
         let gauss = self.method.stages().is_some();
         if !self.dt.is_finite() || self.dt < 0.0 || (gauss && self.dt == 0.0) {
             return Err(Error::InvalidArgument {
@@ -241,8 +252,8 @@ pub struct Trajectory {
     pub evals: u64,
 }
 
-/// Hard cap on the number of steps of one call, so that a tiny `dt` is an
-/// error rather than an apparent hang (10^11 steps is ~a day of computing).
+/// Hard cap on [`Options::max_steps`] (10^11 steps is ~a day of computing);
+/// below 2^53, so step counts held in f64 are exact.
 pub const MAX_STEPS: f64 = 1e11;
 
 /// Fixed-point iterations allowed per Gauss step. Convergence is linear with
@@ -263,6 +274,25 @@ fn substeps(span: f64, dt: f64) -> f64 {
         k.max(1.0)
     } else {
         r.ceil().max(1.0)
+    }
+}
+
+/// Whether a Gauss step of size `h` may start from the stages of the previous
+/// step (size `last_h`, 0 before the first step). Only between normal sizes with
+/// a finite ratio: with a subnormal `h` the products `h b_j` underflow, and a
+/// ratio `h / last_h` can overflow; both once made NaN stages.
+fn reuse_stages(last_h: f64, h: f64) -> bool {
+    last_h.is_normal() && h.is_normal() && (h / last_h).is_finite()
+}
+
+/// The error of an explicit method that needs more than its step budget.
+fn too_many_steps(budget: u64) -> Error {
+    Error::InvalidArgument {
+        what: "rtol/atol",
+        reason: format!(
+            "more steps needed than the remaining budget of {budget} (max_steps); \
+             loosen rtol/atol, shorten t_end or raise max_steps"
+        ),
     }
 }
 
@@ -417,7 +447,7 @@ impl<const S: usize, const M: usize> Stepper for GaussFixed<S, M> {
         for i in 0..S {
             hb[i] = h * self.b[i];
         }
-        if self.last_h == 0.0 {
+        if !reuse_stages(self.last_h, h) {
             // First step: every stage starts from f(y).
             let mut fbuf = [0.0; M];
             f.eval(y, &mut fbuf);
@@ -429,11 +459,12 @@ impl<const S: usize, const M: usize> Stepper for GaussFixed<S, M> {
             }
         } else if h == self.last_h {
             // Predictor: extrapolate the previous step's collocation polynomial,
-            // f at the new nodes = Σ_j ℓ_j(1 + c_i) f(Y_j), with f(Y_j) = L_j / (h b_j).
+            // f at the new nodes = Σ_j ℓ_j(1 + c_i) f(Y_j), with f(Y_j) = L_j / (h b_j);
+            // h cancels (same h), so L_j / b_j is carried and h b_j never divides.
             for k in 0..M {
                 let mut fj = [0.0; S];
                 for j in 0..S {
-                    fj[j] = self.l[k][j] / hb[j];
+                    fj[j] = self.l[k][j] / self.b[j];
                 }
                 let mut acc = [0.0; S];
                 for j in 0..S {
@@ -442,7 +473,7 @@ impl<const S: usize, const M: usize> Stepper for GaussFixed<S, M> {
                     }
                 }
                 for i in 0..S {
-                    self.l[k][i] = hb[i] * acc[i];
+                    self.l[k][i] = self.b[i] * acc[i];
                 }
             }
         } else {
@@ -554,7 +585,7 @@ impl Stepper for GaussDyn {
 
     fn step<F: VectorField>(&mut self, f: &F, y: &mut [f64], h: f64) -> Result<()> {
         let (s, m) = (self.s, self.m);
-        if self.last_h == 0.0 {
+        if !reuse_stages(self.last_h, h) {
             f.eval(y, &mut self.fbuf);
             self.evals += 1;
             for i in 0..s {
@@ -714,13 +745,15 @@ impl Dopri5 {
         }
     }
 
-    /// Advances `y` from `t` to exactly `t_target` with adaptive steps; returns the number of steps.
+    /// Advances `y` from `t` to exactly `t_target` with adaptive steps; returns the number
+    /// of steps, failing once more than `budget` are needed.
     fn advance<F: VectorField>(
         &mut self,
         f: &F,
         y: &mut [f64],
         t: &mut f64,
         t_target: f64,
+        budget: u64,
     ) -> Result<u64> {
         let m = self.m;
         let mut steps = 0u64;
@@ -802,11 +835,8 @@ impl Dopri5 {
             } else {
                 self.h = h * fac.min(1.0);
             }
-            if steps as f64 > MAX_STEPS {
-                return Err(Error::InvalidArgument {
-                    what: "rtol/atol",
-                    reason: format!("more than {MAX_STEPS:e} steps needed"),
-                });
+            if steps > budget {
+                return Err(too_many_steps(budget));
             }
         }
         Ok(steps)
@@ -879,11 +909,12 @@ fn integrate_into<F: VectorField>(
                 (tk, n + substeps(tk - prev, opts.dt))
             })
             .1;
-        if total > MAX_STEPS {
+        if total > opts.max_steps as f64 {
             return Err(Error::InvalidArgument {
                 what: "dt",
                 reason: format!(
-                    "{total:e} steps would be needed (limit {MAX_STEPS:e}); increase dt"
+                    "{total:e} steps would be needed (max_steps = {}); increase dt or max_steps",
+                    opts.max_steps
                 ),
             });
         }
@@ -929,17 +960,21 @@ fn integrate_into<F: VectorField>(
         };
     } else if opts.method == Method::Dop853 {
         let mut d = dop853::Dop853::new(m, opts.dt, opts.rtol, opts.atol);
+        let mut taken = 0u64;
         for &tk in times {
-            *steps += d.advance(f, &mut y, &mut t, tk)?;
+            taken += d.advance(f, &mut y, &mut t, tk, opts.max_steps - taken)?;
             ys.extend_from_slice(&y);
         }
+        *steps += taken;
         *evals += d.evals;
     } else {
         let mut d = Dopri5::new(m, opts);
+        let mut taken = 0u64;
         for &tk in times {
-            *steps += d.advance(f, &mut y, &mut t, tk)?;
+            taken += d.advance(f, &mut y, &mut t, tk, opts.max_steps - taken)?;
             ys.extend_from_slice(&y);
         }
+        *steps += taken;
         *evals += d.evals;
     }
     Ok(())
@@ -1049,6 +1084,7 @@ mod tests {
             dt,
             rtol: 1e-10,
             atol: 1e-10,
+            max_steps: MAX_STEPS as u64,
         }
     }
 
@@ -1130,6 +1166,7 @@ mod tests {
                 dt: h,
                 rtol: 1e3,
                 atol: 1e3,
+                max_steps: MAX_STEPS as u64,
             };
             let tr = integrate(&Osc, &[1.0, 0.0], 0.0, &times, &o).unwrap();
             let n = tr.y.len();
@@ -1190,5 +1227,49 @@ mod tests {
                 assert_eq!(&ys[b * 18..(b + 1) * 18], &tr.y[..]);
             }
         }
+    }
+
+    #[test]
+    fn subnormal_steps_restart_the_stages() {
+        // A subnormal h once made 0/0 (h b_j) in the predictor and an infinite
+        // ratio h / last_h on the next normal step.
+        let top = FrahmTop::manakov(&A, &B).unwrap();
+        let times = [1e-320, 2e-320, 1.0];
+        for m in [Method::Gauss4, Method::Gauss16] {
+            let tr = integrate(&top, &L0, 0.0, &times, &opts(m, 0.05)).unwrap();
+            assert_eq!(&tr.y[..6], &L0[..], "a subnormal step cannot move l");
+            let direct = integrate(&top, &L0, 0.0, &[1.0], &opts(m, 0.05)).unwrap();
+            for k in 0..6 {
+                // Same step on [0, 1]; only the restart of the stage guess differs.
+                assert!((tr.y[12 + k] - direct.y[k]).abs() < 1e-14);
+            }
+        }
+        let osc = integrate(
+            &Osc,
+            &[1.0, 0.0],
+            0.0,
+            &[5e-324, 1.0],
+            &opts(Method::Gauss6, 0.1),
+        );
+        assert!(osc.unwrap().y.iter().all(|v| v.is_finite()));
+    }
+
+    #[test]
+    fn step_budget_counts_every_sample_of_a_call() {
+        let top = FrahmTop::manakov(&A, &B).unwrap();
+        let times: Vec<f64> = (1..=100).map(f64::from).collect();
+        for m in [Method::Dopri5, Method::Dop853, Method::Gauss6] {
+            let mut o = opts(m, if m == Method::Gauss6 { 0.1 } else { 0.0 });
+            let full = integrate(&top, &L0, 0.0, &times, &o).unwrap();
+            // Each sample interval needs fewer steps than the budget, the call more.
+            o.max_steps = full.steps / 2;
+            let err = integrate(&top, &L0, 0.0, &times, &o).unwrap_err();
+            assert!(err.to_string().contains("max_steps"), "{err}");
+            o.max_steps = full.steps;
+            assert_eq!(integrate(&top, &L0, 0.0, &times, &o).unwrap().y, full.y);
+        }
+        let mut o = opts(Method::Gauss6, 0.1);
+        o.max_steps = 0;
+        assert!(o.validate().is_err());
     }
 }

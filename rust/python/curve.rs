@@ -10,49 +10,15 @@ use numpy::{
 };
 use pyo3::prelude::*;
 
+use super::arrays::{array1, rows, vec1};
 use crate::curve::{CurvePoint, KotterCurve};
 use crate::error::Error;
 
 type C = Complex64;
 
-fn shape_err(what: &'static str, expected: String, got: &[usize]) -> PyErr {
-    Error::Shape {
-        what,
-        expected,
-        got: format!("{got:?}"),
-    }
-    .into()
-}
-
 fn curve_of(d: &PyReadonlyArray1<'_, C>) -> PyResult<KotterCurve> {
-    let v = d.as_array();
-    if v.len() != 3 {
-        return Err(shape_err("d", "(3,)".into(), v.shape()));
-    }
-    Ok(KotterCurve::new(v[0], v[1], v[2])?)
-}
-
-fn vec1(a: &PyReadonlyArray1<'_, C>, what: &'static str, n: usize) -> PyResult<Vec<C>> {
-    let v = a.as_array();
-    if v.len() != n {
-        return Err(shape_err(what, format!("({n},)"), v.shape()));
-    }
-    Ok(v.to_vec())
-}
-
-fn rows<T: Copy + numpy::Element, const K: usize>(
-    a: &PyReadonlyArray2<'_, T>,
-    what: &'static str,
-    n: usize,
-) -> PyResult<Vec<[T; K]>> {
-    let v = a.as_array();
-    if v.shape() != [n, K] {
-        return Err(shape_err(what, format!("({n}, {K})"), v.shape()));
-    }
-    Ok(v.rows()
-        .into_iter()
-        .map(|r| std::array::from_fn(|k| r[k]))
-        .collect())
+    let [d1, d2, d3]: [C; 3] = array1(d, "d")?;
+    Ok(KotterCurve::new(d1, d2, d3)?)
 }
 
 /// The two points of row `i` with their offsets `zd = (zd1, zd2)` (a row of 10).
@@ -141,10 +107,10 @@ fn curve_wurzel_py<'py>(
 ) -> PyResult<(Bound<'py, PyArray2<C>>, Bound<'py, PyArray3<C>>)> {
     let k = curve_of(&d)?;
     let n = z1.as_array().len();
-    let (z1, y1) = (vec1(&z1, "z1", n)?, vec1(&y1, "y1", n)?);
-    let (z2, y2) = (vec1(&z2, "z2", n)?, vec1(&y2, "y2", n)?);
-    let eps: Option<Vec<[i8; 5]>> = eps.map(|e| rows(&e, "eps", n)).transpose()?;
-    let zd: Option<Vec<[C; 10]>> = zd.map(|z| rows(&z, "zd", n)).transpose()?;
+    let (z1, y1) = (vec1(&z1, "z1", Some(n))?, vec1(&y1, "y1", Some(n))?);
+    let (z2, y2) = (vec1(&z2, "z2", Some(n))?, vec1(&y2, "y2", Some(n))?);
+    let eps: Option<Vec<[i8; 5]>> = eps.map(|e| rows(&e, "eps", Some(n))).transpose()?;
+    let zd: Option<Vec<[C; 10]>> = zd.map(|z| rows(&z, "zd", Some(n))).transpose()?;
     let out = py.detach(|| -> Result<(Array2<C>, Array3<C>), Error> {
         let mut p = Array2::<C>::zeros((n, 5));
         let mut pjk = Array3::<C>::zeros((n, 5, 5));
@@ -189,18 +155,12 @@ fn curve_xi_eta_py<'py>(
 ) -> PyResult<(Bound<'py, PyArray2<C>>, Bound<'py, PyArray2<C>>)> {
     let k = curve_of(&d)?;
     let n = z1.as_array().len();
-    let (z1, y1) = (vec1(&z1, "z1", n)?, vec1(&y1, "y1", n)?);
-    let (z2, y2) = (vec1(&z2, "z2", n)?, vec1(&y2, "y2", n)?);
-    let g = vec1(&g, "g", n)?;
-    let eps: Option<Vec<[i8; 5]>> = eps.map(|e| rows(&e, "eps", n)).transpose()?;
-    let zd: Option<Vec<[C; 10]>> = zd.map(|z| rows(&z, "zd", n)).transpose()?;
-    let sqrt_c: Option<[C; 3]> = match sqrt_c {
-        None => None,
-        Some(s) => {
-            let v = vec1(&s, "sqrt_c", 3)?;
-            Some([v[0], v[1], v[2]])
-        }
-    };
+    let (z1, y1) = (vec1(&z1, "z1", Some(n))?, vec1(&y1, "y1", Some(n))?);
+    let (z2, y2) = (vec1(&z2, "z2", Some(n))?, vec1(&y2, "y2", Some(n))?);
+    let g = vec1(&g, "g", Some(n))?;
+    let eps: Option<Vec<[i8; 5]>> = eps.map(|e| rows(&e, "eps", Some(n))).transpose()?;
+    let zd: Option<Vec<[C; 10]>> = zd.map(|z| rows(&z, "zd", Some(n))).transpose()?;
+    let sqrt_c: Option<[C; 3]> = sqrt_c.map(|s| array1(&s, "sqrt_c")).transpose()?;
     let out = py.detach(|| -> Result<(Array2<C>, Array2<C>), Error> {
         let mut xi = Array2::<C>::zeros((n, 3));
         let mut eta = Array2::<C>::zeros((n, 3));
@@ -245,16 +205,10 @@ fn curve_points_from_xi_eta_py<'py>(
 )> {
     let k = curve_of(&d)?;
     let n = xi.as_array().shape()[0];
-    let xi: Vec<[C; 3]> = rows(&xi, "xi", n)?;
-    let eta: Vec<[C; 3]> = rows(&eta, "eta", n)?;
-    let g_ref = g_ref.map(|g| vec1(&g, "g_ref", n)).transpose()?;
-    let sqrt_c: Option<[C; 3]> = match sqrt_c {
-        None => None,
-        Some(s) => {
-            let v = vec1(&s, "sqrt_c", 3)?;
-            Some([v[0], v[1], v[2]])
-        }
-    };
+    let xi: Vec<[C; 3]> = rows(&xi, "xi", Some(n))?;
+    let eta: Vec<[C; 3]> = rows(&eta, "eta", Some(n))?;
+    let g_ref = g_ref.map(|g| vec1(&g, "g_ref", Some(n))).transpose()?;
+    let sqrt_c: Option<[C; 3]> = sqrt_c.map(|s| array1(&s, "sqrt_c")).transpose()?;
     type Out = (Array2<C>, Array2<i8>, Array1<f64>, Array2<C>);
     let out = py.detach(|| -> Result<Out, Error> {
         // Columns: z1, y1, z2, y2, g.

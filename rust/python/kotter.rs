@@ -5,65 +5,12 @@ use numpy::{Complex64, IntoPyArray, PyReadonlyArray1, PyReadonlyArray2, PyReadon
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
+use super::arrays::{array1, out_shape_err, rows, shape_err, vec1};
 use crate::error::Error;
 use crate::kotter;
 
 type C = Complex64;
 type LmPair = ([C; 3], [C; 3]);
-
-fn shape_err(what: &'static str, expected: &str, got: &[usize]) -> PyErr {
-    Error::Shape {
-        what,
-        expected: expected.to_string(),
-        got: format!("{got:?}"),
-    }
-    .into()
-}
-
-fn read_a(a: &PyReadonlyArray1<'_, f64>) -> PyResult<[f64; 4]> {
-    let a = a.as_array();
-    if a.len() != 4 {
-        return Err(shape_err("a", "(4,)", a.shape()));
-    }
-    Ok([a[0], a[1], a[2], a[3]])
-}
-
-fn read_rows<const N: usize>(
-    what: &'static str,
-    x: &PyReadonlyArray2<'_, f64>,
-) -> PyResult<Vec<[f64; N]>> {
-    let x = x.as_array();
-    if x.ncols() != N {
-        return Err(shape_err(what, &format!("(n, {N})"), x.shape()));
-    }
-    Ok(x.rows()
-        .into_iter()
-        .map(|r| std::array::from_fn(|i| r[i]))
-        .collect())
-}
-
-fn read_crows<const N: usize>(
-    what: &'static str,
-    x: &PyReadonlyArray2<'_, C>,
-    n: usize,
-) -> PyResult<Vec<[C; N]>> {
-    let x = x.as_array();
-    if x.ncols() != N || x.nrows() != n {
-        return Err(shape_err(what, &format!("({n}, {N})"), x.shape()));
-    }
-    Ok(x.rows()
-        .into_iter()
-        .map(|r| std::array::from_fn(|i| r[i]))
-        .collect())
-}
-
-fn read_c1(what: &'static str, x: &PyReadonlyArray1<'_, C>, n: usize) -> PyResult<Vec<C>> {
-    let x = x.as_array();
-    if x.len() != n {
-        return Err(shape_err(what, &format!("({n},)"), x.shape()));
-    }
-    Ok(x.iter().copied().collect())
-}
 
 /// The integrals (h0, h1, h2, h3) (6)-(7) with the complementary-pair H2, H3, for states `l` of shape (n, 6).
 #[pyfunction(name = "kotter_integrals")]
@@ -72,20 +19,12 @@ fn kotter_integrals_py<'py>(
     a: PyReadonlyArray1<'py, f64>,
     l: PyReadonlyArray2<'py, f64>,
 ) -> PyResult<Bound<'py, PyAny>> {
-    let a = read_a(&a)?;
-    let rows = read_rows::<6>("l", &l)?;
+    let a: [f64; 4] = array1(&a, "a")?;
+    let rows = rows::<f64, 6>(&l, "l", None)?;
     let n = rows.len();
     let out: Vec<f64> = py.detach(|| rows.iter().flat_map(|r| kotter::integrals(&a, r)).collect());
-    let arr = Array2::from_shape_vec((n, 4), out).map_err(|e| shape_err_msg(e.to_string()))?;
+    let arr = Array2::from_shape_vec((n, 4), out).map_err(out_shape_err)?;
     Ok(arr.into_pyarray(py).into_any())
-}
-
-fn shape_err_msg(msg: String) -> PyErr {
-    Error::InvalidArgument {
-        what: "array shape",
-        reason: msg,
-    }
-    .into()
 }
 
 /// Schottky's l(s) (12) and m(s) (17) on the branch sqrt(s_j4) sqrt(s_kl) = sqrt_g.
@@ -97,11 +36,11 @@ fn kotter_schottky_py<'py>(
     s: PyReadonlyArray1<'py, C>,
     sqrt_g: PyReadonlyArray1<'py, C>,
 ) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyAny>)> {
-    let a = read_a(&a)?;
-    let rows = read_rows::<6>("l", &l)?;
+    let a: [f64; 4] = array1(&a, "a")?;
+    let rows = rows::<f64, 6>(&l, "l", None)?;
     let n = rows.len();
-    let s = read_c1("s", &s, n)?;
-    let sg = read_c1("sqrt_g", &sqrt_g, n)?;
+    let s = vec1(&s, "s", Some(n))?;
+    let sg = vec1(&sqrt_g, "sqrt_g", Some(n))?;
     let res: Result<Vec<LmPair>, Error> = py.detach(|| {
         crate::error::check_finite("a", &a)?;
         rows.iter()
@@ -115,8 +54,8 @@ fn kotter_schottky_py<'py>(
     let res = res?;
     let lv: Vec<C> = res.iter().flat_map(|x| x.0).collect();
     let mv: Vec<C> = res.iter().flat_map(|x| x.1).collect();
-    let lv = Array2::from_shape_vec((n, 3), lv).map_err(|e| shape_err_msg(e.to_string()))?;
-    let mv = Array2::from_shape_vec((n, 3), mv).map_err(|e| shape_err_msg(e.to_string()))?;
+    let lv = Array2::from_shape_vec((n, 3), lv).map_err(out_shape_err)?;
+    let mv = Array2::from_shape_vec((n, 3), mv).map_err(out_shape_err)?;
     Ok((
         lv.into_pyarray(py).into_any(),
         mv.into_pyarray(py).into_any(),
@@ -133,18 +72,12 @@ fn kotter_lax_m_py<'py>(
     s: PyReadonlyArray1<'py, C>,
     sqrt_g: PyReadonlyArray1<'py, C>,
 ) -> PyResult<Bound<'py, PyAny>> {
-    let a = read_a(&a)?;
-    let b = {
-        let b = b.as_array();
-        if b.len() != 4 {
-            return Err(shape_err("b", "(4,)", b.shape()));
-        }
-        [b[0], b[1], b[2], b[3]]
-    };
-    let rows = read_rows::<6>("l", &l)?;
+    let a: [f64; 4] = array1(&a, "a")?;
+    let b: [f64; 4] = array1(&b, "b")?;
+    let rows = rows::<f64, 6>(&l, "l", None)?;
     let n = rows.len();
-    let s = read_c1("s", &s, n)?;
-    let sg = read_c1("sqrt_g", &sqrt_g, n)?;
+    let s = vec1(&s, "s", Some(n))?;
+    let sg = vec1(&sqrt_g, "sqrt_g", Some(n))?;
     let res: Result<Vec<[C; 3]>, Error> = py.detach(|| {
         rows.iter()
             .zip(s.iter().zip(sg.iter()))
@@ -152,7 +85,7 @@ fn kotter_lax_m_py<'py>(
             .collect()
     });
     let out: Vec<C> = res?.into_iter().flatten().collect();
-    let arr = Array2::from_shape_vec((n, 3), out).map_err(|e| shape_err_msg(e.to_string()))?;
+    let arr = Array2::from_shape_vec((n, 3), out).map_err(out_shape_err)?;
     Ok(arr.into_pyarray(py).into_any())
 }
 
@@ -163,8 +96,8 @@ fn kotter_quartic_py<'py>(
     a: PyReadonlyArray1<'py, f64>,
     h: PyReadonlyArray2<'py, f64>,
 ) -> PyResult<Bound<'py, PyAny>> {
-    let a = read_a(&a)?;
-    let rows = read_rows::<4>("h", &h)?;
+    let a: [f64; 4] = array1(&a, "a")?;
+    let rows = rows::<f64, 4>(&h, "h", None)?;
     let n = rows.len();
     let res: Result<Vec<[f64; 5]>, Error> = py.detach(|| {
         crate::error::check_finite("a", &a)?;
@@ -176,7 +109,7 @@ fn kotter_quartic_py<'py>(
             .collect()
     });
     let out: Vec<f64> = res?.into_iter().flatten().collect();
-    let arr = Array2::from_shape_vec((n, 5), out).map_err(|e| shape_err_msg(e.to_string()))?;
+    let arr = Array2::from_shape_vec((n, 5), out).map_err(out_shape_err)?;
     Ok(arr.into_pyarray(py).into_any())
 }
 
@@ -188,8 +121,8 @@ fn kotter_batch_py<'py>(
     a: PyReadonlyArray1<'py, f64>,
     l: PyReadonlyArray2<'py, f64>,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let a = read_a(&a)?;
-    let rows = read_rows::<6>("l", &l)?;
+    let a: [f64; 4] = array1(&a, "a")?;
+    let rows = rows::<f64, 6>(&l, "l", None)?;
     let n = rows.len();
     let res: Result<Vec<kotter::KotterState>, Error> =
         py.detach(|| rows.iter().map(|r| kotter::kotter(&a, r)).collect());
@@ -197,14 +130,14 @@ fn kotter_batch_py<'py>(
     let dict = PyDict::new(py);
     let c2 = |f: &dyn Fn(&kotter::KotterState) -> Vec<C>, m: usize| -> PyResult<Array2<C>> {
         let v: Vec<C> = res.iter().flat_map(f).collect();
-        Array2::from_shape_vec((n, m), v).map_err(|e| shape_err_msg(e.to_string()))
+        Array2::from_shape_vec((n, m), v).map_err(out_shape_err)
     };
     let c1 = |f: &dyn Fn(&kotter::KotterState) -> C| -> Array1<C> { res.iter().map(f).collect() };
     let k = |st: &kotter::KotterState| st.constants.clone();
     dict.set_item("h", {
         let v: Vec<f64> = res.iter().flat_map(|st| st.constants.h).collect();
         Array2::from_shape_vec((n, 4), v)
-            .map_err(|e| shape_err_msg(e.to_string()))?
+            .map_err(out_shape_err)?
             .into_pyarray(py)
     })?;
     dict.set_item("s", c2(&|st| k(st).s.to_vec(), 4)?.into_pyarray(py))?;
@@ -217,7 +150,7 @@ fn kotter_batch_py<'py>(
     dict.set_item(
         "l_p",
         Array3::from_shape_vec((n, 4, 3), lp)
-            .map_err(|e| shape_err_msg(e.to_string()))?
+            .map_err(out_shape_err)?
             .into_pyarray(py),
     )?;
     let dd: Vec<C> = res
@@ -227,7 +160,7 @@ fn kotter_batch_py<'py>(
     dict.set_item(
         "Delta",
         Array3::from_shape_vec((n, 3, 3), dd)
-            .map_err(|e| shape_err_msg(e.to_string()))?
+            .map_err(out_shape_err)?
             .into_pyarray(py),
     )?;
     dict.set_item("xi", c2(&|st| st.xi.to_vec(), 3)?.into_pyarray(py))?;
@@ -262,14 +195,14 @@ fn kotter_batch_py<'py>(
     dict.set_item(
         "zd",
         Array3::from_shape_vec((n, 2, 5), zd)
-            .map_err(|e| shape_err_msg(e.to_string()))?
+            .map_err(out_shape_err)?
             .into_pyarray(py),
     )?;
     let br: Vec<i8> = res.iter().flat_map(|st| st.points.eps).collect();
     dict.set_item(
         "branch",
         Array2::from_shape_vec((n, 5), br)
-            .map_err(|e| shape_err_msg(e.to_string()))?
+            .map_err(out_shape_err)?
             .into_pyarray(py),
     )?;
     Ok(dict)
@@ -294,32 +227,23 @@ fn kotter_from_points_py<'py>(
     zd: Option<PyReadonlyArray3<'py, C>>,
 ) -> PyResult<Bound<'py, PyAny>> {
     let n = z1.as_array().len();
-    let al = read_crows::<3>("alpha", &alpha, n)?;
-    let be = read_crows::<3>("beta", &beta, n)?;
-    let ga = read_crows::<3>("gamma", &gamma, n)?;
-    let de = read_crows::<3>("delta", &delta, n)?;
-    let dv = read_crows::<3>("d", &d, n)?;
-    let z1 = read_c1("z1", &z1, n)?;
-    let y1 = read_c1("y1", &y1, n)?;
-    let z2 = read_c1("z2", &z2, n)?;
-    let y2 = read_c1("y2", &y2, n)?;
-    let g = read_c1("g", &g, n)?;
-    let br = {
-        let b = branch.as_array();
-        if b.ncols() != 5 || b.nrows() != n {
-            return Err(shape_err("branch", &format!("({n}, 5)"), b.shape()));
-        }
-        b.rows()
-            .into_iter()
-            .map(|r| std::array::from_fn(|i| r[i]))
-            .collect::<Vec<[i8; 5]>>()
-    };
+    let al = rows::<C, 3>(&alpha, "alpha", Some(n))?;
+    let be = rows::<C, 3>(&beta, "beta", Some(n))?;
+    let ga = rows::<C, 3>(&gamma, "gamma", Some(n))?;
+    let de = rows::<C, 3>(&delta, "delta", Some(n))?;
+    let dv = rows::<C, 3>(&d, "d", Some(n))?;
+    let z1 = vec1(&z1, "z1", Some(n))?;
+    let y1 = vec1(&y1, "y1", Some(n))?;
+    let z2 = vec1(&z2, "z2", Some(n))?;
+    let y2 = vec1(&y2, "y2", Some(n))?;
+    let g = vec1(&g, "g", Some(n))?;
+    let br = rows::<i8, 5>(&branch, "branch", Some(n))?;
     let zd: Option<Vec<[[C; 5]; 2]>> = match zd {
         None => None,
         Some(z) => {
             let z = z.as_array();
             if z.shape() != [n, 2, 5] {
-                return Err(shape_err("zd", &format!("({n}, 2, 5)"), z.shape()));
+                return Err(shape_err("zd", format!("({n}, 2, 5)"), z.shape()));
             }
             Some(
                 (0..n)
@@ -350,7 +274,7 @@ fn kotter_from_points_py<'py>(
             .collect()
     });
     let out: Vec<f64> = res?.into_iter().flatten().collect();
-    let arr = Array2::from_shape_vec((n, 6), out).map_err(|e| shape_err_msg(e.to_string()))?;
+    let arr = Array2::from_shape_vec((n, 6), out).map_err(out_shape_err)?;
     Ok(arr.into_pyarray(py).into_any())
 }
 

@@ -7,6 +7,7 @@
 
 use pyo3::prelude::*;
 
+mod arrays;
 mod curve;
 mod errors;
 mod kotter;

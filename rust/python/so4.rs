@@ -4,14 +4,10 @@ use numpy::ndarray::{Array2, Array3};
 use numpy::{IntoPyArray, PyArray1, PyArray2, PyArray3, PyReadonlyArray1, PyReadonlyArray2};
 use pyo3::prelude::*;
 
+use super::arrays::{out_shape_err, vec1};
 use crate::error::Error;
 use crate::integrate::{self, Method, Options};
 use crate::so4::{self, FrahmTop};
-
-/// Copies a read-only 1-d array (any strides) into a Vec.
-fn vec1(x: &PyReadonlyArray1<'_, f64>) -> Vec<f64> {
-    x.as_array().iter().copied().collect()
-}
 
 /// Copies a read-only 2-d array (any strides) into a row-major Vec with its shape.
 fn vec2(x: &PyReadonlyArray2<'_, f64>) -> (Vec<f64>, usize, usize) {
@@ -43,13 +39,6 @@ fn check_states(what: &'static str, cols: usize, m: usize) -> Result<(), Error> 
     Ok(())
 }
 
-fn shape_err(e: impl std::fmt::Display) -> Error {
-    Error::InvalidArgument {
-        what: "output shape",
-        reason: e.to_string(),
-    }
-}
-
 /// Manakov's c_ij (2) from a, b.
 #[pyfunction(name = "manakov_c")]
 fn manakov_c_py<'py>(
@@ -57,11 +46,11 @@ fn manakov_c_py<'py>(
     a: PyReadonlyArray1<'py, f64>,
     b: PyReadonlyArray1<'py, f64>,
 ) -> PyResult<Bound<'py, PyArray2<f64>>> {
-    let (a, b) = (vec1(&a), vec1(&b));
+    let (a, b) = (vec1(&a, "a", None)?, vec1(&b, "b", None)?);
     let n = a.len();
     let c = py.detach(|| so4::manakov_c(&a, &b))?;
     Ok(Array2::from_shape_vec((n, n), c)
-        .map_err(shape_err)?
+        .map_err(out_shape_err)?
         .into_pyarray(py))
 }
 
@@ -90,7 +79,7 @@ fn vector_field_py<'py>(
         out
     });
     Ok(Array2::from_shape_vec((rows, cols), out)
-        .map_err(shape_err)?
+        .map_err(out_shape_err)?
         .into_pyarray(py))
 }
 
@@ -115,7 +104,7 @@ fn so4_integrals_py<'py>(
     a: PyReadonlyArray1<'py, f64>,
     l: PyReadonlyArray2<'py, f64>,
 ) -> PyResult<Bound<'py, PyArray2<f64>>> {
-    let a = vec1(&a);
+    let a = vec1(&a, "a", None)?;
     let a4: [f64; 4] = a.as_slice().try_into().map_err(|_| Error::Shape {
         what: "a",
         expected: "(4,)".into(),
@@ -132,7 +121,7 @@ fn so4_integrals_py<'py>(
             .collect()
     });
     Ok(Array2::from_shape_vec((rows, 4), out)
-        .map_err(shape_err)?
+        .map_err(out_shape_err)?
         .into_pyarray(py))
 }
 
@@ -149,7 +138,7 @@ fn manakov_integrals_py<'py>(
     a: PyReadonlyArray1<'py, f64>,
     l: PyReadonlyArray2<'py, f64>,
 ) -> PyResult<Bound<'py, PyArray2<f64>>> {
-    let a = vec1(&a);
+    let a = vec1(&a, "a", None)?;
     let n = a.len();
     let (lv, rows, cols) = vec2(&l);
     check_states("l", cols, so4::state_dim(n))?;
@@ -160,7 +149,7 @@ fn manakov_integrals_py<'py>(
             .collect()
     });
     Ok(Array2::from_shape_vec((rows, k), out)
-        .map_err(shape_err)?
+        .map_err(out_shape_err)?
         .into_pyarray(py))
 }
 
@@ -186,16 +175,17 @@ fn poisson_tensor_py<'py>(
         out
     });
     Ok(Array3::from_shape_vec((rows, cols, cols), out)
-        .map_err(shape_err)?
+        .map_err(out_shape_err)?
         .into_pyarray(py))
 }
 
-fn options(method: &str, dt: f64, rtol: f64, atol: f64) -> Result<Options, Error> {
+fn options(method: &str, dt: f64, rtol: f64, atol: f64, max_steps: u64) -> Result<Options, Error> {
     let o = Options {
         method: Method::from_name(method)?,
         dt,
         rtol,
         atol,
+        max_steps,
     };
     o.validate()?;
     Ok(o)
@@ -203,7 +193,7 @@ fn options(method: &str, dt: f64, rtol: f64, atol: f64) -> Result<Options, Error
 
 /// Integrates (1) from l0 at t0, sampling at `times`; returns (l (S, m), steps, evals).
 #[pyfunction(name = "integrate")]
-#[pyo3(signature = (c, l0, t0, times, method, dt, rtol, atol))]
+#[pyo3(signature = (c, l0, t0, times, method, dt, rtol, atol, max_steps))]
 #[allow(clippy::too_many_arguments)]
 fn integrate_py<'py>(
     py: Python<'py>,
@@ -215,21 +205,22 @@ fn integrate_py<'py>(
     dt: f64,
     rtol: f64,
     atol: f64,
+    max_steps: u64,
 ) -> PyResult<(Bound<'py, PyArray2<f64>>, u64, u64)> {
     let top = top_from_c(&c)?;
-    let (l0, times) = (vec1(&l0), vec1(&times));
-    let opts = options(method, dt, rtol, atol)?;
+    let (l0, times) = (vec1(&l0, "l0", None)?, vec1(&times, "times", None)?);
+    let opts = options(method, dt, rtol, atol, max_steps)?;
     let tr = py.detach(|| integrate::integrate(&top, &l0, t0, &times, &opts))?;
     let m = top.dim();
     let y = Array2::from_shape_vec((tr.t.len(), m), tr.y)
-        .map_err(shape_err)?
+        .map_err(out_shape_err)?
         .into_pyarray(py);
     Ok((y, tr.steps, tr.evals))
 }
 
 /// Integrates a batch (B, m) of initial states; returns (l (B, S, m), steps).
 #[pyfunction(name = "integrate_many")]
-#[pyo3(signature = (c, l0s, t0, times, method, dt, rtol, atol, parallel))]
+#[pyo3(signature = (c, l0s, t0, times, method, dt, rtol, atol, max_steps, parallel))]
 #[allow(clippy::too_many_arguments)]
 fn integrate_many_py<'py>(
     py: Python<'py>,
@@ -241,17 +232,18 @@ fn integrate_many_py<'py>(
     dt: f64,
     rtol: f64,
     atol: f64,
+    max_steps: u64,
     parallel: bool,
 ) -> PyResult<(Bound<'py, PyArray3<f64>>, u64)> {
     let top = top_from_c(&c)?;
     let (l0s, rows, cols) = vec2(&l0s);
     check_states("l0s", cols, top.dim())?;
-    let times = vec1(&times);
-    let opts = options(method, dt, rtol, atol)?;
+    let times = vec1(&times, "times", None)?;
+    let opts = options(method, dt, rtol, atol, max_steps)?;
     let (ys, steps) =
         py.detach(|| integrate::integrate_many(&top, &l0s, t0, &times, &opts, parallel))?;
     let y = Array3::from_shape_vec((rows, times.len(), cols), ys)
-        .map_err(shape_err)?
+        .map_err(out_shape_err)?
         .into_pyarray(py);
     Ok((y, steps))
 }
@@ -273,7 +265,7 @@ fn gauss_tableau_py<'py>(py: Python<'py>, method: &str) -> PyResult<Tableau<'py>
     })?;
     let s = b.len();
     let mu = Array2::from_shape_vec((s, s), mu)
-        .map_err(shape_err)?
+        .map_err(out_shape_err)?
         .into_pyarray(py);
     Ok((c.to_vec().into_pyarray(py), b.to_vec().into_pyarray(py), mu))
 }
