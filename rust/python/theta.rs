@@ -33,9 +33,10 @@ fn read_tau(tau: &PyReadonlyArray2<'_, Complex64>) -> Result<(Vec<Complex64>, us
 /// `n` points `z` (shape (n, g)): returns (values (n, 4^g), gradient
 /// (n, 4^g, g or 0), hessian (n, 4^g, g, g or 0), log_scale (n,), finite),
 /// normalised so that θ = exp(log_scale) · values; with `scaled` the arrays hold
-/// θ itself and `finite` is false if some value overflowed.
+/// θ itself and `finite` is false if some value overflowed. With `parallel`
+/// large batches are split over rayon's thread pool.
 #[pyfunction(name = "theta_jet")]
-#[pyo3(signature = (z, tau, tol, order, scaled))]
+#[pyo3(signature = (z, tau, tol, order, scaled, parallel))]
 fn theta_jet_py<'py>(
     py: Python<'py>,
     z: PyReadonlyArray2<'py, Complex64>,
@@ -43,6 +44,7 @@ fn theta_jet_py<'py>(
     tol: f64,
     order: usize,
     scaled: bool,
+    parallel: bool,
 ) -> PyResult<Jet<'py>> {
     let (tau_v, g) = read_tau(&tau)?;
     let zv = z.as_array();
@@ -66,7 +68,7 @@ fn theta_jet_py<'py>(
         _ => (g, g),
     };
     let (values, gradient, hessian, logs, finite) = py.detach(move || -> Result<_, Error> {
-        let plan = ThetaPlan::new(&tau_v, g, tol, order)?;
+        let plan = ThetaPlan::new(&tau_v, g, tol, order)?.with_parallel(parallel);
         let zero = Complex64::new(0.0, 0.0);
         let mut values = vec![zero; npts * n];
         let mut gradient = vec![zero; npts * n * gd];

@@ -181,7 +181,12 @@ impl Batch2 {
         }
         #[cfg(target_arch = "x86_64")]
         {
-            if std::is_x86_feature_detected!("avx2") {
+            if false && std::is_x86_feature_detected!("avx512f") {
+                // SAFETY: the CPU supports AVX-512F (checked just above).
+                unsafe { self.kernel_avx512(sc, &u1, &u2, &norm) };
+                return;
+            }
+            if std::is_x86_feature_detected!("avx2") && std::is_x86_feature_detected!("fma") {
                 // SAFETY: the CPU supports AVX2 (checked just above).
                 unsafe { self.kernel_avx2(sc, &u1, &u2, &norm) };
                 return;
@@ -191,7 +196,21 @@ impl Batch2 {
     }
 
     #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx2")]
+    #[target_feature(enable = "avx512f")]
+    unsafe fn kernel_avx512(
+        &self,
+        sc: &mut BatchScratch,
+        u1: &[Lane; 2],
+        u2: &[Lane; 2],
+        norm: &Lane,
+    ) {
+        fill_powers(u1, self.j1lo, norm, &mut sc.x1re, &mut sc.x1im);
+        fill_powers(u2, self.j2lo, &[1.0; LANES], &mut sc.x2re, &mut sc.x2im);
+        self.rows_body(sc);
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2,fma")]
     unsafe fn kernel_avx2(
         &self,
         sc: &mut BatchScratch,

@@ -43,6 +43,7 @@ pub use chars::{char_from_index, char_index, paper_char_index, parity, MAX_GENUS
 
 use crate::error::{check_finite, Error, Result};
 use num_complex::Complex64;
+use rayon::prelude::*;
 
 /// Default truncation tolerance: the absolute error of every normalised value
 /// `Ω = θ·exp(-L)` (and of its z-derivatives at the reduced point) from the
@@ -69,6 +70,11 @@ const FAST_PATH_MAX_IMAG_DIAG: f64 = 50.0;
 /// Batches of at least this many points (values only, genus 2) use the
 /// vectorised kernel; its plan-time table costs about as much as 100 points.
 const BATCH_KERNEL_MIN_POINTS: usize = 64;
+
+/// Batches of at least this many points are split over rayon's thread pool
+/// (when the plan allows it): ~0.5 ms of work, well above the cost of waking
+/// the pool (measured, docs/theta.md "Benchmarks").
+const PARALLEL_MIN_POINTS: usize = 4096;
 
 /// A validated period matrix with everything the sums need that depends only
 /// on τ, the tolerance and the derivative order: build once, evaluate at many z.
@@ -101,6 +107,8 @@ pub struct ThetaPlan {
     /// Genus-2 batch kernel for values (see `batch.rs`), built on first use by
     /// a large enough batch (its table costs ~20 µs), `None` inside if not applicable.
     batch2: std::sync::OnceLock<Option<batch::Batch2>>,
+    /// Split large batches over rayon's thread pool.
+    parallel: bool,
 }
 
 /// Values and z-derivatives of all 4^g theta functions at one point, normalised:
@@ -303,6 +311,7 @@ impl ThetaPlan {
             qinv,
             fast_g2,
             batch2: std::sync::OnceLock::new(),
+            parallel: true,
         };
         let expected = plan.info().expected_terms;
         if expected > MAX_TERMS {
@@ -316,6 +325,14 @@ impl ThetaPlan {
             });
         }
         Ok(plan)
+    }
+
+    /// Whether batches of at least 4096 points are split over rayon's thread pool
+    /// (default `true`; the pool size follows `RAYON_NUM_THREADS`). Results do not
+    /// depend on it: every point is computed by the same code either way.
+    pub fn with_parallel(mut self, parallel: bool) -> Self {
+        self.parallel = parallel;
+        self
     }
 
     /// Genus.
@@ -727,7 +744,60 @@ impl ThetaPlan {
     /// Evaluates a batch: `z` holds `npts` points of `g` entries (row-major);
     /// the outputs hold `npts` blocks of 4^g, 4^g·g and 4^g·g² entries
     /// (gradient/Hessian may be empty to skip them); `log_scale` has `npts` entries.
+    /// With [`ThetaPlan::with_parallel`] (the default) large batches are split
+    /// over rayon's thread pool.
     pub fn eval_batch(
+        &self,
+        z: &[Complex64],
+        values: &mut [Complex64],
+        gradient: &mut [Complex64],
+        hessian: &mut [Complex64],
+        log_scale: &mut [f64],
+    ) -> Result<()> {
+        let g = self.g;
+        let n = 1usize << (2 * g);
+        let npts = log_scale.len();
+        let (gs, hs) = (n * g, n * g * g);
+        let shapes_ok = z.len() == npts * g
+            && values.len() == npts * n
+            && (gradient.is_empty() || gradient.len() == npts * gs)
+            && (hessian.is_empty() || hessian.len() == npts * hs);
+        let Some(chunk) = self.parallel_chunk(npts).filter(|_| shapes_ok) else {
+            return self.eval_batch_serial(z, values, gradient, hessian, log_scale);
+        };
+        let gs = if gradient.is_empty() { 0 } else { gs };
+        let hs = if hessian.is_empty() { 0 } else { hs };
+        let mut gchunks: Vec<&mut [Complex64]> = if gs == 0 {
+            (0..npts.div_ceil(chunk)).map(|_| &mut [][..]).collect()
+        } else {
+            gradient.chunks_mut(chunk * gs).collect()
+        };
+        let mut hchunks: Vec<&mut [Complex64]> = if hs == 0 {
+            (0..npts.div_ceil(chunk)).map(|_| &mut [][..]).collect()
+        } else {
+            hessian.chunks_mut(chunk * hs).collect()
+        };
+        z.par_chunks(chunk * g)
+            .zip(values.par_chunks_mut(chunk * n))
+            .zip(gchunks.par_iter_mut())
+            .zip(hchunks.par_iter_mut())
+            .zip(log_scale.par_chunks_mut(chunk))
+            .try_for_each(|((((zc, vc), gc), hc), lc)| self.eval_batch_serial(zc, vc, gc, hc, lc))
+    }
+
+    /// Chunk size for splitting a batch of `npts` points over the thread pool,
+    /// `None` to stay on the calling thread.
+    fn parallel_chunk(&self, npts: usize) -> Option<usize> {
+        let threads = rayon::current_num_threads();
+        if !self.parallel || threads < 2 || npts < PARALLEL_MIN_POINTS {
+            return None;
+        }
+        // a few chunks per thread for load balance; whole kernel chunks
+        let per = npts.div_ceil(4 * threads);
+        Some(per.div_ceil(batch::LANES).max(1) * batch::LANES)
+    }
+
+    fn eval_batch_serial(
         &self,
         z: &[Complex64],
         values: &mut [Complex64],
@@ -839,13 +909,32 @@ impl ThetaPlan {
         values: &mut [Complex64],
         log_scale: &mut [f64],
     ) -> Result<bool> {
+        let (g, npts) = (self.g, log_scale.len());
+        let n = 1usize << (2 * g);
+        let shapes_ok = z.len() == npts * g && values.len() == npts * n;
+        let Some(chunk) = self.parallel_chunk(npts).filter(|_| shapes_ok) else {
+            return self.eval_batch_scaled_serial(z, values, log_scale);
+        };
+        z.par_chunks(chunk * g)
+            .zip(values.par_chunks_mut(chunk * n))
+            .zip(log_scale.par_chunks_mut(chunk))
+            .map(|((zc, vc), lc)| self.eval_batch_scaled_serial(zc, vc, lc))
+            .try_reduce(|| true, |a, b| Ok(a && b))
+    }
+
+    fn eval_batch_scaled_serial(
+        &self,
+        z: &[Complex64],
+        values: &mut [Complex64],
+        log_scale: &mut [f64],
+    ) -> Result<bool> {
         let npts = log_scale.len();
         if z.len() == 2 * npts && values.len() == 16 * npts && npts >= BATCH_KERNEL_MIN_POINTS {
             if let Some(b2) = self.batch2.get_or_init(|| batch::Batch2::build(self)) {
                 return self.eval_batch_g2(b2, z, values, log_scale, true);
             }
         }
-        self.eval_batch(z, values, &mut [], &mut [], log_scale)?;
+        self.eval_batch_serial(z, values, &mut [], &mut [], log_scale)?;
         Ok(apply_scale(values, &mut [], &mut [], log_scale))
     }
 }
