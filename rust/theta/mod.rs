@@ -134,8 +134,11 @@ struct Reduced {
     wr: [f64; MAX_GENUS],
     q: [f64; MAX_GENUS],
     log_scale: f64,
-    /// `exp(iφ)`, `φ = -π qᵀX'q - 2π qᵀ Re z_r`.
+    /// `exp(iφ)`, `φ = -π qᵀX'q - 2π qᵀ Re z_r` (left at 1 by the batch kernel's
+    /// reduction, which evaluates it for 16 points at once from `phase`).
     prefactor: Complex64,
+    /// `φ/π` (genus 2 only).
+    phase: f64,
     /// Parities of `p` and `q` as bit masks (coordinate k at bit g-1-k).
     pbits: usize,
     qbits: usize,
@@ -473,7 +476,7 @@ impl ThetaPlan {
     /// The reduction `z = z_r + p + τ'q` and the factors it contributes.
     fn reduce(&self, z: &[Complex64]) -> Result<Reduced> {
         if self.g == 2 && z.len() == 2 {
-            return self.reduce2([z[0], z[1]]);
+            return self.reduce2::<true>([z[0], z[1]]);
         }
         let g = self.g;
         for (k, c) in z.iter().enumerate() {
@@ -562,13 +565,15 @@ impl ThetaPlan {
             q,
             log_scale,
             prefactor,
+            phase: 0.0,
             pbits,
             qbits,
         })
     }
 
-    /// [`ThetaPlan::reduce`] written out for genus 2 (same operations, fixed size).
-    fn reduce2(&self, z: [Complex64; 2]) -> Result<Reduced> {
+    /// [`ThetaPlan::reduce`] written out for genus 2 (same operations, fixed size);
+    /// `PREFACTOR = false` leaves `prefactor = 1` and only records `phase`.
+    fn reduce2<const PREFACTOR: bool>(&self, z: [Complex64; 2]) -> Result<Reduced> {
         for (k, c) in z.iter().enumerate() {
             if !(c.re.is_finite() && c.im.is_finite()) {
                 return Err(Error::NonFinite {
@@ -621,15 +626,13 @@ impl ThetaPlan {
         red.q[1] = q[1];
         let log_scale = pi() * z[0].im * (q[0] + red.wr[0]) + pi() * z[1].im * (q[1] + red.wr[1]);
         red.log_scale = log_scale.max(0.0);
-        red.prefactor = if shifted {
-            let mut phi = -pi() * quad_mod2(x, &q, 2);
-            for i in 0..2 {
-                phi -= 2.0 * pi() * q[i] * red.zr[i].re;
+        red.prefactor = Complex64::new(1.0, 0.0);
+        if shifted {
+            red.phase = -quad_mod2(x, &q, 2) - 2.0 * (q[0] * red.zr[0].re + q[1] * red.zr[1].re);
+            if PREFACTOR {
+                red.prefactor = Complex64::from_polar(1.0, pi() * red.phase);
             }
-            Complex64::from_polar(1.0, phi)
-        } else {
-            Complex64::new(1.0, 0.0)
-        };
+        }
         red.pbits = ((p[0] as i64 & 1) << 1 | (p[1] as i64 & 1)) as usize;
         red.qbits = ((q[0] as i64 & 1) << 1 | (q[1] as i64 & 1)) as usize;
         Ok(red)
@@ -862,36 +865,42 @@ impl ThetaPlan {
     ) -> Result<bool> {
         const L: usize = batch::LANES;
         let mut finite = true;
-        let zero = Complex64::new(0.0, 0.0);
         let npts = log_scale.len();
         let mut sc = b2.scratch();
+        let mut inp = batch::ChunkIn::default();
         let mut i0 = 0;
         while i0 < npts {
             let m = (npts - i0).min(L);
-            let mut zr = [[zero; 2]; L];
-            let mut wr = [[0.0; 2]; L];
-            let mut reds = [Reduced::default(); L];
-            for p in 0..m {
-                let red = self.reduce(&z[2 * (i0 + p)..2 * (i0 + p) + 2])?;
-                zr[p] = [red.zr[0], red.zr[1]];
-                wr[p] = [red.wr[0], red.wr[1]];
-                reds[p] = red;
+            if m < L {
+                inp = batch::ChunkIn::default();
             }
-            b2.class_sums(self, &zr, &wr, &mut sc);
             for p in 0..m {
                 let k = i0 + p;
-                let class_sum = |r: usize| Complex64::new(sc.sre[r][p], sc.sim[r][p]);
-                let mut red = reds[p];
-                if scaled {
-                    red.prefactor *= red.log_scale.exp();
+                let red = self.reduce2::<false>([z[2 * k], z[2 * k + 1]])?;
+                for i in 0..2 {
+                    inp.zre[i][p] = red.zr[i].re;
+                    inp.zim[i][p] = red.zr[i].im;
+                    inp.wr[i][p] = red.wr[i];
                 }
-                let out = &mut values[16 * k..16 * k + 16];
-                self.combine_g2_values(&red, class_sum, out);
-                // |Ω| ≤ number of terms ≤ MAX_TERMS = 2e8, so exp(L)|Ω| < f64::MAX for L ≤ 690
-                if scaled && red.log_scale > 690.0 {
-                    finite &= out.iter().all(|v| v.re.is_finite() && v.im.is_finite());
+                inp.phase[p] = red.phase;
+                inp.logs[p] = red.log_scale;
+                for h in 0..4 {
+                    inp.sa[h][p] = 1.0 - 2.0 * f64::from((h & red.pbits).count_ones() & 1);
+                    inp.sb[h][p] = 1.0 - 2.0 * f64::from((h & red.qbits).count_ones() & 1);
                 }
                 log_scale[k] = red.log_scale;
+            }
+            b2.eval_chunk(self, &inp, scaled, &mut sc);
+            for p in 0..m {
+                let k = i0 + p;
+                let out = &mut values[16 * k..16 * k + 16];
+                for (idx, v) in out.iter_mut().enumerate() {
+                    *v = Complex64::new(sc.out_re[idx][p], sc.out_im[idx][p]);
+                }
+                // |Ω| ≤ number of terms ≤ MAX_TERMS = 2e8, so exp(L)|Ω| < f64::MAX for L ≤ 690
+                if scaled && inp.logs[p] > 690.0 {
+                    finite &= out.iter().all(|v| v.re.is_finite() && v.im.is_finite());
+                }
             }
             i0 += m;
         }
