@@ -17,7 +17,7 @@ Two comparisons, each printed as its own table:
 
 python-flint is single-threaded either way; its one-core time is used in both.
 
-Run:  python benches/theta_compare.py            (about two minutes)
+Run:  python benches/theta_compare.py            (about 15 s)
       python benches/theta_compare.py --quick    (fewer points and repeats)
 """
 
