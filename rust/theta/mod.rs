@@ -76,6 +76,9 @@ const BATCH_KERNEL_MIN_POINTS: usize = 64;
 /// the pool (measured, docs/theta.md "Benchmarks").
 const PARALLEL_MIN_POINTS: usize = 4096;
 
+/// Smallest piece of a batch handed to one thread.
+const PARALLEL_CHUNK: usize = 1024;
+
 /// A validated period matrix with everything the sums need that depends only
 /// on τ, the tolerance and the derivative order: build once, evaluate at many z.
 #[derive(Debug, Clone)]
@@ -795,9 +798,11 @@ impl ThetaPlan {
         if !self.parallel || threads < 2 || npts < PARALLEL_MIN_POINTS {
             return None;
         }
-        // a few chunks per thread for load balance; whole kernel chunks
-        let per = npts.div_ceil(4 * threads);
-        Some(per.div_ceil(batch::LANES).max(1) * batch::LANES)
+        // Many chunks per thread (≥ PARALLEL_CHUNK points, ~0.2 ms each): on a
+        // shared machine a thread may lose its core for a while, and work stealing
+        // can only rebalance if there is work left to steal. Whole kernel chunks.
+        let per = npts.div_ceil(16 * threads).max(PARALLEL_CHUNK);
+        Some(per.div_ceil(batch::LANES) * batch::LANES)
     }
 
     fn eval_batch_serial(
