@@ -23,6 +23,28 @@ const W_MARGIN: f64 = 0.51;
 
 pub(super) type Lane = [f64; LANES];
 
+/// A [`Lane`] aligned to a cache line. The tables are read with 64-byte vector
+/// loads; with the 32-byte alignment the allocator happened to give, every such
+/// load straddled two cache lines (measured: the row sums ran ~1.2× slower).
+#[derive(Debug, Clone, Copy, Default)]
+#[repr(C, align(64))]
+pub(super) struct ALane(pub(super) Lane);
+
+impl std::ops::Deref for ALane {
+    type Target = Lane;
+    fn deref(&self) -> &Lane {
+        &self.0
+    }
+}
+
+impl std::ops::DerefMut for ALane {
+    fn deref_mut(&mut self) -> &mut Lane {
+        &mut self.0
+    }
+}
+
+const AZERO: ALane = ALane([0.0; LANES]);
+
 /// `i^u` as (re, im), `u = 0..4`.
 const UNIT: [(f64, f64); 4] = [(1.0, 0.0), (0.0, 1.0), (-1.0, 0.0), (0.0, -1.0)];
 
@@ -42,20 +64,21 @@ pub(super) struct Batch2 {
 /// Scratch for one chunk (power tables and class sums).
 #[derive(Debug, Clone, Default)]
 pub(super) struct BatchScratch {
-    x1re: Vec<Lane>,
-    x1im: Vec<Lane>,
-    x2re: Vec<Lane>,
-    x2im: Vec<Lane>,
+    x1re: Vec<ALane>,
+    x1im: Vec<ALane>,
+    x2re: Vec<ALane>,
+    x2im: Vec<ALane>,
     /// Class sums, `sre[r][p] + i sim[r][p]` for class `r` and lane `p`.
-    sre: Vec<Lane>,
-    sim: Vec<Lane>,
+    sre: Vec<ALane>,
+    sim: Vec<ALane>,
     /// The 16 values, `out_re[idx][p] + i out_im[idx][p]` (FLINT order).
-    pub(super) out_re: Vec<Lane>,
-    pub(super) out_im: Vec<Lane>,
+    pub(super) out_re: Vec<ALane>,
+    pub(super) out_im: Vec<ALane>,
 }
 
 /// Reduced points of one chunk, one lane per point (unused lanes hold zeros).
 #[derive(Debug, Clone, Default)]
+#[repr(C, align(64))]
 pub(super) struct ChunkIn {
     /// `Re z_r`, `Im z_r` per coordinate.
     pub(super) zre: [Lane; 2],
@@ -164,14 +187,14 @@ impl Batch2 {
 
     pub(super) fn scratch(&self) -> BatchScratch {
         BatchScratch {
-            x1re: vec![[0.0; LANES]; self.n1],
-            x1im: vec![[0.0; LANES]; self.n1],
-            x2re: vec![[0.0; LANES]; self.n2],
-            x2im: vec![[0.0; LANES]; self.n2],
-            sre: vec![[0.0; LANES]; 16],
-            sim: vec![[0.0; LANES]; 16],
-            out_re: vec![[0.0; LANES]; 16],
-            out_im: vec![[0.0; LANES]; 16],
+            x1re: vec![AZERO; self.n1],
+            x1im: vec![AZERO; self.n1],
+            x2re: vec![AZERO; self.n2],
+            x2im: vec![AZERO; self.n2],
+            sre: vec![AZERO; 16],
+            sim: vec![AZERO; 16],
+            out_re: vec![AZERO; 16],
+            out_im: vec![AZERO; 16],
         }
     }
 
@@ -308,7 +331,7 @@ impl Batch2 {
     #[inline(always)]
     fn rows_body(&self, sc: &mut BatchScratch) {
         for v in sc.sre.iter_mut().chain(sc.sim.iter_mut()) {
-            *v = [0.0; LANES];
+            *v = AZERO;
         }
         for (a, &(lo, hi)) in self.rows.iter().enumerate() {
             if lo > hi {
@@ -346,7 +369,7 @@ impl Batch2 {
 /// `x[j - lo] = scale · u^j` for all lanes, `j = lo..lo+len` (`lo ≤ 0`), by
 /// products outward from `j = 0` (phases stay small near the centre).
 #[inline(always)]
-fn fill_powers(u: &[Lane; 2], lo: i64, scale: &Lane, re: &mut [Lane], im: &mut [Lane]) {
+fn fill_powers(u: &[Lane; 2], lo: i64, scale: &Lane, re: &mut [ALane], im: &mut [ALane]) {
     let zero = (-lo) as usize;
     // 1/u = conj(u) / |u|²
     let mut inv = [[0.0; LANES]; 2];
@@ -355,8 +378,8 @@ fn fill_powers(u: &[Lane; 2], lo: i64, scale: &Lane, re: &mut [Lane], im: &mut [
         inv[0][p] = u[0][p] / n2;
         inv[1][p] = -u[1][p] / n2;
     }
-    re[zero] = *scale;
-    im[zero] = [0.0; LANES];
+    re[zero] = ALane(*scale);
+    im[zero] = AZERO;
     for k in zero + 1..re.len() {
         let (pr, pi) = (re[k - 1], im[k - 1]);
         for p in 0..LANES {
