@@ -514,6 +514,73 @@ mod tests {
     /// sums can absorb (they amplify input errors by |j| ≲ 20 anyway).
     const LANE_RTOL: f64 = 4.0 * f64::EPSILON;
 
+    /// The three compiled copies of the chunk kernel (baseline, AVX2, AVX-512,
+    /// as far as this CPU has them) give the same values: the dispatch only picks
+    /// instruction sets, the operations are the same (no FMA contraction in Rust).
+    #[test]
+    fn compiled_copies_of_the_chunk_kernel_agree() {
+        let tau = [
+            Complex64::new(0.3, 1.1),
+            Complex64::new(0.1, 0.4),
+            Complex64::new(0.1, 0.4),
+            Complex64::new(-0.2, 1.3),
+        ];
+        let plan = ThetaPlan::new(&tau, 2, 1e-15, 0).unwrap();
+        let b2 = Batch2::build(&plan).unwrap();
+        let mut inp = ChunkIn::default();
+        for p in 0..LANES {
+            let t = p as f64;
+            let red = plan
+                .reduce2::<false>([
+                    Complex64::new((0.37 * t).sin() * 3.0, (0.71 * t).cos() * 2.5),
+                    Complex64::new((0.53 * t).cos() * 2.0, (0.29 * t).sin() * 1.5),
+                ])
+                .unwrap();
+            for i in 0..2 {
+                inp.zre[i][p] = red.zr[i].re;
+                inp.zim[i][p] = red.zr[i].im;
+                inp.wr[i][p] = red.wr[i];
+            }
+            inp.phase[p] = red.phase;
+            inp.logs[p] = red.log_scale;
+            for h in 0..4 {
+                inp.sa[h][p] = 1.0 - 2.0 * f64::from((h & red.pbits).count_ones() & 1);
+                inp.sb[h][p] = 1.0 - 2.0 * f64::from((h & red.qbits).count_ones() & 1);
+            }
+        }
+        let mut base = b2.scratch();
+        b2.chunk_body(&plan, &inp, true, &mut base);
+        let mut variants = Vec::new();
+        #[cfg(target_arch = "x86_64")]
+        {
+            if std::is_x86_feature_detected!("avx2") && std::is_x86_feature_detected!("fma") {
+                let mut sc = b2.scratch();
+                // SAFETY: feature checked just above.
+                unsafe { b2.chunk_avx2(&plan, &inp, true, &mut sc) };
+                variants.push(sc);
+            }
+            if std::is_x86_feature_detected!("avx512f") {
+                let mut sc = b2.scratch();
+                // SAFETY: feature checked just above.
+                unsafe { b2.chunk_avx512(&plan, &inp, true, &mut sc) };
+                variants.push(sc);
+            }
+        }
+        for sc in &variants {
+            for idx in 0..16 {
+                for p in 0..LANES {
+                    let scale = (0..16)
+                        .map(|i| base.out_re[i][p].hypot(base.out_im[i][p]))
+                        .fold(0.0, f64::max);
+                    let d = (sc.out_re[idx][p] - base.out_re[idx][p])
+                        .hypot(sc.out_im[idx][p] - base.out_im[idx][p]);
+                    // same operations; only the vector width differs (sum order is per lane)
+                    assert!(d <= 1e-15 * scale, "idx {idx} lane {p}: {d:e}");
+                }
+            }
+        }
+    }
+
     #[test]
     fn sincos_pi_matches_std() {
         let xs: Vec<f64> = (0..4000)
