@@ -71,8 +71,8 @@ fn theta_jet_py<'py>(
     };
     // The values and L are written straight into numpy-allocated arrays: numpy
     // asks for huge pages for large arrays, which saves most of the page faults
-    // of first touching a fresh 256-bytes-per-point output (measured ~15% of a
-    // 10^5-point call).
+    // of first touching a fresh 256-bytes-per-point output (measured: a one-core
+    // 10^5-point call went from 0.160 to 0.147 µs/point).
     let values_arr = PyArray2::<Complex64>::zeros(py, [npts, n], false);
     let logs_arr = PyArray1::<f64>::zeros(py, npts, false);
     // SAFETY: both arrays were created just above, are contiguous and not yet
