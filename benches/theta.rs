@@ -1,6 +1,7 @@
 //! Criterion benches for `manakov::theta` on the shared benchmark τ of
 //! problems.json ("benchmark" → "theta"): the 16 genus-2 values at one point,
-//! one characteristic, gradient + Hessian, and batch throughput.
+//! one characteristic, gradient + Hessian, and batch throughput on one core
+//! (`with_parallel(false)`) and on all cores (rayon, the default).
 
 use criterion::{black_box, criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
 use manakov::theta::{ThetaPlan, DEFAULT_TOL};
@@ -73,16 +74,24 @@ fn theta(c: &mut Criterion) {
     });
     group.finish();
 
+    let plan1 = ThetaPlan::new(&tau, 2, DEFAULT_TOL, 0)
+        .unwrap()
+        .with_parallel(false);
     let mut group = c.benchmark_group("theta_g2_batch");
-    for &n in &[100usize, 10_000] {
+    for &(n, parallel) in &[(100usize, false), (10_000, false), (100_000, true)] {
+        let plan = if parallel { &plan0 } else { &plan1 };
+        let name = if parallel {
+            "all16_all_cores"
+        } else {
+            "all16_one_core"
+        };
         let zs = points(n);
         let mut v = vec![C::new(0.0, 0.0); 16 * n];
         let mut l = vec![0.0; n];
         group.throughput(Throughput::Elements(n as u64));
-        group.bench_with_input(BenchmarkId::new("all16", n), &n, |bch, _| {
+        group.bench_with_input(BenchmarkId::new(name, n), &n, |bch, _| {
             bch.iter(|| {
-                plan0
-                    .eval_batch(black_box(&zs), &mut v, &mut [], &mut [], &mut l)
+                plan.eval_batch(black_box(&zs), &mut v, &mut [], &mut [], &mut l)
                     .unwrap()
             })
         });

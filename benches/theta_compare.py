@@ -7,30 +7,46 @@ The shared batch of problems.json ("benchmark" -> "theta"): tau as given and
 maximum error relative to the largest of the 16 values at each point (truth:
 python-flint at 200 bits on a subset), and the speed ratios.
 
-All methods run on one core (BLAS threads set to 1 before numpy is imported).
+Two comparisons, each printed as its own table:
 
-Run:  python benches/theta_compare.py            (about a minute)
+* one core: manakov with ``parallel=False``, numpy with its BLAS pinned to one
+  thread (OPENBLAS/OMP/MKL_NUM_THREADS=1, set before numpy is imported);
+* all cores: manakov with its default ``parallel=True`` (rayon, all cores) and
+  numpy with its BLAS threads left at their default, measured in a child process
+  started without those variables (they must be set before numpy is imported).
+
+python-flint is single-threaded either way; its one-core time is used in both.
+
+Run:  python benches/theta_compare.py            (about 15 s)
       python benches/theta_compare.py --quick    (fewer points and repeats)
 """
 
 from __future__ import annotations
 
 import os
+import sys
 
-# One core for every method (the comparison is per core): numpy's BLAS would
-# otherwise use all cores for the separable variant's matrix products.
-for _var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
-    os.environ.setdefault(_var, "1")
+_BLAS_VARS = ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS")
+_CHILD_FLAG = "--all-cores-child"
+_CHILD = _CHILD_FLAG in sys.argv
+if not _CHILD:
+    # One core for every method of the first comparison: numpy's BLAS would
+    # otherwise use all cores for the matrix products of both numpy variants.
+    for _var in _BLAS_VARS:
+        os.environ[_var] = "1"
 
 import argparse  # noqa: E402
 import itertools  # noqa: E402
+import json  # noqa: E402
 import statistics  # noqa: E402
+import subprocess  # noqa: E402
 import time  # noqa: E402
 
 import numpy as np  # noqa: E402
 from flint import acb, acb_mat, ctx  # noqa: E402
 
 import manakov  # noqa: E402
+from manakov.theta import DEFAULT_TOL  # noqa: E402
 
 SEED = 20261121
 
@@ -124,9 +140,51 @@ def max_rel_error(got: np.ndarray, truth: np.ndarray) -> float:
     return float(np.max(np.max(np.abs(got - truth), axis=1) / scale))
 
 
+def measure(
+    z: np.ndarray, tau: np.ndarray, *, parallel: bool, repeats: int, n_truth: int, tol: float
+) -> list[tuple[str, float, np.ndarray, int]]:
+    """(name, seconds per point, values on the first n_truth points, points) for
+    manakov and the two numpy sums."""
+    n = len(z)
+    rows = []
+    t, vals = timed(lambda: manakov.theta_all(z, tau, tol=tol, parallel=parallel), repeats)
+    rows.append(("manakov.theta_all", t / n, vals[:n_truth], n))
+    t, vals = timed(lambda: numpy_brute(z, tau), max(1, repeats // 2))
+    rows.append((f"numpy brute force (box |n| <= {NMAX})", t / n, vals[:n_truth], n))
+    t, vals = timed(lambda: numpy_separable(z, tau), repeats)
+    rows.append(("numpy separable (same box, BLAS products)", t / n, vals[:n_truth], n))
+    return rows
+
+
+def to_json(vals: np.ndarray) -> list:
+    return np.stack([vals.real, vals.imag], axis=-1).tolist()
+
+
+def from_json(data: list) -> np.ndarray:
+    arr = np.asarray(data, float)
+    return arr[..., 0] + 1j * arr[..., 1]
+
+
+def print_table(title: str, rows: list, truth: np.ndarray) -> None:
+    base = rows[0][1]
+    print(title)
+    head = f"{'points':>7s} {'us/point':>10s} {'x manakov':>10s} {'max rel err':>12s}"
+    print(f"  {'method':44s} {head}")
+    for name, per, vals, npts in rows:
+        err = max_rel_error(vals, truth[: len(vals)])
+        print(f"  {name:44s} {npts:7d} {per * 1e6:10.3f} {per / base:10.1f} {err:12.2e}")
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("--quick", action="store_true", help="fewer points and repeats")
+    parser.add_argument(
+        "--tol",
+        type=float,
+        default=DEFAULT_TOL,
+        help=f"manakov's truncation tolerance (default: the package default, {DEFAULT_TOL:g})",
+    )
+    parser.add_argument(_CHILD_FLAG, action="store_true", help=argparse.SUPPRESS)
     args = parser.parse_args()
     n = 10**4 if args.quick else 10**5
     n_flint = 50 if args.quick else 200
@@ -134,40 +192,45 @@ def main() -> None:
     repeats = 3 if args.quick else 7
     tau, z = load_batch(10**5)
     z = z[:n]
-    sub = z[:n_truth]
 
-    truth = flint_all(sub, tau, 200)
+    if args.all_cores_child:
+        rows = measure(z, tau, parallel=True, repeats=repeats, n_truth=n_truth, tol=args.tol)
+        json.dump([(name, per, to_json(vals), npts) for name, per, vals, npts in rows], sys.stdout)
+        return
 
-    rows = []
-    t, vals = timed(lambda: manakov.theta_all(z, tau), repeats)
-    rows.append(("manakov.theta_all", t / n, max_rel_error(vals[:n_truth], truth), n))
+    truth = flint_all(z[:n_truth], tau, 200)
+    one = measure(z, tau, parallel=False, repeats=repeats, n_truth=n_truth, tol=args.tol)
     t, vals = timed(lambda: flint_all(z[:n_flint], tau, 53), max(1, repeats // 2))
-    rows.append(
-        (
-            "python-flint acb_mat.theta (prec 53)",
-            t / n_flint,
-            max_rel_error(vals[:n_truth], truth[:n_flint]),
-            n_flint,
-        )
-    )
-    t, vals = timed(lambda: numpy_brute(z, tau), max(1, repeats // 2))
-    rows.append(("numpy brute force", t / n, max_rel_error(vals[:n_truth], truth), n))
-    t, vals = timed(lambda: numpy_separable(z, tau), repeats)
-    rows.append(("numpy separable", t / n, max_rel_error(vals[:n_truth], truth), n))
+    flint_row = ("python-flint acb_mat.theta (prec 53)", t / n_flint, vals[:n_truth], n_flint)
+    one.insert(1, flint_row)
 
-    base = rows[0][1]
+    env = {k: v for k, v in os.environ.items() if k not in _BLAS_VARS}
+    cmd = [sys.executable, os.path.abspath(__file__), _CHILD_FLAG, "--tol", repr(args.tol)]
+    if args.quick:
+        cmd.append("--quick")
+    child = subprocess.run(cmd, env=env, capture_output=True, text=True, check=True)
+    all_cores = [
+        (name, per, from_json(vals), npts) for name, per, vals, npts in json.loads(child.stdout)
+    ]
+    all_cores.insert(1, ("python-flint (1 thread; time from above)",) + flint_row[1:])
+
     print(f"tau = {tau.tolist()}")
-    print(f"points: {n} (errors on the first {n_truth}; truth: python-flint at 200 bits)")
     print(
-        f"{'method':40s} {'points':>7s} {'us/point':>10s} {'x manakov':>10s} {'max rel err':>12s}"
+        f"points: {n} (errors on the first {n_truth}; truth: python-flint at 200 bits); "
+        f"manakov tol = {args.tol:g}; cores: {os.cpu_count()}"
     )
-    for name, per, err, npts in rows:
-        print(f"{name:40s} {npts:7d} {per * 1e6:10.3f} {per / base:10.1f} {err:12.2e}")
+    print_table("one core (manakov parallel=False; numpy BLAS threads = 1):", one, truth)
+    print_table("all cores (manakov parallel=True; numpy BLAS threads default):", all_cores, truth)
+    err = max(max_rel_error(one[0][2], truth), max_rel_error(all_cores[0][2], truth))
     print(
-        f"goals: >= 1000x flint: {rows[1][1] / base:.0f}x; "
-        f">= 10x separable numpy: {rows[3][1] / base:.1f}x; "
-        f"error <= 1e-13: {rows[0][2]:.2e}"
+        f"goals, one core:  >= 1000x flint: {one[1][1] / one[0][1]:.0f}x; "
+        f">= 10x separable numpy: {one[3][1] / one[0][1]:.1f}x"
     )
+    print(
+        f"goals, all cores: >= 1000x flint: {all_cores[1][1] / all_cores[0][1]:.0f}x; "
+        f">= 10x separable numpy: {all_cores[3][1] / all_cores[0][1]:.1f}x"
+    )
+    print(f"manakov max rel error: {err:.2e} (goal <= 1e-13)")
 
 
 if __name__ == "__main__":

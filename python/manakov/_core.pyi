@@ -124,6 +124,7 @@ def theta_jet(
     tol: float,
     order: int,
     scaled: bool,
+    parallel: bool,
 ) -> tuple[
     npt.NDArray[np.complex128],
     npt.NDArray[np.complex128],

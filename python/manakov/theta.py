@@ -189,9 +189,12 @@ def _jet(
     tol: float,
     order: int,
     scaled: bool,
+    parallel: bool,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """Core call; with ``scaled`` the arrays hold theta itself (scaled in Rust)."""
-    vals, grad, hess, log, finite = _core.theta_jet(z2, tau_a, _check_tol(tol), order, scaled)
+    vals, grad, hess, log, finite = _core.theta_jet(
+        z2, tau_a, _check_tol(tol), order, scaled, bool(parallel)
+    )
     if not finite:
         raise OverflowError(
             f"theta overflows float64 (log of the exponential factor up to "
@@ -219,6 +222,7 @@ def theta_all(
     *,
     tol: float = DEFAULT_TOL,
     log_scale: bool = False,
+    parallel: bool = True,
 ) -> Any:
     r"""All ``4^g`` theta functions with half-integer characteristics at once.
 
@@ -238,6 +242,10 @@ def theta_all(
     log_scale : bool, optional
         If True return ``(Omega, L)`` with ``theta = Omega * exp(L)``,
         ``L = pi Im(z)^T Im(tau)^{-1} Im(z)`` of shape ``(...)``.
+    parallel : bool, optional
+        Split batches of at least 4096 points over threads (rayon's pool, size
+        from ``RAYON_NUM_THREADS``, default all cores). ``False`` keeps the
+        computation on one core. The values do not depend on it.
 
     Returns
     -------
@@ -262,7 +270,7 @@ def theta_all(
     (16,)
     """
     z2, tau_a, lead, g = _prepare(z, tau)
-    vals, _, _, log = _jet(z2, tau_a, lead, g, tol, 0, not log_scale)
+    vals, _, _, log = _jet(z2, tau_a, lead, g, tol, 0, not log_scale, parallel)
     if log_scale:
         return vals, _out(log, lead)
     return vals
@@ -276,6 +284,7 @@ def theta(
     derivs: Sequence[int] = (),
     tol: float = DEFAULT_TOL,
     log_scale: bool = False,
+    parallel: bool = True,
 ) -> Any:
     r"""One theta function ``theta[a;b](z, tau)`` or one of its z-derivatives.
 
@@ -299,6 +308,10 @@ def theta(
         Absolute truncation error on normalised values (see :func:`theta_all`).
     log_scale : bool, optional
         If True return ``(Omega, L)`` with result ``= Omega * exp(L)``.
+    parallel : bool, optional
+        Split batches of at least 4096 points over threads (rayon's pool, size
+        from ``RAYON_NUM_THREADS``, default all cores). ``False`` keeps the
+        computation on one core. The values do not depend on it.
 
     Returns
     -------
@@ -309,7 +322,7 @@ def theta(
     d = tuple(operator.index(k) for k in derivs)
     if len(d) > 2 or any(not 0 <= k < g for k in d):
         raise ValueError(f"derivs must list at most 2 coordinates in 0..{g - 1}, got {derivs!r}")
-    vals, grad, hess, log = _jet(z2, tau_a, lead, g, tol, len(d), not log_scale)
+    vals, grad, hess, log = _jet(z2, tau_a, lead, g, tol, len(d), not log_scale, parallel)
     if len(d) == 0:
         out = vals[..., idx]
     elif len(d) == 1:
@@ -329,6 +342,7 @@ def theta_jet(
     all_chars: bool = False,
     tol: float = DEFAULT_TOL,
     log_scale: bool = False,
+    parallel: bool = True,
 ) -> Any:
     r"""Value, gradient and Hessian in z of theta functions, from one lattice sum.
 
@@ -337,8 +351,8 @@ def theta_jet(
 
     Parameters
     ----------
-    z, tau, char, tol
-        As in :func:`theta`.
+    z, tau, char, tol, parallel
+        As in :func:`theta` and :func:`theta_all`.
     all_chars : bool, optional
         If True ignore ``char`` and return all ``4^g`` characteristics (FLINT
         order) along an axis after the leading ones.
@@ -354,7 +368,7 @@ def theta_jet(
         Only if ``log_scale`` is True.
     """
     z2, tau_a, lead, g = _prepare(z, tau)
-    vals, grad, hess, log = _jet(z2, tau_a, lead, g, tol, 2, not log_scale)
+    vals, grad, hess, log = _jet(z2, tau_a, lead, g, tol, 2, not log_scale, parallel)
     if not all_chars:
         idx = _resolve_char(char, g)
         vals, grad, hess = vals[..., idx], grad[..., idx, :], hess[..., idx, :, :]

@@ -1,8 +1,10 @@
 //! Bindings for `crate::theta`.
 
 use num_complex::Complex64;
-use numpy::ndarray::{Array2, Array3, Array4};
-use numpy::{IntoPyArray, PyArray1, PyArray2, PyArray3, PyArray4, PyReadonlyArray2};
+use numpy::ndarray::{Array3, Array4};
+use numpy::{
+    IntoPyArray, PyArray1, PyArray2, PyArray3, PyArray4, PyArrayMethods, PyReadonlyArray2,
+};
 use pyo3::prelude::*;
 
 use crate::error::Error;
@@ -33,9 +35,10 @@ fn read_tau(tau: &PyReadonlyArray2<'_, Complex64>) -> Result<(Vec<Complex64>, us
 /// `n` points `z` (shape (n, g)): returns (values (n, 4^g), gradient
 /// (n, 4^g, g or 0), hessian (n, 4^g, g, g or 0), log_scale (n,), finite),
 /// normalised so that θ = exp(log_scale) · values; with `scaled` the arrays hold
-/// θ itself and `finite` is false if some value overflowed.
+/// θ itself and `finite` is false if some value overflowed. With `parallel`
+/// large batches are split over rayon's thread pool.
 #[pyfunction(name = "theta_jet")]
-#[pyo3(signature = (z, tau, tol, order, scaled))]
+#[pyo3(signature = (z, tau, tol, order, scaled, parallel))]
 fn theta_jet_py<'py>(
     py: Python<'py>,
     z: PyReadonlyArray2<'py, Complex64>,
@@ -43,6 +46,7 @@ fn theta_jet_py<'py>(
     tol: f64,
     order: usize,
     scaled: bool,
+    parallel: bool,
 ) -> PyResult<Jet<'py>> {
     let (tau_v, g) = read_tau(&tau)?;
     let zv = z.as_array();
@@ -65,34 +69,40 @@ fn theta_jet_py<'py>(
         1 => (g, 0),
         _ => (g, g),
     };
-    let (values, gradient, hessian, logs, finite) = py.detach(move || -> Result<_, Error> {
-        let plan = ThetaPlan::new(&tau_v, g, tol, order)?;
+    // The values and L are written straight into numpy-allocated arrays: numpy
+    // asks for huge pages for large arrays, which saves most of the page faults
+    // of first touching a fresh 256-bytes-per-point output (measured: a one-core
+    // 10^5-point call went from 0.160 to 0.147 µs/point).
+    let values_arr = PyArray2::<Complex64>::zeros(py, [npts, n], false);
+    let logs_arr = PyArray1::<f64>::zeros(py, npts, false);
+    // SAFETY: both arrays were created just above, are contiguous and not yet
+    // shared with Python or anything else, so these are the only references.
+    let (values, logs) = unsafe { (values_arr.as_slice_mut()?, logs_arr.as_slice_mut()?) };
+    let (gradient, hessian, finite) = py.detach(move || -> Result<_, Error> {
+        let plan = ThetaPlan::new(&tau_v, g, tol, order)?.with_parallel(parallel);
         let zero = Complex64::new(0.0, 0.0);
-        let mut values = vec![zero; npts * n];
         let mut gradient = vec![zero; npts * n * gd];
         let mut hessian = vec![zero; npts * n * g * hd];
-        let mut logs = vec![0.0; npts];
         let finite = if scaled && order == 0 {
-            plan.eval_batch_scaled(&z_flat, &mut values, &mut logs)?
+            plan.eval_batch_scaled(&z_flat, values, logs)?
         } else {
-            plan.eval_batch(&z_flat, &mut values, &mut gradient, &mut hessian, &mut logs)?;
-            !scaled || apply_scale(&mut values, &mut gradient, &mut hessian, &logs)
+            plan.eval_batch(&z_flat, values, &mut gradient, &mut hessian, logs)?;
+            !scaled || apply_scale(values, &mut gradient, &mut hessian, logs)
         };
-        Ok((values, gradient, hessian, logs, finite))
+        Ok((gradient, hessian, finite))
     })?;
     let shape_err = |e: numpy::ndarray::ShapeError| Error::Shape {
         what: "theta output",
         expected: "consistent sizes".into(),
         got: e.to_string(),
     };
-    let values = Array2::from_shape_vec((npts, n), values).map_err(shape_err)?;
     let gradient = Array3::from_shape_vec((npts, n, gd), gradient).map_err(shape_err)?;
     let hessian = Array4::from_shape_vec((npts, n, gd, hd), hessian).map_err(shape_err)?;
     Ok((
-        values.into_pyarray(py),
+        values_arr,
         gradient.into_pyarray(py),
         hessian.into_pyarray(py),
-        logs.into_pyarray(py),
+        logs_arr,
         finite,
     ))
 }

@@ -43,6 +43,7 @@ pub use chars::{char_from_index, char_index, paper_char_index, parity, MAX_GENUS
 
 use crate::error::{check_finite, Error, Result};
 use num_complex::Complex64;
+use rayon::prelude::*;
 
 /// Default truncation tolerance: the absolute error of every normalised value
 /// `Ω = θ·exp(-L)` (and of its z-derivatives at the reduced point) from the
@@ -69,6 +70,14 @@ const FAST_PATH_MAX_IMAG_DIAG: f64 = 50.0;
 /// Batches of at least this many points (values only, genus 2) use the
 /// vectorised kernel; its plan-time table costs about as much as 100 points.
 const BATCH_KERNEL_MIN_POINTS: usize = 64;
+
+/// Batches of at least this many points are split over rayon's thread pool
+/// (when the plan allows it): ~0.5 ms of work, well above the cost of waking
+/// the pool (measured, docs/theta.md "Benchmarks").
+const PARALLEL_MIN_POINTS: usize = 4096;
+
+/// Smallest piece of a batch handed to one thread.
+const PARALLEL_CHUNK: usize = 1024;
 
 /// A validated period matrix with everything the sums need that depends only
 /// on τ, the tolerance and the derivative order: build once, evaluate at many z.
@@ -101,6 +110,8 @@ pub struct ThetaPlan {
     /// Genus-2 batch kernel for values (see `batch.rs`), built on first use by
     /// a large enough batch (its table costs ~20 µs), `None` inside if not applicable.
     batch2: std::sync::OnceLock<Option<batch::Batch2>>,
+    /// Split large batches over rayon's thread pool.
+    parallel: bool,
 }
 
 /// Values and z-derivatives of all 4^g theta functions at one point, normalised:
@@ -126,8 +137,11 @@ struct Reduced {
     wr: [f64; MAX_GENUS],
     q: [f64; MAX_GENUS],
     log_scale: f64,
-    /// `exp(iφ)`, `φ = -π qᵀX'q - 2π qᵀ Re z_r`.
+    /// `exp(iφ)`, `φ = -π qᵀX'q - 2π qᵀ Re z_r` (left at 1 by the batch kernel's
+    /// reduction, which evaluates it for 16 points at once from `phase`).
     prefactor: Complex64,
+    /// `φ/π` (genus 2 only).
+    phase: f64,
     /// Parities of `p` and `q` as bit masks (coordinate k at bit g-1-k).
     pbits: usize,
     qbits: usize,
@@ -303,6 +317,7 @@ impl ThetaPlan {
             qinv,
             fast_g2,
             batch2: std::sync::OnceLock::new(),
+            parallel: true,
         };
         let expected = plan.info().expected_terms;
         if expected > MAX_TERMS {
@@ -316,6 +331,14 @@ impl ThetaPlan {
             });
         }
         Ok(plan)
+    }
+
+    /// Whether batches of at least 4096 points are split over rayon's thread pool
+    /// (default `true`; the pool size follows `RAYON_NUM_THREADS`). Results do not
+    /// depend on it: every point is computed by the same code either way.
+    pub fn with_parallel(mut self, parallel: bool) -> Self {
+        self.parallel = parallel;
+        self
     }
 
     /// Genus.
@@ -456,7 +479,7 @@ impl ThetaPlan {
     /// The reduction `z = z_r + p + τ'q` and the factors it contributes.
     fn reduce(&self, z: &[Complex64]) -> Result<Reduced> {
         if self.g == 2 && z.len() == 2 {
-            return self.reduce2([z[0], z[1]]);
+            return self.reduce2::<true>([z[0], z[1]]);
         }
         let g = self.g;
         for (k, c) in z.iter().enumerate() {
@@ -545,13 +568,15 @@ impl ThetaPlan {
             q,
             log_scale,
             prefactor,
+            phase: 0.0,
             pbits,
             qbits,
         })
     }
 
-    /// [`ThetaPlan::reduce`] written out for genus 2 (same operations, fixed size).
-    fn reduce2(&self, z: [Complex64; 2]) -> Result<Reduced> {
+    /// [`ThetaPlan::reduce`] written out for genus 2 (same operations, fixed size);
+    /// `PREFACTOR = false` leaves `prefactor = 1` and only records `phase`.
+    fn reduce2<const PREFACTOR: bool>(&self, z: [Complex64; 2]) -> Result<Reduced> {
         for (k, c) in z.iter().enumerate() {
             if !(c.re.is_finite() && c.im.is_finite()) {
                 return Err(Error::NonFinite {
@@ -604,15 +629,13 @@ impl ThetaPlan {
         red.q[1] = q[1];
         let log_scale = pi() * z[0].im * (q[0] + red.wr[0]) + pi() * z[1].im * (q[1] + red.wr[1]);
         red.log_scale = log_scale.max(0.0);
-        red.prefactor = if shifted {
-            let mut phi = -pi() * quad_mod2(x, &q, 2);
-            for i in 0..2 {
-                phi -= 2.0 * pi() * q[i] * red.zr[i].re;
+        red.prefactor = Complex64::new(1.0, 0.0);
+        if shifted {
+            red.phase = -quad_mod2(x, &q, 2) - 2.0 * (q[0] * red.zr[0].re + q[1] * red.zr[1].re);
+            if PREFACTOR {
+                red.prefactor = Complex64::from_polar(1.0, pi() * red.phase);
             }
-            Complex64::from_polar(1.0, phi)
-        } else {
-            Complex64::new(1.0, 0.0)
-        };
+        }
         red.pbits = ((p[0] as i64 & 1) << 1 | (p[1] as i64 & 1)) as usize;
         red.qbits = ((q[0] as i64 & 1) << 1 | (q[1] as i64 & 1)) as usize;
         Ok(red)
@@ -727,7 +750,62 @@ impl ThetaPlan {
     /// Evaluates a batch: `z` holds `npts` points of `g` entries (row-major);
     /// the outputs hold `npts` blocks of 4^g, 4^g·g and 4^g·g² entries
     /// (gradient/Hessian may be empty to skip them); `log_scale` has `npts` entries.
+    /// With [`ThetaPlan::with_parallel`] (the default) large batches are split
+    /// over rayon's thread pool.
     pub fn eval_batch(
+        &self,
+        z: &[Complex64],
+        values: &mut [Complex64],
+        gradient: &mut [Complex64],
+        hessian: &mut [Complex64],
+        log_scale: &mut [f64],
+    ) -> Result<()> {
+        let g = self.g;
+        let n = 1usize << (2 * g);
+        let npts = log_scale.len();
+        let (gs, hs) = (n * g, n * g * g);
+        let shapes_ok = z.len() == npts * g
+            && values.len() == npts * n
+            && (gradient.is_empty() || gradient.len() == npts * gs)
+            && (hessian.is_empty() || hessian.len() == npts * hs);
+        let Some(chunk) = self.parallel_chunk(npts).filter(|_| shapes_ok) else {
+            return self.eval_batch_serial(z, values, gradient, hessian, log_scale);
+        };
+        let gs = if gradient.is_empty() { 0 } else { gs };
+        let hs = if hessian.is_empty() { 0 } else { hs };
+        let mut gchunks: Vec<&mut [Complex64]> = if gs == 0 {
+            (0..npts.div_ceil(chunk)).map(|_| &mut [][..]).collect()
+        } else {
+            gradient.chunks_mut(chunk * gs).collect()
+        };
+        let mut hchunks: Vec<&mut [Complex64]> = if hs == 0 {
+            (0..npts.div_ceil(chunk)).map(|_| &mut [][..]).collect()
+        } else {
+            hessian.chunks_mut(chunk * hs).collect()
+        };
+        z.par_chunks(chunk * g)
+            .zip(values.par_chunks_mut(chunk * n))
+            .zip(gchunks.par_iter_mut())
+            .zip(hchunks.par_iter_mut())
+            .zip(log_scale.par_chunks_mut(chunk))
+            .try_for_each(|((((zc, vc), gc), hc), lc)| self.eval_batch_serial(zc, vc, gc, hc, lc))
+    }
+
+    /// Chunk size for splitting a batch of `npts` points over the thread pool,
+    /// `None` to stay on the calling thread.
+    fn parallel_chunk(&self, npts: usize) -> Option<usize> {
+        let threads = rayon::current_num_threads();
+        if !self.parallel || threads < 2 || npts < PARALLEL_MIN_POINTS {
+            return None;
+        }
+        // Many chunks per thread (≥ PARALLEL_CHUNK points, ~0.2 ms each): on a
+        // shared machine a thread may lose its core for a while, and work stealing
+        // can only rebalance if there is work left to steal. Whole kernel chunks.
+        let per = npts.div_ceil(16 * threads).max(PARALLEL_CHUNK);
+        Some(per.div_ceil(batch::LANES) * batch::LANES)
+    }
+
+    fn eval_batch_serial(
         &self,
         z: &[Complex64],
         values: &mut [Complex64],
@@ -792,36 +870,42 @@ impl ThetaPlan {
     ) -> Result<bool> {
         const L: usize = batch::LANES;
         let mut finite = true;
-        let zero = Complex64::new(0.0, 0.0);
         let npts = log_scale.len();
         let mut sc = b2.scratch();
+        let mut inp = batch::ChunkIn::default();
         let mut i0 = 0;
         while i0 < npts {
             let m = (npts - i0).min(L);
-            let mut zr = [[zero; 2]; L];
-            let mut wr = [[0.0; 2]; L];
-            let mut reds = [Reduced::default(); L];
-            for p in 0..m {
-                let red = self.reduce(&z[2 * (i0 + p)..2 * (i0 + p) + 2])?;
-                zr[p] = [red.zr[0], red.zr[1]];
-                wr[p] = [red.wr[0], red.wr[1]];
-                reds[p] = red;
+            if m < L {
+                inp = batch::ChunkIn::default();
             }
-            b2.class_sums(self, &zr, &wr, &mut sc);
             for p in 0..m {
                 let k = i0 + p;
-                let class_sum = |r: usize| Complex64::new(sc.sre[r][p], sc.sim[r][p]);
-                let mut red = reds[p];
-                if scaled {
-                    red.prefactor *= red.log_scale.exp();
+                let red = self.reduce2::<false>([z[2 * k], z[2 * k + 1]])?;
+                for i in 0..2 {
+                    inp.zre[i][p] = red.zr[i].re;
+                    inp.zim[i][p] = red.zr[i].im;
+                    inp.wr[i][p] = red.wr[i];
                 }
-                let out = &mut values[16 * k..16 * k + 16];
-                self.combine_g2_values(&red, class_sum, out);
-                // |Ω| ≤ number of terms ≤ MAX_TERMS = 2e8, so exp(L)|Ω| < f64::MAX for L ≤ 690
-                if scaled && red.log_scale > 690.0 {
-                    finite &= out.iter().all(|v| v.re.is_finite() && v.im.is_finite());
+                inp.phase[p] = red.phase;
+                inp.logs[p] = red.log_scale;
+                for h in 0..4 {
+                    inp.sa[h][p] = 1.0 - 2.0 * f64::from((h & red.pbits).count_ones() & 1);
+                    inp.sb[h][p] = 1.0 - 2.0 * f64::from((h & red.qbits).count_ones() & 1);
                 }
                 log_scale[k] = red.log_scale;
+            }
+            b2.eval_chunk(self, &inp, scaled, &mut sc);
+            for p in 0..m {
+                let k = i0 + p;
+                let out = &mut values[16 * k..16 * k + 16];
+                for (idx, v) in out.iter_mut().enumerate() {
+                    *v = Complex64::new(sc.out_re[idx][p], sc.out_im[idx][p]);
+                }
+                // |Ω| ≤ number of terms ≤ MAX_TERMS = 2e8, so exp(L)|Ω| < f64::MAX for L ≤ 690
+                if scaled && inp.logs[p] > 690.0 {
+                    finite &= out.iter().all(|v| v.re.is_finite() && v.im.is_finite());
+                }
             }
             i0 += m;
         }
@@ -839,13 +923,32 @@ impl ThetaPlan {
         values: &mut [Complex64],
         log_scale: &mut [f64],
     ) -> Result<bool> {
+        let (g, npts) = (self.g, log_scale.len());
+        let n = 1usize << (2 * g);
+        let shapes_ok = z.len() == npts * g && values.len() == npts * n;
+        let Some(chunk) = self.parallel_chunk(npts).filter(|_| shapes_ok) else {
+            return self.eval_batch_scaled_serial(z, values, log_scale);
+        };
+        z.par_chunks(chunk * g)
+            .zip(values.par_chunks_mut(chunk * n))
+            .zip(log_scale.par_chunks_mut(chunk))
+            .map(|((zc, vc), lc)| self.eval_batch_scaled_serial(zc, vc, lc))
+            .try_reduce(|| true, |a, b| Ok(a && b))
+    }
+
+    fn eval_batch_scaled_serial(
+        &self,
+        z: &[Complex64],
+        values: &mut [Complex64],
+        log_scale: &mut [f64],
+    ) -> Result<bool> {
         let npts = log_scale.len();
         if z.len() == 2 * npts && values.len() == 16 * npts && npts >= BATCH_KERNEL_MIN_POINTS {
             if let Some(b2) = self.batch2.get_or_init(|| batch::Batch2::build(self)) {
                 return self.eval_batch_g2(b2, z, values, log_scale, true);
             }
         }
-        self.eval_batch(z, values, &mut [], &mut [], log_scale)?;
+        self.eval_batch_serial(z, values, &mut [], &mut [], log_scale)?;
         Ok(apply_scale(values, &mut [], &mut [], log_scale))
     }
 }
