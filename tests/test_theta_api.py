@@ -408,3 +408,9 @@ def test_fuzzed_bad_inputs_never_warn_or_return_nan():
                 continue
             vals = out[0] if log_scale else out
             assert np.all(np.isfinite(vals)), (z, tau)
+
+
+@pytest.mark.parametrize("derivs", [1, (0.5,), ("0",), None])
+def test_derivs_of_the_wrong_type_name_the_argument(derivs):
+    with pytest.raises(TypeError, match="derivs must be a sequence of integers"):
+        theta(Z0, BENCH_TAU, derivs=derivs)

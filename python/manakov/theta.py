@@ -432,7 +432,10 @@ def theta(
     """
     z2, tau_a, lead, g = _prepare(z, tau)
     idx = _resolve_char(char, g)
-    d = tuple(operator.index(k) for k in derivs)
+    try:
+        d = tuple(operator.index(k) for k in derivs)
+    except TypeError as exc:
+        raise TypeError(f"derivs must be a sequence of integers, got {derivs!r}") from exc
     if len(d) > 2 or any(not 0 <= k < g for k in d):
         raise ValueError(f"derivs must list at most 2 coordinates in 0..{g - 1}, got {derivs!r}")
     vals, grad, hess, log = _jet(z2, tau_a, lead, g, tol, len(d), not log_scale, parallel)
