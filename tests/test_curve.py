@@ -70,6 +70,16 @@ ROUNDTRIP_SEEDED_RTOL = 1e-12
 #: Round trips of single, well-separated example pairs (|z1 - z2| >= 1, O(1)
 #: values): the inverse reproduces them to ~1e-15; 1e-12 is the claim.
 EXAMPLE_RTOL = 1e-12
+# Points 1e-3 apart recovered from their Wurzelfunktionen: (28) divides by z1 - z2
+# (rounding ~u/delta in the data) and the inverse amplifies by ~1/delta, ~1e-10; 1e-8
+# leaves a factor 100 for the constants.
+CLOSE_PAIR_TOL = 1e-8
+# Machine epsilon (2^-52 = 2.22e-16, written rounded down) in the first-order forward
+# error bound eps |F| sqrt(6) / sigma_min(J) of the inverse map.
+EPS_DOUBLE = 2.2e-16
+# The forward error may exceed that first-order bound by the constant of the backward
+# error (a few units of rounding): a factor 10.
+FORWARD_BOUND_FACTOR = 10
 
 
 # ----------------------------------------------------------------------------
@@ -546,11 +556,11 @@ def test_inverse_conditioning():
         for i in range(6):
             J[i, col] = (F[i] - F0[i]) / h
     sigma_min = min(mpmath.svd_c(J, compute_uv=False))
-    bound_z = float(2.2e-16 * max(abs(f) for f in F0) * np.sqrt(6) / sigma_min)
+    bound_z = float(EPS_DOUBLE * max(abs(f) for f in F0) * np.sqrt(6) / sigma_min)
     err_z = max(abs(back.z1 - z1), abs(back.z2 - z2))
     if abs(back.z1 - z1) > abs(back.z1 - z2):
         err_z = max(abs(back.z2 - z1), abs(back.z1 - z2))
-    assert err_z <= 10 * bound_z
+    assert err_z <= FORWARD_BOUND_FACTOR * bound_z
     assert back.residual <= BACKWARD_RTOL * max(np.abs(xi).max(), np.abs(eta).max())
 
 
@@ -688,7 +698,7 @@ def test_inverse_double_root():
     back = k.points_from_wurzel(xi2, eta2)
     # The data carry the rounding of (28)'s division by z1 - z2 (~u/delta) and
     # the inverse amplifies by ~1/delta: error ~u/delta**2 ~ 1e-10.
-    assert min(abs(back.z1 - z), abs(back.z2 - z)) < 1e-8
+    assert min(abs(back.z1 - z), abs(back.z2 - z)) < CLOSE_PAIR_TOL
 
 
 def test_shapes_broadcasting_and_scalars():

@@ -93,9 +93,10 @@ def test_gauss_tables_generator_is_reproducible(tmp_path):
     """The committed Rust table is what the committed generator writes."""
     import runpy
 
+    # The tests run from a checkout (.ci/test runs pytest at its root), so the Rust source
+    # is always beside them; a missing file is a failure, not a skip.
     src = Path(__file__).resolve().parents[1] / "rust" / "integrate" / "gauss_tables.rs"
-    if not src.exists():
-        pytest.skip("source tree not available")
+    assert src.is_file(), f"{src} missing: tests must run from a source checkout"
     gen = runpy.run_path(str(DATA / "gen_gauss_tables.py"))
     out = tmp_path / "gauss_tables.rs"
     gen["main"](out)
@@ -270,6 +271,42 @@ def test_bad_integration_arguments_raise_value_error(kwargs):
     t_end = kwargs.pop("t_end")
     with pytest.raises(ValueError):
         top.integrate(p.l0, t_end, **kwargs)
+
+
+# scipy's floor on rtol: an error target below ~100 ulps of the state is below the rounding
+# of one step.
+RTOL_FLOOR = 100 * np.finfo(float).eps
+
+
+@pytest.mark.parametrize("method", ["dopri5", "dop853"])
+@pytest.mark.parametrize(
+    ("rtol", "atol"),
+    [(1e-300, 1e-300), (0.0, 1e-12), (1e-16, 1e-16), (RTOL_FLOOR * (1 - 2**-20), 1e-12)],
+)
+def test_rtol_below_the_floor_is_a_value_error(method, rtol, atol):
+    """rtol = atol = 1e-300 once overflowed the error norm and was reported as a
+    ConvergenceError "state became non-finite"; every rtol below 100 eps is refused up
+    front, for both entry points."""
+    p = manakov.problem("generic")
+    top = manakov.ManakovTop(p.a, p.b)
+    with pytest.raises(ValueError, match="rtol"):
+        top.integrate(p.l0, 1.0, method=method, rtol=rtol, atol=atol)
+    with pytest.raises(ValueError, match="rtol"):
+        top.integrate_many(np.array([p.l0]), 1.0, method=method, rtol=rtol, atol=atol)
+
+
+@pytest.mark.parametrize("method", ["dopri5", "dop853"])
+@pytest.mark.parametrize("atol", [0.0, 1e-300])
+def test_rtol_at_the_floor_with_tiny_atol_integrates(method, atol):
+    """At the floor (and with atol from 0 to tiny, on a state with zero components) the
+    explicit methods run and stay on the energy surface (H conserved to 1e-12 relative,
+    the drift bound of the explicit methods at this tolerance over t = 1)."""
+    p = manakov.problem("generic")
+    top = manakov.ManakovTop(p.a, p.b)
+    l0 = np.array([0.0, 1.0, 0.0, 0.5, 0.0, -0.3])
+    tr = top.integrate(l0, 1.0, method=method, rtol=RTOL_FLOOR, atol=atol, t_eval=[0.0, 1.0])
+    h = top.hamiltonian(tr.l)
+    assert np.all(np.isfinite(tr.l)) and abs(h[1] - h[0]) <= 1e-12 * abs(h[0])
 
 
 @pytest.mark.parametrize("l0", [[np.nan, 0, 0, 0, 0, 0], [1.0, 2.0], [[1.0] * 6] * 2])

@@ -11,6 +11,8 @@ import manakov
 from manakov import reduction
 
 P = manakov.problem("generic")
+# The round trip l -> Kotter -> l, relative to |l|: the claim of issue 4.
+ROUND_TRIP_TOL = 1e-12
 L0 = np.asarray(P.l0, dtype=float)
 
 
@@ -103,8 +105,8 @@ def test_kotter_inside_the_range_round_trips(scale):
     top = manakov.ManakovTop(P.a, P.b)
     l = L0 * scale
     back = top.from_kotter(top.kotter(l))
-    # The round-trip claim of issue 4 (1e-12, relative to |l|), at any scale in range.
-    np.testing.assert_allclose(back, l, rtol=0, atol=1e-12 * np.max(np.abs(l)))
+    # The round-trip claim of issue 4, at any scale in range.
+    np.testing.assert_allclose(back, l, rtol=0, atol=ROUND_TRIP_TOL * np.max(np.abs(l)))
 
 
 def test_from_kotter_rejects_g_zero_and_non_kotter():
@@ -117,3 +119,34 @@ def test_from_kotter_rejects_g_zero_and_non_kotter():
         top.from_kotter(dataclasses.replace(k, g=0.0))
     with pytest.raises(TypeError, match="Kotter"):
         top.from_kotter(5)
+
+
+def test_kotter_fields_are_read_only_like_the_curve_outputs():
+    """Every array field of a Kotter is read-only (as the curve's outputs are), for one
+    state and a batch; dataclasses.replace with a caller's writable array stores a
+    read-only copy and leaves the caller's array alone; from_kotter still inverts."""
+    import dataclasses
+
+    top = manakov.ManakovTop(P.a, P.b)
+    for l in (L0, np.array([L0, 1.1 * L0])):
+        k = top.kotter(l)
+        arrays = {f.name: getattr(k, f.name) for f in dataclasses.fields(k)}
+        arrays = {n: v for n, v in arrays.items() if isinstance(v, np.ndarray)}
+        assert {"xi", "eta", "d", "s", "branch", "zd"} <= set(arrays)
+        for name, v in arrays.items():
+            assert not v.flags.writeable, name
+            with pytest.raises(ValueError, match="read-only"):
+                v[...] = v
+        np.testing.assert_allclose(
+            top.from_kotter(k), l, rtol=0, atol=ROUND_TRIP_TOL * np.max(np.abs(l))
+        )
+    k = top.kotter(L0)
+    zd = k.zd.copy()
+    k2 = dataclasses.replace(k, zd=zd)
+    assert not k2.zd.flags.writeable and zd.flags.writeable
+    zd[0, 0] += 1.0  # the caller's array stays the caller's: k2 holds a copy
+    np.testing.assert_array_equal(k2.zd, k.zd)
+    k3 = dataclasses.replace(k, zd=k.zd.copy())
+    np.testing.assert_allclose(
+        top.from_kotter(k3), L0, rtol=0, atol=ROUND_TRIP_TOL * np.max(np.abs(L0))
+    )

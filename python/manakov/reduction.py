@@ -22,6 +22,7 @@ The state is ordered ``l = (l12, l13, l14, l23, l24, l34)``.
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass
 from typing import Any
 
@@ -247,6 +248,10 @@ class Kotter:
     with leading shape ``S`` every field gains the leading axes ``S`` (scalars
     become arrays of shape ``S``).
 
+    Array fields are read-only, like the curve's outputs; ``dataclasses.replace``
+    works (a writable array passed in is copied and frozen, the caller's array is
+    left alone).
+
     Attributes
     ----------
     h : ndarray (4,)
@@ -337,6 +342,18 @@ class Kotter:
     curve: Any
     zd: Any = None
 
+    def __post_init__(self) -> None:
+        # Read-only like the curve's outputs: a Kotter describes one level set and
+        # its points, and editing one field in place would silently desynchronise it
+        # from the others. Arrays passed in writable (dataclasses.replace) are
+        # copied first, so the caller's array is neither frozen nor aliased.
+        for f in dataclasses.fields(self):
+            v = getattr(self, f.name)
+            if isinstance(v, np.ndarray) and v.flags.writeable:
+                v = np.array(v, copy=True)
+                v.setflags(write=False)
+                object.__setattr__(self, f.name, v)
+
 
 _FIELD_SHAPES = {
     "h": (4,),
@@ -422,6 +439,8 @@ def kotter(a: Any, b: Any, l: Any) -> Kotter:
         arr = np.asarray(raw[name]).reshape(shape + fshape)
         if arr.ndim == 0:
             arr = arr[()]
+        else:
+            arr.setflags(write=False)  # fresh from the core: frozen without a copy
         fields[name] = arr
     d_all = np.asarray(raw["d"])
     curves = [_make_curve(dd) for dd in d_all]
@@ -430,7 +449,9 @@ def kotter(a: Any, b: Any, l: Any) -> Kotter:
     else:
         carr = np.empty(len(curves), dtype=object)
         carr[:] = curves
-        fields["curve"] = carr.reshape(shape)
+        carr = carr.reshape(shape)
+        carr.setflags(write=False)
+        fields["curve"] = carr
     return Kotter(**fields)
 
 

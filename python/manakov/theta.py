@@ -66,10 +66,35 @@ CharLike = Union[None, int, str, Sequence[Sequence[int]]]
 
 
 def characteristics(g: int = 2) -> list[Characteristic]:
-    """The ``4^g`` characteristics ``(a, b)`` in FLINT's order.
+    r"""The ``4^g`` half-integer characteristics ``(a, b)`` in FLINT's order.
+
+    The characteristic ``[a; b]`` labels the series (the paper's (36) with
+    characteristics, (35))
+
+    .. math:: \theta[a;b](z,\tau)=\sum_{n\in\mathbb Z^g}
+              e^{i\pi (n+a/2)^T\tau(n+a/2)+2\pi i(n+a/2)^T(z+b/2)},
+              \qquad a, b \in \{0, 1\}^g.
 
     Entry ``i`` has ``a = bits 2g-1 .. g`` and ``b = bits g-1 .. 0`` of ``i``
     (most significant first), matching python-flint's ``acb_mat.theta``.
+
+    Parameters
+    ----------
+    g : int, optional
+        The genus, 1 to 6 (default 2).
+
+    Returns
+    -------
+    list of (tuple of int, tuple of int)
+        ``4^g`` pairs ``(a, b)`` of 0/1 tuples of length g; entry ``i`` is the
+        characteristic of output ``i`` of :func:`theta_all`.
+
+    Raises
+    ------
+    TypeError
+        ``g`` is not an integer.
+    ValueError
+        ``g`` is outside 1..6.
     """
     g = operator.index(g)
     if not 1 <= g <= 6:
@@ -107,7 +132,31 @@ PAPER_CHARACTERISTICS: dict[str, Characteristic] = {
 
 
 def char_index(a: Sequence[int], b: Sequence[int]) -> int:
-    """FLINT index of ``[a; b]``: the bits ``a_1..a_g b_1..b_g``, most significant first."""
+    """FLINT index of the characteristic ``[a; b]`` of (35)-(36).
+
+    ``index = sum_k 2^(2g-1-k) c_k`` with ``c = (a_1, ..., a_g, b_1, ..., b_g)``:
+    the bits ``a_1..a_g b_1..b_g``, most significant first (for g = 2,
+    ``8 a1 + 4 a2 + 2 b1 + b2``). Inverse of :func:`characteristics`.
+
+    Parameters
+    ----------
+    a, b : sequence of int
+        The two halves of the characteristic, entries 0 or 1, of the same
+        length g in 1..6.
+
+    Returns
+    -------
+    int
+        The index in ``0 .. 4^g - 1``.
+
+    Raises
+    ------
+    ValueError
+        Lengths differ or are outside 1..6, or an entry is not 0 or 1 (booleans
+        are refused).
+    TypeError
+        ``a`` or ``b`` is not a sequence.
+    """
     a_t, b_t = tuple(a), tuple(b)
     if len(a_t) != len(b_t) or not 1 <= len(a_t) <= 6:
         raise ValueError(f"a and b must have the same length g in 1..6, got {a_t!r}, {b_t!r}")
@@ -122,7 +171,30 @@ def char_index(a: Sequence[int], b: Sequence[int]) -> int:
 def parity(char: CharLike, g: int = 2) -> int:
     """``+1`` for an even, ``-1`` for an odd characteristic: ``(-1)^{a.b}``.
 
-    ``theta[a;b](-z) = (-1)^{a.b} theta[a;b](z)``; in genus 2, 10 are even, 6 odd.
+    From the series (36) with characteristics, substituting ``n -> -n - a``:
+    ``theta[a;b](-z) = (-1)^{a.b} theta[a;b](z)``; in genus 2, 10 are even and
+    6 odd (the odd ones vanish at ``z = 0``).
+
+    Parameters
+    ----------
+    char : None, int, str or (a, b)
+        As in :func:`theta`: None for ``[0; 0]``, a FLINT index, a label of the
+        paper's table (35) (genus 2) or a pair ``(a, b)``.
+    g : int, optional
+        The genus (default 2).
+
+    Returns
+    -------
+    int
+        ``+1`` or ``-1``.
+
+    Raises
+    ------
+    ValueError
+        Unknown characteristic (index out of range, unknown label, bad pair) or
+        ``g`` outside 1..6.
+    TypeError
+        ``g`` is not an integer.
     """
     idx = _resolve_char(char, g)
     a, b = characteristics(g)[idx]
@@ -160,13 +232,15 @@ def _resolve_char(char: CharLike, g: int) -> int:
 def _prepare(
     z: npt.ArrayLike, tau: npt.ArrayLike
 ) -> tuple[npt.NDArray[np.complex128], npt.NDArray[np.complex128], tuple[int, ...], int]:
-    tau_a = np.array(tau, dtype=np.complex128)
+    tau_a = _as_complex("tau", tau)
     if tau_a.ndim == 0:
         tau_a = tau_a.reshape(1, 1)
     if tau_a.ndim != 2 or tau_a.shape[0] != tau_a.shape[1]:
         raise ValueError(f"tau must have shape (g, g), got {tau_a.shape}")
     g = tau_a.shape[0]
-    z_a = np.asarray(z, dtype=np.complex128)
+    if g == 0:
+        raise ValueError("tau has shape (0, 0): the genus must be in 1..6")
+    z_a = _as_complex("z", z)
     if z_a.ndim == 0 or z_a.shape[-1] != g:
         raise ValueError(f"z must have shape (..., {g}) for tau of genus {g}, got {z_a.shape}")
     lead = z_a.shape[:-1]
@@ -174,11 +248,22 @@ def _prepare(
     return z2, np.ascontiguousarray(tau_a), lead, g
 
 
+def _as_complex(what: str, x: npt.ArrayLike) -> npt.NDArray[np.complex128]:
+    """``x`` as a complex128 array (a copy or a read-only view: never modified)."""
+    try:
+        return np.asarray(x, dtype=np.complex128)
+    except (TypeError, ValueError) as exc:
+        raise ValueError(f"{what} must be numeric (convertible to complex128): {exc}") from exc
+
+
 def _check_tol(tol: float) -> float:
-    tol = float(tol)
-    if not 0.0 < tol < 1.0:
-        raise ValueError(f"tol must be in (0, 1), got {tol}")
-    return tol
+    arr = np.asarray(tol)
+    if arr.ndim != 0 or arr.dtype.kind not in "fiu":
+        raise ValueError(f"tol must be a real number in (0, 1), got {tol!r}")
+    value = float(arr)
+    if not 0.0 < value < 1.0:
+        raise ValueError(f"tol must be in (0, 1), got {value}")
+    return value
 
 
 def _jet(
@@ -229,7 +314,7 @@ def theta_all(
     .. math:: \theta[a;b](z,\tau)=\sum_{n\in\mathbb Z^g}
               e^{i\pi (n+a/2)^T\tau(n+a/2)+2\pi i(n+a/2)^T(z+b/2)}
 
-    (the paper's (36) with characteristics, (35)).
+    (the paper's (36) with characteristics, (35); ``[0; 0]`` is (36) itself).
 
     Parameters
     ----------
@@ -256,10 +341,21 @@ def theta_all(
     Raises
     ------
     ValueError
-        Wrong shapes, non-finite entries, non-symmetric tau, ``Im tau`` not
-        positive definite (the message gives the smallest eigenvalue), bad tol.
+        Non-numeric input; wrong shapes (genus 0 or above 6 included);
+        non-finite entries; non-symmetric tau; ``Im tau`` not positive definite
+        (the message gives the smallest eigenvalue) or not factorisable in
+        double precision; ``Im tau`` so ill-conditioned that more than 2e8
+        terms would be needed; ``|Re z|`` or ``|(Im tau)^-1 Im z|`` beyond
+        4.5e15 (no fractional digit left: theta is not determined) or ``L``
+        overflowing; ``tol`` not a real number in (0, 1).
     OverflowError
         A value exceeds the double range and ``log_scale`` is False.
+
+    Notes
+    -----
+    Zero-size batches work like numpy: ``z`` of shape ``(0, g)`` gives a result
+    of shape ``(0, 4^g)``. Inputs of any numeric dtype, order and strides are
+    converted to complex128 and never modified.
 
     Examples
     --------
@@ -291,6 +387,10 @@ def theta(
     .. math:: \theta[a;b](z,\tau)=\sum_{n\in\mathbb Z^g}
               e^{i\pi (n+a/2)^T\tau(n+a/2)+2\pi i(n+a/2)^T(z+b/2)}
 
+    (the paper's (36) with characteristics, (35); ``char=None`` is (36) itself).
+    Derivatives are the series differentiated term by term:
+    ``d/dz_k -> 2 pi i (n + a/2)_k``.
+
     Parameters
     ----------
     z : array_like, shape (..., g)
@@ -316,10 +416,26 @@ def theta(
     Returns
     -------
     complex or ndarray of shape (...)
+        The value (or derivative) at each point; a Python complex for a single
+        point. With ``log_scale`` a pair ``(Omega, L)``, result ``= Omega * exp(L)``,
+        ``L = pi Im(z)^T Im(tau)^{-1} Im(z)`` (float or ndarray of shape (...)).
+
+    Raises
+    ------
+    ValueError
+        Bad ``z``, ``tau`` or ``tol`` (see :func:`theta_all`), unknown ``char``,
+        ``derivs`` with more than 2 entries or an entry outside 0..g-1.
+    TypeError
+        ``derivs`` is not a sequence of integers.
+    OverflowError
+        A value exceeds the double range and ``log_scale`` is False.
     """
     z2, tau_a, lead, g = _prepare(z, tau)
     idx = _resolve_char(char, g)
-    d = tuple(operator.index(k) for k in derivs)
+    try:
+        d = tuple(operator.index(k) for k in derivs)
+    except TypeError as exc:
+        raise TypeError(f"derivs must be a sequence of integers, got {derivs!r}") from exc
     if len(d) > 2 or any(not 0 <= k < g for k in d):
         raise ValueError(f"derivs must list at most 2 coordinates in 0..{g - 1}, got {derivs!r}")
     vals, grad, hess, log = _jet(z2, tau_a, lead, g, tol, len(d), not log_scale, parallel)
@@ -346,8 +462,13 @@ def theta_jet(
 ) -> Any:
     r"""Value, gradient and Hessian in z of theta functions, from one lattice sum.
 
+    With the terms of the paper's (36) with characteristics (35),
+
+    .. math:: E(m) = e^{i\pi m^T\tau m + 2\pi i m^T(z+b/2)}, \quad m = n + a/2,
+              \quad \theta[a;b](z,\tau) = \sum_{n\in\mathbb Z^g} E(m),
+
     ``gradient[..., k] = d theta / d z_k = sum 2 pi i m_k E(m)`` and
-    ``hessian[..., k, l] = sum (2 pi i)^2 m_k m_l E(m)`` with ``m = n + a/2``.
+    ``hessian[..., k, l] = sum (2 pi i)^2 m_k m_l E(m)``.
 
     Parameters
     ----------
@@ -366,6 +487,14 @@ def theta_jet(
     hessian : ndarray, shape (..., g, g) or (..., 4^g, g, g)
     log_scale : float or ndarray, shape (...)
         Only if ``log_scale`` is True.
+
+    Raises
+    ------
+    ValueError
+        Bad ``z``, ``tau``, ``tol`` (see :func:`theta_all`) or unknown ``char``
+        (checked only when ``all_chars`` is False).
+    OverflowError
+        A value exceeds the double range and ``log_scale`` is False.
     """
     z2, tau_a, lead, g = _prepare(z, tau)
     vals, grad, hess, log = _jet(z2, tau_a, lead, g, tol, 2, not log_scale, parallel)

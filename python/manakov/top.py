@@ -518,7 +518,11 @@ class FrahmTop:
             Default (neither given): 1001 evenly spaced samples.
         method : {"gauss16", "gauss6", "gauss4", "dopri5", "dop853"}
         rtol, atol : float
-            Tolerances of ``dopri5`` and ``dop853`` (ignored by Gauss methods).
+            Tolerances of ``dopri5`` and ``dop853`` (ignored by Gauss methods):
+            each step keeps its error estimate below ``atol + rtol |l|``
+            componentwise. ``rtol`` must be at least ``100 eps`` (about 2.2e-14,
+            scipy's floor; a smaller relative target is below the rounding of a
+            step) and ``atol`` >= 0; otherwise ValueError.
         progress : callable, optional
             Called with the fraction done after each chunk.
         chunks : int
@@ -536,7 +540,8 @@ class FrahmTop:
         ------
         ValueError
             Bad shapes, non-finite values, ``t_end`` < 0 or NaN, ``dt`` <= 0,
-            an unknown ``method``, or more than ``max_steps`` steps needed.
+            an unknown ``method``, ``rtol`` below ``100 eps`` or ``atol`` < 0 for
+            an explicit method, or more than ``max_steps`` steps needed.
         manakov.ConvergenceError
             A Gauss step whose stage equations do not converge (``dt`` too large).
         """

@@ -13,7 +13,7 @@
 #![allow(clippy::needless_range_loop)]
 #![allow(clippy::excessive_precision)]
 
-use super::VectorField;
+use super::{scaled, starting_step, VectorField};
 use crate::error::{Error, Result};
 
 /// Nodes `c_i`. The vector field is autonomous, so only the order-condition
@@ -271,15 +271,11 @@ impl Dop853 {
             let (mut d0, mut d1) = (0.0f64, 0.0f64);
             for i in 0..m {
                 let sc = self.atol + self.rtol * y[i].abs();
-                d0 += (y[i] / sc).powi(2);
-                d1 += (self.k[i] / sc).powi(2);
+                d0 += scaled(y[i], sc).powi(2);
+                d1 += scaled(self.k[i], sc).powi(2);
             }
             let (d0, d1) = ((d0 / m as f64).sqrt(), (d1 / m as f64).sqrt());
-            self.h = if d0 < 1e-5 || d1 < 1e-5 {
-                1e-6
-            } else {
-                0.01 * d0 / d1
-            };
+            self.h = starting_step(d0, d1);
         }
         while *t < t_target {
             let remaining = t_target - *t;
@@ -320,8 +316,8 @@ impl Dop853 {
                     - BHH[2] * self.k[11 * m + i];
                 self.ynew[i] = y[i] + h * bsum;
                 let sk = self.atol + self.rtol * y[i].abs().max(self.ynew[i].abs());
-                err5 += (e5 / sk).powi(2);
-                err3 += (e3 / sk).powi(2);
+                err5 += scaled(e5, sk).powi(2);
+                err3 += scaled(e3, sk).powi(2);
             }
             let deno = if err5 + 0.01 * err3 > 0.0 {
                 err5 + 0.01 * err3

@@ -187,6 +187,38 @@ impl Method {
     }
 }
 
+/// Smallest `rtol` of the explicit methods, `100 ε` (scipy's floor): a relative error
+/// target per step below ~100 ulps of the state is below the rounding of the step
+/// itself, and `rtol = atol = 1e-300` made the error norm overflow.
+pub const RTOL_MIN: f64 = 100.0 * f64::EPSILON;
+
+/// `x / sc` in the error norms, with `0 / 0 = 0`: with `atol = 0` a component that is
+/// exactly zero has scale 0, and it contributes nothing to the norm.
+pub(crate) fn scaled(x: f64, sc: f64) -> f64 {
+    if x == 0.0 {
+        0.0
+    } else {
+        x / sc
+    }
+}
+
+/// Starting step from the norms `d0 = ‖y‖`, `d1 = ‖f(y)‖` (HNW I, II.4, first part):
+/// `0.01 d0/d1`, or `1e-6` when either is tiny — and also when `d1` overflowed (a
+/// component with zero scale and nonzero derivative, or a tiny `atol`), where the
+/// formula would give 0; the step controller adapts from there.
+pub(crate) fn starting_step(d0: f64, d1: f64) -> f64 {
+    let h = if d0 < 1e-5 || d1 < 1e-5 {
+        1e-6
+    } else {
+        0.01 * d0 / d1
+    };
+    if h.is_finite() && h > 0.0 {
+        h
+    } else {
+        1e-6
+    }
+}
+
 /// Integration options.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Options {
@@ -194,7 +226,8 @@ pub struct Options {
     pub method: Method,
     /// Gauss methods: the largest step. `dopri5`: the initial step (0 = automatic).
     pub dt: f64,
-    /// `dopri5` relative tolerance.
+    /// Relative tolerance of `dopri5` and `dop853`, at least [`RTOL_MIN`] (ignored by
+    /// the Gauss methods).
     pub rtol: f64,
     /// `dopri5` absolute tolerance.
     pub atol: f64,
@@ -229,10 +262,14 @@ impl Options {
                 });
             }
         }
-        if !gauss && self.rtol == 0.0 && self.atol == 0.0 {
+        if !gauss && self.rtol < RTOL_MIN {
             return Err(Error::InvalidArgument {
                 what: "rtol",
-                reason: "rtol and atol cannot both be 0".into(),
+                reason: format!(
+                    "must be >= 100 eps = {RTOL_MIN:e} for the explicit methods (a smaller \
+                     relative error per step is below rounding), got {:e}",
+                    self.rtol
+                ),
             });
         }
         Ok(())
@@ -767,15 +804,11 @@ impl Dopri5 {
             let (mut d0, mut d1) = (0.0f64, 0.0f64);
             for i in 0..m {
                 let sc = self.atol + self.rtol * y[i].abs();
-                d0 += (y[i] / sc).powi(2);
-                d1 += (self.k[i] / sc).powi(2);
+                d0 += scaled(y[i], sc).powi(2);
+                d1 += scaled(self.k[i], sc).powi(2);
             }
             let (d0, d1) = ((d0 / m as f64).sqrt(), (d1 / m as f64).sqrt());
-            self.h = if d0 < 1e-5 || d1 < 1e-5 {
-                1e-6
-            } else {
-                0.01 * d0 / d1
-            };
+            self.h = starting_step(d0, d1);
         }
         while *t < t_target {
             let remaining = t_target - *t;
@@ -809,7 +842,7 @@ impl Dopri5 {
                     e += (DP_B[j] - DP_BHAT[j]) * self.k[j * m + i];
                 }
                 let sc = self.atol + self.rtol * y[i].abs().max(self.ytmp[i].abs());
-                err += (h * e / sc).powi(2);
+                err += scaled(h * e, sc).powi(2);
             }
             let err = (err / m as f64).sqrt();
             if !err.is_finite() {
@@ -1086,6 +1119,44 @@ mod tests {
             atol: 1e-10,
             max_steps: MAX_STEPS as u64,
         }
+    }
+
+    /// rtol below 100 ε is refused for the explicit methods (rtol = atol = 1e-300 once
+    /// overflowed the error norm and failed as "state became non-finite"); the Gauss
+    /// methods ignore rtol. At the floor with atol = 0 and a zero component (0/0 in the
+    /// norms before) dopri5 and dop853 run and stay on the circle.
+    #[test]
+    fn rtol_floor_and_zero_scale_components() {
+        for m in [Method::Dopri5, Method::Dop853] {
+            for (rtol, atol) in [(1e-300, 1e-300), (0.0, 1e-12), (RTOL_MIN * 0.999, 1.0)] {
+                let o = Options {
+                    rtol,
+                    atol,
+                    ..opts(m, 0.0)
+                };
+                match integrate(&Osc, &[1.0, 0.0], 0.0, &[1.0], &o) {
+                    Err(Error::InvalidArgument { what: "rtol", .. }) => {}
+                    other => panic!("{m:?} {rtol}: {other:?}"),
+                }
+            }
+            for atol in [0.0, 1e-300] {
+                let o = Options {
+                    rtol: RTOL_MIN,
+                    atol,
+                    ..opts(m, 0.0)
+                };
+                let tr = integrate(&Osc, &[1.0, 0.0], 0.0, &[1.0], &o).unwrap();
+                let r2 = tr.y[0] * tr.y[0] + tr.y[1] * tr.y[1];
+                // the explicit methods' per-step error at rtol = 100 ε over t = 1
+                assert!((r2 - 1.0).abs() < 1e-12, "{m:?} atol {atol}: r² = {r2}");
+            }
+        }
+        let o = Options {
+            rtol: 0.0,
+            atol: 0.0,
+            ..opts(Method::Gauss6, 0.1)
+        };
+        assert!(integrate(&Osc, &[1.0, 0.0], 0.0, &[1.0], &o).is_ok());
     }
 
     #[test]

@@ -8,7 +8,7 @@ use numpy::{
 use pyo3::prelude::*;
 
 use crate::error::Error;
-use crate::theta::{apply_scale, ThetaPlan};
+use crate::theta::{apply_scale, ThetaPlan, MAX_GENUS};
 
 type Jet<'py> = (
     Bound<'py, PyArray2<Complex64>>,
@@ -21,17 +21,27 @@ type Jet<'py> = (
 fn read_tau(tau: &PyReadonlyArray2<'_, Complex64>) -> Result<(Vec<Complex64>, usize), Error> {
     let t = tau.as_array();
     let (r, c) = t.dim();
-    if r != c || r == 0 {
+    if r != c {
         return Err(Error::Shape {
             what: "tau",
-            expected: "(g, g) with g >= 1".into(),
+            expected: "(g, g)".into(),
             got: format!("({r}, {c})"),
+        });
+    }
+    // Checked here, before 4^g = 1 << 2g sizes the output arrays (the shift overflows
+    // for g >= 32); ThetaPlan::new checks it again for Rust callers.
+    if r == 0 || r > MAX_GENUS {
+        return Err(Error::InvalidArgument {
+            what: "genus",
+            reason: format!("g must be in 1..={MAX_GENUS}, got {r} (tau of shape ({r}, {c}))"),
         });
     }
     Ok((t.iter().copied().collect(), r))
 }
 
-/// All 4^g theta values (FLINT order) and their z-derivatives up to `order` at
+/// All 4^g theta values θ[a;b](z, τ) = Σ_n exp(iπ mᵀτm + 2πi mᵀ(z + b/2)),
+/// m = n + a/2 (the paper's (36) with the characteristics of (35)), FLINT order,
+/// and their z-derivatives up to `order` at
 /// `n` points `z` (shape (n, g)): returns (values (n, 4^g), gradient
 /// (n, 4^g, g or 0), hessian (n, 4^g, g, g or 0), log_scale (n,), finite),
 /// normalised so that θ = exp(log_scale) · values; with `scaled` the arrays hold
@@ -107,7 +117,8 @@ fn theta_jet_py<'py>(
     ))
 }
 
-/// (radius, rho, error_bound, expected_terms) of the summation plan for `tau`.
+/// (radius, rho, error_bound, expected_terms) of the summation plan for `tau`
+/// (the truncated lattice sum of (36), docs/theta.md).
 #[pyfunction(name = "theta_plan_info")]
 #[pyo3(signature = (tau, tol, order))]
 fn theta_plan_info_py(

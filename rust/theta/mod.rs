@@ -231,10 +231,28 @@ impl ThetaPlan {
                 max_asym,
             });
         }
-        let sym = |i: usize, k: usize| 0.5 * (tau[i * g + k] + tau[k * g + i]);
+        // Halving first gives the same (exact) result as halving the sum, but cannot
+        // overflow for entries near the double range.
+        let sym = |i: usize, k: usize| tau[i * g + k] * 0.5 + tau[k * g + i] * 0.5;
         let y: Vec<f64> = (0..g * g).map(|ik| sym(ik / g, ik % g).im).collect();
-        let (ldl_d, ldl_l) = ldl_reversed(&y, g).ok_or_else(|| Error::ImagNotPositiveDefinite {
-            min_eig: min_eigenvalue(&y, g),
+        let (ldl_d, ldl_l) = ldl_reversed(&y, g).ok_or_else(|| {
+            let min_eig = min_eigenvalue(&y, g);
+            if min_eig > 0.0 {
+                // Positive definite, yet the factorisation overflowed (entries beyond
+                // ~1e154 square to infinity) or rounded a pivot to <= 0: saying "not
+                // positive definite" would be false.
+                let ymax = y.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+                Error::InvalidArgument {
+                    what: "tau",
+                    reason: format!(
+                        "Im tau is positive definite (smallest eigenvalue {min_eig:e}) but its \
+                         LDL^T factorisation fails in double precision (largest entry \
+                         {ymax:e})"
+                    ),
+                }
+            } else {
+                Error::ImagNotPositiveDefinite { min_eig }
+            }
         })?;
         let yinv = invert_spd(&ldl_d, &ldl_l, g);
         // Re τ = Re τ' + 2S exactly (x - 2 round(x/2) is exact in binary floating point).
@@ -244,7 +262,10 @@ impl ThetaPlan {
             for k in 0..g {
                 let t = sym(i, k);
                 let sik = (0.5 * t.re).round();
-                s[i * g + k] = sik as i64;
+                // Only S mod 4 enters (through unit_pow); rem_euclid is exact on the
+                // integer-valued double, where a cast would saturate beyond 2^63 (and the
+                // sums below overflow) for huge Re tau.
+                s[i * g + k] = sik.rem_euclid(4.0) as i64;
                 taur[i * g + k] = Complex64::new(t.re - 2.0 * sik, t.im);
             }
         }
@@ -543,7 +564,7 @@ impl ThetaPlan {
         for i in 0..g {
             log_scale += pi() * z[i].im * (q[i] + wr[i]);
         }
-        let log_scale = log_scale.max(0.0);
+        let log_scale = finite_log_scale(log_scale)?;
         // φ = -π qᵀX'q - 2π qᵀ Re z_r, the quadratic part reduced mod 2 exactly.
         let mut phi = 0.0;
         if shifted {
@@ -628,7 +649,7 @@ impl ThetaPlan {
         red.q[0] = q[0];
         red.q[1] = q[1];
         let log_scale = pi() * z[0].im * (q[0] + red.wr[0]) + pi() * z[1].im * (q[1] + red.wr[1]);
-        red.log_scale = log_scale.max(0.0);
+        red.log_scale = finite_log_scale(log_scale)?;
         red.prefactor = Complex64::new(1.0, 0.0);
         if shifted {
             red.phase = -quad_mod2(x, &q, 2) - 2.0 * (q[0] * red.zr[0].re + q[1] * red.zr[1].re);
@@ -1133,6 +1154,21 @@ fn gamma_half_int(n: usize) -> f64 {
 /// `Q(u) = uᵀYu = Σ_i d_i (u_i + Σ_{k<i} l_ik u_k)²`: eliminate from the last
 /// coordinate down (Schur complements), so that enumerating `u_1, …, u_{g-1}`
 /// first leaves the last coordinate innermost. `None` if `Y` is not positive definite.
+/// `L` clamped at 0 (it is `≥ 0` up to rounding); an overflowed `L` (Im z and Im τ
+/// near the double range) would turn into NaN values downstream, so it is refused.
+fn finite_log_scale(log_scale: f64) -> Result<f64> {
+    if log_scale.is_finite() {
+        Ok(log_scale.max(0.0))
+    } else {
+        Err(Error::InvalidArgument {
+            what: "z",
+            reason: "L = pi Im(z)^T (Im tau)^-1 Im(z) overflows the double range: theta is not \
+                     representable, not even with log_scale"
+                .into(),
+        })
+    }
+}
+
 fn ldl_reversed(y: &[f64], g: usize) -> Option<(Vec<f64>, Vec<f64>)> {
     let mut a = y.to_vec();
     let mut d = vec![0.0; g];

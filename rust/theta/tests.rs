@@ -216,6 +216,59 @@ fn bad_tau_is_rejected() {
     ));
 }
 
+/// Entries of Re τ beyond the i64 range once saturated in the reduction
+/// Re τ = Re τ' + 2S (and overflowed the sum aᵀSa): θ(z, τ + 8K) = θ(z, τ) for
+/// integer K, and every shift below is a multiple of 8 as a double.
+#[test]
+fn huge_real_tau_reduces_exactly() {
+    let base: Vec<C> = bench_tau().iter().map(|t| C::new(0.0, t.im)).collect();
+    let z = [C::new(0.2, 0.1), C::new(0.7, -0.3)];
+    let want = full(&ThetaPlan::new(&base, 2, DEFAULT_TOL, 0).unwrap(), &z);
+    for shift in [8.0, 2f64.powi(60), 1e20, 1e300, -1e300, 1.7e308] {
+        assert_eq!(shift % 8.0, 0.0);
+        let tau: Vec<C> = base.iter().map(|t| C::new(shift, t.im)).collect();
+        let got = full(&ThetaPlan::new(&tau, 2, DEFAULT_TOL, 0).unwrap(), &z);
+        for (g, w) in got.iter().zip(&want) {
+            assert!(
+                (g - w).norm() <= AGREE * max_abs(&want),
+                "{shift}: {g} vs {w}"
+            );
+        }
+    }
+}
+
+/// Overflow at the edge of the double range is an error, never NaN values: L
+/// overflowing, and a positive definite Im τ whose factorisation overflows (reported
+/// as such, not as "not positive definite").
+#[test]
+fn double_range_edges_are_errors_not_nan() {
+    let tau = tau2(C::new(0.3, 1e308), C::new(0.1, 0.4), C::new(-0.2, 1.3));
+    let plan = ThetaPlan::new(&tau, 2, DEFAULT_TOL, 0).unwrap();
+    let z = [C::new(0.0, -1e308), C::new(0.5, 0.1)];
+    assert!(matches!(
+        plan.theta_all(&z),
+        Err(Error::InvalidArgument { what: "z", .. })
+    ));
+    let plan2 = ThetaPlan::new(&tau, 2, DEFAULT_TOL, 2).unwrap();
+    assert!(matches!(
+        plan2.jet(&z, 2),
+        Err(Error::InvalidArgument { what: "z", .. })
+    ));
+    let tau: Vec<C> = bench_tau().iter().map(|t| t * 1e300).collect();
+    match ThetaPlan::new(&tau, 2, DEFAULT_TOL, 0) {
+        Err(Error::InvalidArgument {
+            what: "tau",
+            reason,
+        }) => {
+            assert!(
+                reason.contains("positive definite (smallest eigenvalue"),
+                "{reason}"
+            )
+        }
+        other => panic!("{other:?}"),
+    }
+}
+
 #[test]
 fn plan_bound_is_below_tol_and_rho_is_shortest() {
     let plan = ThetaPlan::new(&bench_tau(), 2, 1e-15, 2).unwrap();
