@@ -267,15 +267,7 @@ impl Dop853 {
             self.k1_valid = true;
         }
         if self.h == 0.0 {
-            // Starting step (HNW I, II.4), exponent 1/8.
-            let (mut d0, mut d1) = (0.0f64, 0.0f64);
-            for i in 0..m {
-                let sc = self.atol + self.rtol * y[i].abs();
-                d0 += scaled(y[i], sc).powi(2);
-                d1 += scaled(self.k[i], sc).powi(2);
-            }
-            let (d0, d1) = ((d0 / m as f64).sqrt(), (d1 / m as f64).sqrt());
-            self.h = starting_step(d0, d1);
+            self.h = starting_step(y, &self.k[0..m], self.atol, self.rtol);
         }
         while *t < t_target {
             let remaining = t_target - *t;

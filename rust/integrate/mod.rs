@@ -202,11 +202,20 @@ pub(crate) fn scaled(x: f64, sc: f64) -> f64 {
     }
 }
 
-/// Starting step from the norms `d0 = ‖y‖`, `d1 = ‖f(y)‖` (HNW I, II.4, first part):
-/// `0.01 d0/d1`, or `1e-6` when either is tiny — and also when `d1` overflowed (a
-/// component with zero scale and nonzero derivative, or a tiny `atol`), where the
-/// formula would give 0; the step controller adapts from there.
-pub(crate) fn starting_step(d0: f64, d1: f64) -> f64 {
+/// Starting step (HNW I, II.4, first part) from `d0 = ‖y‖` and `d1 = ‖f(y)‖` in the
+/// error norm with scale `atol + rtol |y_i|`: `0.01 d0/d1`, or `1e-6` when either is
+/// tiny — and also when `d1` overflowed (a component with zero scale and nonzero
+/// derivative, or a tiny `atol`), where the formula would give 0; the step controller
+/// adapts from there.
+pub(crate) fn starting_step(y: &[f64], f0: &[f64], atol: f64, rtol: f64) -> f64 {
+    let m = y.len().max(1) as f64;
+    let (mut d0, mut d1) = (0.0f64, 0.0f64);
+    for (&yi, &fi) in y.iter().zip(f0) {
+        let sc = atol + rtol * yi.abs();
+        d0 += scaled(yi, sc).powi(2);
+        d1 += scaled(fi, sc).powi(2);
+    }
+    let (d0, d1) = ((d0 / m).sqrt(), (d1 / m).sqrt());
     let h = if d0 < 1e-5 || d1 < 1e-5 {
         1e-6
     } else {
@@ -800,15 +809,7 @@ impl Dopri5 {
             self.fsal_valid = true;
         }
         if self.h == 0.0 {
-            // Starting step (HNW I, II.4): h = 0.01 ‖y‖ / ‖f‖ in the error norm.
-            let (mut d0, mut d1) = (0.0f64, 0.0f64);
-            for i in 0..m {
-                let sc = self.atol + self.rtol * y[i].abs();
-                d0 += scaled(y[i], sc).powi(2);
-                d1 += scaled(self.k[i], sc).powi(2);
-            }
-            let (d0, d1) = ((d0 / m as f64).sqrt(), (d1 / m as f64).sqrt());
-            self.h = starting_step(d0, d1);
+            self.h = starting_step(y, &self.k[0..m], self.atol, self.rtol);
         }
         while *t < t_target {
             let remaining = t_target - *t;
