@@ -392,3 +392,33 @@ def test_35_parities_explained_by_riemann_constant(top_is_a):
     )
     assert sorted(ok) == expected
     assert all(manakov.parity(k) == -1 for k in ok)
+
+
+#: Half-period characteristic eta(e_i) of the i-th smallest branch point (base
+#: point infinity, eta(infinity) = 0) in the basis of abel_ref.py.
+ETA_SORTED = [
+    ((1, 0), (0, 0)),
+    ((1, 0), (1, 0)),
+    ((0, 1), (1, 0)),
+    ((0, 1), (1, 1)),
+    ((0, 0), (1, 1)),
+]
+
+
+@pytest.mark.parametrize("name", CURVES)
+def test_characteristics_follow_the_sorted_branch_points(name):
+    """chi_j = eta(position of d_j among the sorted branch points) on both curves
+    (the label enters only through the ordering), chi_jk = chi_j + chi_k, and
+    K = eta(e1) + eta(e3) + eta(e5) (the classical Riemann constant for base
+    point infinity)."""
+    d1, d2, d3 = CURVES[name]
+    dj = [0.0, d1, d2, d3, d1 * d2 * d3]
+    order = sorted(range(5), key=lambda j: dj[j])
+    for pos, j in enumerate(order):
+        assert FOUND[name][str(j)] == ETA_SORTED[pos]
+    k = (
+        np.array(ETA_SORTED[0][0] + ETA_SORTED[0][1])
+        + np.array(ETA_SORTED[2][0] + ETA_SORTED[2][1])
+        + np.array(ETA_SORTED[4][0] + ETA_SORTED[4][1])
+    ) % 2
+    assert tuple(k) == K_CHAR[0] + K_CHAR[1]
