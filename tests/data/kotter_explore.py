@@ -6,98 +6,23 @@ It prints, for each formula, the residual as printed and, where it fails, the
 residual of the corrected form pinned down here (see docs/errata.md).
 """
 
-import itertools
+import sys
+from pathlib import Path
 
 import numpy as np
 from scipy.integrate import solve_ivp
 
-CYC = [(0, 1, 2), (1, 2, 0), (2, 0, 1)]  # (j,k,l) cyclic, 0-based
-
-
-def full(l):
-    m = np.zeros((4, 4))
-    m[0, 1], m[0, 2], m[0, 3], m[1, 2], m[1, 3], m[2, 3] = l
-    return m - m.T
-
-
-def cmat(a, b):
-    c = np.zeros((4, 4))
-    for i in range(4):
-        for j in range(4):
-            if i != j:
-                c[i, j] = (b[i] - b[j]) / (a[i] - a[j])
-    return c
-
-
-def rhs(a, b):
-    c = cmat(a, b)
-
-    def f(t, y):
-        L = full(y)
-        W = c * L
-        # (1) literally: ldot_ij = sum_k (l_ik w_kj - w_ik l_kj)
-        D = L @ W - W @ L
-        return np.array([D[0, 1], D[0, 2], D[0, 3], D[1, 2], D[1, 3], D[2, 3]])
-
-    return f
-
-
-def mn(l):
-    L = full(l)
-    m = np.array([L[k, ll] for (j, k, ll) in CYC])
-    n = np.array([L[j, 3] for (j, k, ll) in CYC])
-    return m, n
-
-
-def integrals(a, l, printed=False):
-    L = full(l)
-    h0 = L[0, 1] * L[2, 3] + L[1, 2] * L[0, 3] + L[2, 0] * L[1, 3]
-    h1 = h2 = h3 = 0.0
-    for j, k in itertools.combinations(range(4), 2):
-        lo, mo = [x for x in range(4) if x not in (j, k)]
-        h1 += L[j, k] ** 2
-        if printed:
-            h2 += (a[j] + a[k]) * L[j, k] ** 2
-            h3 += a[j] * a[k] * L[j, k] ** 2
-        else:
-            h2 += (a[lo] + a[mo]) * L[j, k] ** 2
-            h3 += a[lo] * a[mo] * L[j, k] ** 2
-    return h0, h1, h2, h3
-
-
-def sq(s, a, j, k):
-    return (s - a[j]) * (s - a[k])
-
-
-def lvec(s, a, l, sqG):
-    """l(s) (12) with sqrt(s_j4) principal and sqrt(s_kl) = sqG / sqrt(s_j4)."""
-    m, n = mn(l)
-    out = []
-    for j, k, ll in CYC:
-        r = np.sqrt(complex(sq(s, a, j, 3)))
-        out.append(r * m[j] + sqG / r * n[j])
-    return np.array(out)
-
-
-def mvec(s, a, l, sqG):
-    m, n = mn(l)
-    out = []
-    for j, k, ll in CYC:
-        r = np.sqrt(complex(sq(s, a, j, 3)))
-        out.append(sqG / r * m[j] + r * n[j])
-    return np.array(out)
-
-
-def skew3(v):
-    return np.array([[0, v[2], -v[1]], [-v[2], 0, v[0]], [v[1], -v[0], 0]])
-
-
-def Fcoef(a, h):
-    h0, h1, h2, h3 = h
-    P = np.array([h1, -h2, h3])
-    G = np.poly(a)
-    num = np.polysub(np.polymul(P, P), 4 * h0**2 * G)
-    return num / (h1**2 - 4 * h0**2)
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from kotter_ref import (  # noqa: E402  (the shared independent reference)
+    CYC,
+    integrals,
+    skew3,
+)
+from kotter_ref import F_coeffs as Fcoef  # noqa: E402
+from kotter_ref import frahm_rhs as rhs  # noqa: E402
+from kotter_ref import l_of_s as lvec  # noqa: E402
+from kotter_ref import m_of_s as mvec  # noqa: E402
+from kotter_ref import s_pair as sq  # noqa: E402
 
 
 def main():
