@@ -19,7 +19,6 @@ __all__ = [
     "integrate_many",
     "kotter_batch",
     "kotter_from_points",
-    "kotter_integrals",
     "kotter_lax_m",
     "kotter_quartic",
     "kotter_schottky",
@@ -138,9 +137,6 @@ def theta_plan_info(
 
 # --- kotter (rust/python/kotter.rs) ---
 
-def kotter_integrals(
-    a: npt.NDArray[np.float64], l: npt.NDArray[np.float64]
-) -> npt.NDArray[np.float64]: ...
 def kotter_schottky(
     a: npt.NDArray[np.float64],
     l: npt.NDArray[np.float64],

@@ -92,7 +92,7 @@ def integrals(a: Any, l: Any) -> np.ndarray:
     """
     a = _check_a(a)
     flat, shape = _states(l)
-    return _finite_result(np.asarray(_core.kotter_integrals(a, flat))).reshape(shape + (4,))
+    return _finite_result(np.asarray(_core.so4_integrals(a, flat))).reshape(shape + (4,))
 
 
 def schottky(a: Any, l: Any, s: Any, *, sqrt_g: Any = None) -> tuple[np.ndarray, np.ndarray]:

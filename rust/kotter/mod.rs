@@ -95,20 +95,9 @@ pub fn l_from_m_n(m: &[f64; 3], n: &[f64; 3]) -> [f64; 6] {
 }
 
 /// The integrals `(h0, h1, h2, h3)`: `H0` (6), `H1` (7), and `H2`, `H3` in the
-/// form consistent with (15): `H2 = Σ_{j<k} (a_l + a_m) l_jk²`,
-/// `H3 = Σ_{j<k} a_l a_m l_jk²`, `{l, m}` the complement of `{j, k}`.
-pub fn integrals(a: &[f64; 4], l: &[f64; 6]) -> [f64; 4] {
-    let (m, n) = m_n(l);
-    let h0 = m[0] * n[0] + m[1] * n[1] + m[2] * n[2];
-    let mut h = [h0, 0.0, 0.0, 0.0];
-    for (j, &(_, k, ll)) in CYCLIC.iter().enumerate() {
-        // m_j = l_kl has complement {j, 4}; n_j = l_j4 has complement {k, l}.
-        h[1] += m[j] * m[j] + n[j] * n[j];
-        h[2] += (a[j] + a[3]) * m[j] * m[j] + (a[k] + a[ll]) * n[j] * n[j];
-        h[3] += a[j] * a[3] * m[j] * m[j] + a[k] * a[ll] * n[j] * n[j];
-    }
-    h
-}
+/// form consistent with (15) (complementary index pairs) — the dynamics module's
+/// [`crate::so4::integrals4`], under the name the reduction uses.
+pub use crate::so4::integrals4 as integrals;
 
 /// `s_jk = (s − a_j)(s − a_k)` (13), 0-based indices.
 fn s_pair(s: C, a: &[f64; 4], j: usize, k: usize) -> C {

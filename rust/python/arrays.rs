@@ -2,7 +2,7 @@
 //! into owned Rust data, with the shape checks that keep user input away from
 //! indexing panics, and the error of an output reshape.
 
-use numpy::ndarray::ShapeError;
+use numpy::ndarray::{Array2, ShapeError};
 use numpy::{Element, PyReadonlyArray1, PyReadonlyArray2};
 use pyo3::PyErr;
 
@@ -71,4 +71,13 @@ pub(super) fn rows<T: Element + Copy, const K: usize>(
         .into_iter()
         .map(|r| std::array::from_fn(|k| r[k]))
         .collect())
+}
+
+/// Rows of `K` values as an `(n, K)` array: the inverse of [`rows`] for results.
+pub(super) fn stack<T: Copy, const K: usize>(
+    rows: impl IntoIterator<Item = [T; K]>,
+) -> Result<Array2<T>, PyErr> {
+    let flat: Vec<T> = rows.into_iter().flatten().collect();
+    let n = flat.len() / K.max(1);
+    Array2::from_shape_vec((n, K), flat).map_err(out_shape_err)
 }

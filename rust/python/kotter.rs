@@ -5,27 +5,12 @@ use numpy::{Complex64, IntoPyArray, PyReadonlyArray1, PyReadonlyArray2, PyReadon
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
-use super::arrays::{array1, out_shape_err, rows, shape_err, vec1};
+use super::arrays::{array1, out_shape_err, rows, shape_err, stack, vec1};
 use crate::error::Error;
 use crate::kotter;
 
 type C = Complex64;
 type LmPair = ([C; 3], [C; 3]);
-
-/// The integrals (h0, h1, h2, h3) (6)-(7) with the complementary-pair H2, H3, for states `l` of shape (n, 6).
-#[pyfunction(name = "kotter_integrals")]
-fn kotter_integrals_py<'py>(
-    py: Python<'py>,
-    a: PyReadonlyArray1<'py, f64>,
-    l: PyReadonlyArray2<'py, f64>,
-) -> PyResult<Bound<'py, PyAny>> {
-    let a: [f64; 4] = array1(&a, "a")?;
-    let rows = rows::<f64, 6>(&l, "l", None)?;
-    let n = rows.len();
-    let out: Vec<f64> = py.detach(|| rows.iter().flat_map(|r| kotter::integrals(&a, r)).collect());
-    let arr = Array2::from_shape_vec((n, 4), out).map_err(out_shape_err)?;
-    Ok(arr.into_pyarray(py).into_any())
-}
 
 /// Schottky's l(s) (12) and m(s) (17) on the branch sqrt(s_j4) sqrt(s_kl) = sqrt_g.
 #[pyfunction(name = "kotter_schottky")]
@@ -52,10 +37,8 @@ fn kotter_schottky_py<'py>(
             .collect()
     });
     let res = res?;
-    let lv: Vec<C> = res.iter().flat_map(|x| x.0).collect();
-    let mv: Vec<C> = res.iter().flat_map(|x| x.1).collect();
-    let lv = Array2::from_shape_vec((n, 3), lv).map_err(out_shape_err)?;
-    let mv = Array2::from_shape_vec((n, 3), mv).map_err(out_shape_err)?;
+    let lv = stack(res.iter().map(|x| x.0))?;
+    let mv = stack(res.iter().map(|x| x.1))?;
     Ok((
         lv.into_pyarray(py).into_any(),
         mv.into_pyarray(py).into_any(),
@@ -84,9 +67,7 @@ fn kotter_lax_m_py<'py>(
             .map(|(r, (&si, &gi))| kotter::lax_m(&a, &b, r, si, gi))
             .collect()
     });
-    let out: Vec<C> = res?.into_iter().flatten().collect();
-    let arr = Array2::from_shape_vec((n, 3), out).map_err(out_shape_err)?;
-    Ok(arr.into_pyarray(py).into_any())
+    Ok(stack(res?)?.into_pyarray(py).into_any())
 }
 
 /// Coefficients of F(s) (19), monic, highest power first, for integrals h of shape (n, 4).
@@ -98,7 +79,6 @@ fn kotter_quartic_py<'py>(
 ) -> PyResult<Bound<'py, PyAny>> {
     let a: [f64; 4] = array1(&a, "a")?;
     let rows = rows::<f64, 4>(&h, "h", None)?;
-    let n = rows.len();
     let res: Result<Vec<[f64; 5]>, Error> = py.detach(|| {
         crate::error::check_finite("a", &a)?;
         rows.iter()
@@ -108,9 +88,7 @@ fn kotter_quartic_py<'py>(
             })
             .collect()
     });
-    let out: Vec<f64> = res?.into_iter().flatten().collect();
-    let arr = Array2::from_shape_vec((n, 5), out).map_err(out_shape_err)?;
-    Ok(arr.into_pyarray(py).into_any())
+    Ok(stack(res?)?.into_pyarray(py).into_any())
 }
 
 /// Kötter's reduction and the uniformization for states `l` of shape (n, 6):
@@ -273,14 +251,11 @@ fn kotter_from_points_py<'py>(
             })
             .collect()
     });
-    let out: Vec<f64> = res?.into_iter().flatten().collect();
-    let arr = Array2::from_shape_vec((n, 6), out).map_err(out_shape_err)?;
-    Ok(arr.into_pyarray(py).into_any())
+    Ok(stack(res?)?.into_pyarray(py).into_any())
 }
 
 /// Adds this module's functions to `manakov._core`.
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
-    m.add_function(wrap_pyfunction!(kotter_integrals_py, m)?)?;
     m.add_function(wrap_pyfunction!(kotter_schottky_py, m)?)?;
     m.add_function(wrap_pyfunction!(kotter_quartic_py, m)?)?;
     m.add_function(wrap_pyfunction!(kotter_lax_m_py, m)?)?;

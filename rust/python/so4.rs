@@ -4,7 +4,7 @@ use numpy::ndarray::{Array2, Array3};
 use numpy::{IntoPyArray, PyArray1, PyArray2, PyArray3, PyReadonlyArray1, PyReadonlyArray2};
 use pyo3::prelude::*;
 
-use super::arrays::{out_shape_err, vec1};
+use super::arrays::{array1, out_shape_err, rows, stack, vec1};
 use crate::error::Error;
 use crate::integrate::{self, Method, Options};
 use crate::so4::{self, FrahmTop};
@@ -104,25 +104,10 @@ fn so4_integrals_py<'py>(
     a: PyReadonlyArray1<'py, f64>,
     l: PyReadonlyArray2<'py, f64>,
 ) -> PyResult<Bound<'py, PyArray2<f64>>> {
-    let a = vec1(&a, "a", None)?;
-    let a4: [f64; 4] = a.as_slice().try_into().map_err(|_| Error::Shape {
-        what: "a",
-        expected: "(4,)".into(),
-        got: format!("({},)", a.len()),
-    })?;
-    let (lv, rows, cols) = vec2(&l);
-    check_states("l", cols, so4::DIM4)?;
-    let out: Vec<f64> = py.detach(|| {
-        lv.chunks(6)
-            .flat_map(|x| {
-                let x: [f64; 6] = [x[0], x[1], x[2], x[3], x[4], x[5]];
-                so4::integrals4(&a4, &x)
-            })
-            .collect()
-    });
-    Ok(Array2::from_shape_vec((rows, 4), out)
-        .map_err(out_shape_err)?
-        .into_pyarray(py))
+    let a4: [f64; 4] = array1(&a, "a")?;
+    let ls = rows::<f64, 6>(&l, "l", None)?;
+    let out: Vec<[f64; 4]> = py.detach(|| ls.iter().map(|x| so4::integrals4(&a4, x)).collect());
+    Ok(stack(out)?.into_pyarray(py))
 }
 
 /// Labels (k, j) of Manakov's integrals on so(n).
