@@ -46,6 +46,7 @@ from typing import Any
 import numpy as np
 
 from . import _core
+from .top import _finite_result
 
 __all__ = ["CurvePoints", "KotterCurve", "Wurzel", "INVERSE_RTOL"]
 
@@ -71,10 +72,7 @@ def _scalar_or(a: np.ndarray, scalar: bool) -> Any:
 
 
 def _finite(values: np.ndarray) -> np.ndarray:
-    """Raise instead of returning an overflowed (inf/NaN) value from finite input."""
-    if not np.all(np.isfinite(values)):
-        raise ValueError("the result overflows (inf or NaN) for this x: |x| is too large")
-    return values
+    return _finite_result(values, "this x: |x| is too large")
 
 
 def _zd_rows(zd: Any, shape: tuple[int, ...]) -> np.ndarray | None:

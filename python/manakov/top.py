@@ -109,10 +109,10 @@ def _states(l: Any, m: int, what: str = "l") -> tuple[np.ndarray, tuple[int, ...
     return np.ascontiguousarray(arr.reshape(-1, m)), lead
 
 
-def _finite_result(values: np.ndarray) -> np.ndarray:
+def _finite_result(values: np.ndarray, cause: str = "this l: rescale l") -> np.ndarray:
     """Raise instead of returning an overflowed (inf/NaN) result from finite input."""
     if not np.all(np.isfinite(values)):
-        raise ValueError("the result overflows (inf or NaN) for this l: rescale l")
+        raise ValueError(f"the result overflows (inf or NaN) for {cause}")
     return values
 
 
