@@ -94,6 +94,24 @@ pub(super) struct ChunkIn {
     pub(super) sb: [Lane; 4],
 }
 
+impl ChunkIn {
+    /// Lane `p` from the reduced point `red`.
+    #[inline(always)]
+    pub(super) fn set(&mut self, p: usize, red: &super::Reduced) {
+        for i in 0..2 {
+            self.zre[i][p] = red.zr[i].re;
+            self.zim[i][p] = red.zr[i].im;
+            self.wr[i][p] = red.wr[i];
+        }
+        self.phase[p] = red.phase;
+        self.logs[p] = red.log_scale;
+        for h in 0..4 {
+            self.sa[h][p] = 1.0 - 2.0 * f64::from((h & red.pbits).count_ones() & 1);
+            self.sb[h][p] = 1.0 - 2.0 * f64::from((h & red.qbits).count_ones() & 1);
+        }
+    }
+}
+
 impl Batch2 {
     /// `None` unless g = 2, the table is small and `Xk` cannot overflow.
     pub(super) fn build(plan: &ThetaPlan) -> Option<Batch2> {
@@ -536,17 +554,7 @@ mod tests {
                     Complex64::new((0.53 * t).cos() * 2.0, (0.29 * t).sin() * 1.5),
                 ])
                 .unwrap();
-            for i in 0..2 {
-                inp.zre[i][p] = red.zr[i].re;
-                inp.zim[i][p] = red.zr[i].im;
-                inp.wr[i][p] = red.wr[i];
-            }
-            inp.phase[p] = red.phase;
-            inp.logs[p] = red.log_scale;
-            for h in 0..4 {
-                inp.sa[h][p] = 1.0 - 2.0 * f64::from((h & red.pbits).count_ones() & 1);
-                inp.sb[h][p] = 1.0 - 2.0 * f64::from((h & red.qbits).count_ones() & 1);
-            }
+            inp.set(p, &red);
         }
         let mut base = b2.scratch();
         b2.chunk_body(&plan, &inp, true, &mut base);

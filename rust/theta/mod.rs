@@ -63,6 +63,19 @@ pub const MAX_TERMS: f64 = 2e8;
 /// has no fractional part, so θ is not determined to any digit.
 const MAX_REDUCTION: f64 = 4.5e15;
 
+/// The nearest integer to the reduced real part `re` of an entry `z_re` of z,
+/// refused beyond [`MAX_REDUCTION`], where double precision no longer fixes it.
+#[inline(always)]
+fn integer_part(re: f64, z_re: f64) -> Result<f64> {
+    if re.abs() > MAX_REDUCTION {
+        return Err(Error::InvalidArgument {
+            what: "z",
+            reason: format!("Re z has an entry {z_re:e}: theta is not determined"),
+        });
+    }
+    Ok(sum::round_i64(re) as f64)
+}
+
 /// Above this diagonal entry of `Im τ` the genus-2 walk would multiply by
 /// `exp(π Im τ_kk / 2) > e^{78}`; the generic path (upward sweeps only) is used.
 const FAST_PATH_MAX_IMAG_DIAG: f64 = 50.0;
@@ -545,13 +558,7 @@ impl ThetaPlan {
             } else {
                 (z[i].re, z[i].im)
             };
-            if re.abs() > MAX_REDUCTION {
-                return Err(Error::InvalidArgument {
-                    what: "z",
-                    reason: format!("Re z has an entry {:e}: theta is not determined", z[i].re),
-                });
-            }
-            p[i] = sum::round_i64(re) as f64;
+            p[i] = integer_part(re, z[i].re)?;
             zr[i] = Complex64::new(re - p[i], im);
         }
         let mut wr = [0.0f64; MAX_GENUS];
@@ -634,13 +641,7 @@ impl ThetaPlan {
             } else {
                 (z[i].re, z[i].im)
             };
-            if re.abs() > MAX_REDUCTION {
-                return Err(Error::InvalidArgument {
-                    what: "z",
-                    reason: format!("Re z has an entry {:e}: theta is not determined", z[i].re),
-                });
-            }
-            p[i] = sum::round_i64(re) as f64;
+            p[i] = integer_part(re, z[i].re)?;
             red.zr[i] = Complex64::new(re - p[i], im);
         }
         let (zr0, zr1) = (red.zr[0].im, red.zr[1].im);
@@ -903,17 +904,7 @@ impl ThetaPlan {
             for p in 0..m {
                 let k = i0 + p;
                 let red = self.reduce2::<false>([z[2 * k], z[2 * k + 1]])?;
-                for i in 0..2 {
-                    inp.zre[i][p] = red.zr[i].re;
-                    inp.zim[i][p] = red.zr[i].im;
-                    inp.wr[i][p] = red.wr[i];
-                }
-                inp.phase[p] = red.phase;
-                inp.logs[p] = red.log_scale;
-                for h in 0..4 {
-                    inp.sa[h][p] = 1.0 - 2.0 * f64::from((h & red.pbits).count_ones() & 1);
-                    inp.sb[h][p] = 1.0 - 2.0 * f64::from((h & red.qbits).count_ones() & 1);
-                }
+                inp.set(p, &red);
                 log_scale[k] = red.log_scale;
             }
             b2.eval_chunk(self, &inp, scaled, &mut sc);
