@@ -43,6 +43,8 @@ pub enum Error {
         reached: f64,
         iterations: usize,
     },
+    /// The computation was cancelled (Ctrl-C in Python; see [`crate::cancel`]).
+    Interrupted,
 }
 
 /// `Result` with the crate's [`Error`].
@@ -85,6 +87,7 @@ impl fmt::Display for Error {
                 f,
                 "{what} did not converge: tolerance {tol:e}, reached {reached:e} after {iterations} iterations"
             ),
+            Error::Interrupted => write!(f, "interrupted"),
         }
     }
 }

@@ -16,6 +16,7 @@
 //! The crate is pure Rust; the Python bindings live behind the `python`
 //! feature in a private module.
 
+pub mod cancel;
 pub mod curve;
 pub mod error;
 pub mod integrate;

@@ -46,7 +46,7 @@ from typing import Any
 import numpy as np
 
 from . import _core
-from .top import _finite_result
+from ._checks import _finite_result
 
 __all__ = ["CurvePoints", "KotterCurve", "Wurzel", "INVERSE_RTOL"]
 

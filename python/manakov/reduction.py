@@ -29,8 +29,9 @@ from typing import Any
 import numpy as np
 
 from . import _core
-from .top import _finite_result, _float_array
-from .top import _states as _top_states
+from ._checks import _finite_result, _float_array
+from ._checks import _states as _top_states
+from .curve import KotterCurve
 
 __all__ = [
     "Kotter",
@@ -387,10 +388,6 @@ _FIELD_SHAPES = {
 
 
 def _make_curve(d: np.ndarray) -> Any:
-    try:
-        from .curve import KotterCurve  # type: ignore[attr-defined]
-    except ImportError:  # the curve module is merged separately
-        return None
     return KotterCurve(complex(d[0]), complex(d[1]), complex(d[2]))
 
 

@@ -29,6 +29,9 @@ from typing import Any, Callable
 import numpy as np
 
 from . import _core
+from ._checks import _finite_result, _float_array, _n_from_dim, _out, _states, state_dim
+from .reduction import from_kotter as _from_kotter
+from .reduction import kotter as _kotter
 
 __all__ = [
     "FrahmTop",
@@ -65,62 +68,6 @@ DEFAULT_MAX_STEPS = 10**8
 
 #: The core's hard cap on ``max_steps`` (``integrate::MAX_STEPS``).
 _MAX_STEPS_CAP = 10**11
-
-
-def state_dim(n: int) -> int:
-    """Length ``n(n-1)/2`` of the so(n) state vector (the strict upper triangle of l).
-
-    Parameters
-    ----------
-    n : int
-
-    Returns
-    -------
-    int
-    """
-    return n * (n - 1) // 2
-
-
-def _n_from_dim(m: int) -> int:
-    n = int(round((1 + math.sqrt(1 + 8 * m)) / 2))
-    if state_dim(n) != m or n < 2:
-        raise ValueError(f"last axis of length {m} is not n(n-1)/2 for any n")
-    return n
-
-
-def _float_array(x: Any, what: str) -> np.ndarray:
-    arr = np.asarray(x)
-    if np.iscomplexobj(arr):
-        raise ValueError(f"{what} must be real, got a complex array")
-    if arr.dtype == object:
-        raise ValueError(f"{what} must be a numeric array")
-    arr = arr.astype(np.float64, copy=False)
-    if not np.all(np.isfinite(arr)):
-        raise ValueError(f"{what} must be finite; it contains NaN or infinity")
-    return arr
-
-
-def _states(l: Any, m: int, what: str = "l") -> tuple[np.ndarray, tuple[int, ...]]:
-    """``l`` as a C-contiguous (N, m) float array and its leading shape."""
-    arr = _float_array(l, what)
-    if arr.ndim == 0 or arr.shape[-1] != m:
-        raise ValueError(f"{what} must have shape (..., {m}), got {arr.shape}")
-    lead = arr.shape[:-1]
-    return np.ascontiguousarray(arr.reshape(-1, m)), lead
-
-
-def _finite_result(values: np.ndarray, cause: str = "this l: rescale l") -> np.ndarray:
-    """Raise instead of returning an overflowed (inf/NaN) result from finite input."""
-    if not np.all(np.isfinite(values)):
-        raise ValueError(f"the result overflows (inf or NaN) for {cause}")
-    return values
-
-
-def _out(values: np.ndarray, lead: tuple[int, ...]) -> Any:
-    """Reshape per-state results back to the leading shape; 0-d → scalar."""
-    values = _finite_result(values)
-    res = values.reshape(lead + values.shape[1:])
-    return res[()] if res.ndim == 0 else res
 
 
 def to_matrix(l: Any) -> np.ndarray:
@@ -781,10 +728,8 @@ class ManakovTop(FrahmTop):
         ValueError
             ``n != 4``, and as :func:`manakov.kotter`.
         """
-        from .reduction import kotter
-
         self._require_so4("kotter")
-        return kotter(self._a, self._b, l)
+        return _kotter(self._a, self._b, l)
 
     def from_kotter(self, k: Any) -> np.ndarray:
         """Map Schottky–Kötter coordinates back to the state l (n = 4 only).
@@ -806,10 +751,8 @@ class ManakovTop(FrahmTop):
         ValueError
             ``n != 4``, and as :func:`manakov.from_kotter`.
         """
-        from .reduction import from_kotter
-
         self._require_so4("from_kotter")
-        return from_kotter(self._a, self._b, k)
+        return _from_kotter(self._a, self._b, k)
 
     def _require_so4(self, what: str) -> None:
         if self.n != 4:

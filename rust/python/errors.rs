@@ -1,7 +1,7 @@
 //! The one map from the core's `Error` to Python exceptions.
 
 use pyo3::create_exception;
-use pyo3::exceptions::{PyRuntimeError, PyValueError};
+use pyo3::exceptions::{PyKeyboardInterrupt, PyRuntimeError, PyValueError};
 use pyo3::PyErr;
 
 use crate::error::Error;
@@ -19,6 +19,7 @@ impl From<Error> for PyErr {
         // Exhaustive on purpose: a new variant must choose its exception here.
         match e {
             Error::NoConvergence { .. } => ConvergenceError::new_err(msg),
+            Error::Interrupted => PyKeyboardInterrupt::new_err(msg),
             Error::Shape { .. }
             | Error::NonFinite { .. }
             | Error::RepeatedA { .. }
@@ -28,4 +29,12 @@ impl From<Error> for PyErr {
             | Error::InvalidArgument { .. } => PyValueError::new_err(msg),
         }
     }
+}
+
+/// A cancellation token for a call that runs with the GIL released: it runs
+/// Python's signal handlers (so Ctrl-C is seen) from the calling thread, at
+/// most every `cancel::POLL_INTERVAL`.
+#[allow(dead_code)] // used by the integrate and theta bindings as they adopt it
+pub fn py_cancel() -> crate::cancel::Cancel {
+    crate::cancel::Cancel::with_poll(|| pyo3::Python::attach(|py| py.check_signals().is_err()))
 }

@@ -1,0 +1,132 @@
+//! Cooperative cancellation of long computations.
+//!
+//! Long loops (integration, theta batches, frequency maps) call
+//! [`Cancel::check`] between chunks of work. A [`Cancel`] made by
+//! [`Cancel::with_poll`] asks its poll function (the Python binding passes one
+//! that runs the interpreter's signal handlers, so that Ctrl-C is seen) at most
+//! every [`POLL_INTERVAL`], and only from the thread that made it: Python runs
+//! signal handlers in its main thread only. Worker threads see the shared flag.
+//! The core never depends on Python: [`Cancel::never`] is the plain-Rust default.
+
+use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
+use std::thread::ThreadId;
+use std::time::{Duration, Instant};
+
+use crate::error::{Error, Result};
+
+/// How often the poll function runs at most. Ctrl-C must stop a call within
+/// 0.5 s; 20 ms leaves the rest of that for the chunk of work between checks.
+pub const POLL_INTERVAL: Duration = Duration::from_millis(20);
+
+type Poll = Box<dyn Fn() -> bool + Send + Sync>;
+
+/// A cancellation token shared by the threads of one computation.
+pub struct Cancel {
+    flag: AtomicBool,
+    poll: Option<Poll>,
+    owner: Option<ThreadId>,
+    start: Instant,
+    next_poll_ns: AtomicU64,
+}
+
+impl std::fmt::Debug for Cancel {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Cancel")
+            .field("cancelled", &self.is_cancelled())
+            .field("polls", &self.poll.is_some())
+            .finish()
+    }
+}
+
+impl Default for Cancel {
+    fn default() -> Self {
+        Self::never()
+    }
+}
+
+impl Cancel {
+    /// A token that is cancelled only by [`Cancel::cancel`].
+    pub fn never() -> Self {
+        Cancel {
+            flag: AtomicBool::new(false),
+            poll: None,
+            owner: None,
+            start: Instant::now(),
+            next_poll_ns: AtomicU64::new(0),
+        }
+    }
+
+    /// A token that also asks `poll` (true = stop) from the calling thread.
+    pub fn with_poll(poll: impl Fn() -> bool + Send + Sync + 'static) -> Self {
+        Cancel {
+            poll: Some(Box::new(poll)),
+            owner: Some(std::thread::current().id()),
+            ..Self::never()
+        }
+    }
+
+    /// Request cancellation; every later [`Cancel::check`] fails.
+    pub fn cancel(&self) {
+        self.flag.store(true, Ordering::Relaxed);
+    }
+
+    /// Whether cancellation was requested (without polling).
+    pub fn is_cancelled(&self) -> bool {
+        self.flag.load(Ordering::Relaxed)
+    }
+
+    /// `Err(Error::Interrupted)` once cancelled; polls when due on the owner thread.
+    pub fn check(&self) -> Result<()> {
+        if self.is_cancelled() {
+            return Err(Error::Interrupted);
+        }
+        if let (Some(poll), Some(owner)) = (&self.poll, self.owner) {
+            if std::thread::current().id() == owner {
+                let now = self.start.elapsed().as_nanos() as u64;
+                if now >= self.next_poll_ns.load(Ordering::Relaxed) {
+                    self.next_poll_ns
+                        .store(now + POLL_INTERVAL.as_nanos() as u64, Ordering::Relaxed);
+                    if poll() {
+                        self.cancel();
+                        return Err(Error::Interrupted);
+                    }
+                }
+            }
+        }
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::sync::atomic::AtomicUsize;
+    use std::sync::Arc;
+
+    #[test]
+    fn never_is_never_cancelled_until_asked() {
+        let c = Cancel::never();
+        assert!(c.check().is_ok());
+        c.cancel();
+        assert_eq!(c.check(), Err(Error::Interrupted));
+    }
+
+    #[test]
+    fn poll_runs_on_the_owner_thread_at_most_every_interval() {
+        let calls = Arc::new(AtomicUsize::new(0));
+        let k = calls.clone();
+        let c = Cancel::with_poll(move || k.fetch_add(1, Ordering::Relaxed) >= 1);
+        assert!(c.check().is_ok()); // first poll: false
+        assert!(c.check().is_ok()); // not due yet
+        assert_eq!(calls.load(Ordering::Relaxed), 1);
+        std::thread::scope(|s| {
+            s.spawn(|| assert!(c.check().is_ok())); // other thread: no poll
+        });
+        assert_eq!(calls.load(Ordering::Relaxed), 1);
+        std::thread::sleep(POLL_INTERVAL + Duration::from_millis(5));
+        assert_eq!(c.check(), Err(Error::Interrupted)); // second poll: true
+        std::thread::scope(|s| {
+            s.spawn(|| assert_eq!(c.check(), Err(Error::Interrupted))); // the flag is shared
+        });
+    }
+}
