@@ -252,8 +252,13 @@ pub fn p_poly(h: &[f64; 4], s: C) -> C {
 /// Errors: `h1² = 4 h0²` (to [`DEGENERATE_RTOL`]), i.e. `m = ±n`: (19) is not
 /// defined (and `f(s)` has fewer than four zeros).
 pub fn quartic_f(a: &[f64; 4], h: &[f64; 4]) -> Result<[f64; 5]> {
+    quartic_f_den(a, h, h[1] * h[1] - 4.0 * h[0] * h[0])
+}
+
+/// [`quartic_f`] with `h1² − 4h0²` given (from the state, `|m − n|² |m + n|²`
+/// keeps its relative accuracy where the difference of squares loses it).
+fn quartic_f_den(a: &[f64; 4], h: &[f64; 4], den: f64) -> Result<[f64; 5]> {
     let [h0, h1, h2, h3] = *h;
-    let den = h1 * h1 - 4.0 * h0 * h0;
     if den.abs() <= DEGENERATE_RTOL * h1 * h1 || h1 == 0.0 {
         return Err(Error::InvalidArgument {
             what: "state l",
@@ -344,9 +349,27 @@ pub fn quartic_roots(f: &[f64; 5]) -> Result<[C; 4]> {
     let scale = z.iter().fold(1.0f64, |m, v| m.max(v.norm()));
     // A cluster is reported as a repeated root even when the iteration has not
     // met its tolerance: Aberth converges only linearly to a multiple root.
-    for i in 0..4 {
-        for j in (i + 1)..4 {
-            if (z[i] - z[j]).norm() <= REPEATED_ROOT_RTOL * scale {
+    check_repeated(&z)?;
+    if !converged && last > ROOT_STAGNATION {
+        return Err(Error::NoConvergence {
+            what: "roots of F(s) (19)",
+            tol: ROOT_STAGNATION,
+            reached: last,
+            iterations: 500,
+        });
+    }
+    Ok(order_roots(z, scale))
+}
+
+/// Two roots closer than [`REPEATED_ROOT_RTOL`] times the larger of the two
+/// are a repeated root. Relative to the pair, not to the largest root: near
+/// the singular set `h1² = 4h0²` one or two roots of `F` grow like the
+/// inverse distance to it while the others stay of the size of the `a_i`.
+fn check_repeated(z: &[C]) -> Result<()> {
+    for i in 0..z.len() {
+        for j in (i + 1)..z.len() {
+            let pair = z[i].norm().max(z[j].norm());
+            if (z[i] - z[j]).norm() <= REPEATED_ROOT_RTOL * pair {
                 return Err(Error::InvalidArgument {
                     what: "state l",
                     reason: format!(
@@ -361,15 +384,7 @@ pub fn quartic_roots(f: &[f64; 5]) -> Result<[C; 4]> {
             }
         }
     }
-    if !converged && last > ROOT_STAGNATION {
-        return Err(Error::NoConvergence {
-            what: "roots of F(s) (19)",
-            tol: ROOT_STAGNATION,
-            reached: last,
-            iterations: 500,
-        });
-    }
-    Ok(order_roots(z, scale))
+    Ok(())
 }
 
 fn order_roots(z: [C; 4], scale: f64) -> [C; 4] {
@@ -500,7 +515,7 @@ pub fn kotter_constants(a: &[f64; 4], l: &[f64; 6]) -> Result<KotterConstants> {
             })
             .sum()
     });
-    constants_impl(a, &h, &p_at_a)
+    constants_impl(a, &h, &p_at_a, Some((m, n)))
 }
 
 /// [`kotter_constants`] from the integrals `h = (h0, h1, h2, h3)` directly.
@@ -511,20 +526,117 @@ pub fn kotter_constants(a: &[f64; 4], l: &[f64; 6]) -> Result<KotterConstants> {
 pub fn constants_from_h(a: &[f64; 4], h: &[f64; 4]) -> Result<KotterConstants> {
     check_finite("h", h)?;
     let p_at_a: [f64; 4] = std::array::from_fn(|i| (h[1] * a[i] - h[2]) * a[i] + h[3]);
-    constants_impl(a, h, &p_at_a)
+    constants_impl(a, h, &p_at_a, None)
 }
 
-/// The offsets `s_p − a_i` to full relative accuracy, and `P(s_p)`.
+/// What the polish of the roots of `F` needs of the level set: `a`, `h`,
+/// `h1² − 4h0²` and, when the reduction starts from a state, `(m, n)`
+/// themselves (then `P(s)` and `f(s)` are summed from the state, without the
+/// cancellation of the forms in `h`).
+struct Level<'a> {
+    a: &'a [f64; 4],
+    h: &'a [f64; 4],
+    mn: Option<([f64; 3], [f64; 3])>,
+    den: f64,
+}
+
+impl Level<'_> {
+    /// `P(s) = h1 s² − h2 s + h3` and `P'(s)` from the offsets `x_m = s − a_m`.
+    /// From the state, `P(s) = Σ_j (x_j x_4 m_j² + x_k x_l n_j²)`: the
+    /// offsets carry `s − a_m` to full relative accuracy, so `P` near a root of
+    /// `G` (where it is small) keeps its relative accuracy.
+    fn p_dp(&self, s: C, x: &[C; 4]) -> (C, C) {
+        match self.mn {
+            Some((m, n)) => {
+                let mut p = ZERO;
+                let mut dp = ZERO;
+                for (j, &(_, k, l)) in CYCLIC.iter().enumerate() {
+                    let (m2, n2) = (m[j] * m[j], n[j] * n[j]);
+                    p += x[j] * x[3] * m2 + x[k] * x[l] * n2;
+                    dp += (x[j] + x[3]) * m2 + (x[k] + x[l]) * n2;
+                }
+                (p, dp)
+            }
+            None => (p_poly(self.h, s), 2.0 * self.h[1] * s - self.h[2]),
+        }
+    }
+
+    /// `f(s) = Σ_j l_j(s)²` (14) on the branch `√G = sigma` and its size (the
+    /// sum of the magnitudes of its terms, for the convergence test). From the
+    /// state, `l_j(s) = √s_j4 (m_j + τ n_j) + n_j (s_kl − s_j4)/(√s_kl + τ √s_j4)`
+    /// with `τ = ±1` making the denominator the larger of `√s_kl ± √s_j4`:
+    /// near the singular set `m ≈ ∓n` and at large `|s|` the two terms of
+    /// `√s_j4 m_j + √s_kl n_j` cancel, this form does not.
+    fn f(&self, s: C, x: &[C; 4], sigma: C) -> (C, f64) {
+        match self.mn {
+            Some((m, n)) => {
+                let mut f = ZERO;
+                let mut size = 0.0;
+                for (j, &(_, k, l)) in CYCLIC.iter().enumerate() {
+                    let r = sqrt_principal(x[j] * x[3]);
+                    let q = sigma / r;
+                    let tau = if (q * r.conj()).re >= 0.0 { 1.0 } else { -1.0 };
+                    let lj = r * (m[j] + tau * n[j])
+                        + n[j] * (x[k] * x[l] - x[j] * x[3]) / (q + tau * r);
+                    f += lj * lj;
+                    size += (r.norm() * m[j].abs() + q.norm() * n[j].abs()).powi(2);
+                }
+                (f, size)
+            }
+            None => {
+                let (p, _) = self.p_dp(s, x);
+                let [h0, h1, h2, h3] = *self.h;
+                let size =
+                    (h1 * s * s).norm() + (h2 * s).norm() + h3.abs() + (2.0 * h0 * sigma).norm();
+                (p + 2.0 * h0 * sigma, size)
+            }
+        }
+    }
+}
+
+/// The offsets `x_m = s − a_m` with `s = a_i + t` (`i` the nearest `a`):
+/// `x_i = t`, `x_m = (a_i − a_m) + t`, to full relative accuracy when `t` is.
+fn offsets_at(a: &[f64; 4], i: usize, t: C) -> [C; 4] {
+    std::array::from_fn(|m| if m == i { t } else { (a[i] - a[m]) + t })
+}
+
+/// The continuation of the branch `√G(s)`: the root of `Π x_m` nearest `prev`.
+fn sqrt_g_near(x: &[C; 4], prev: C) -> C {
+    let r = sqrt_principal(x.iter().product());
+    if (r - prev).norm() <= (r + prev).norm() {
+        r
+    } else {
+        -r
+    }
+}
+
+/// A root of `F` (19) polished on its own branch, with what (20) needs there.
+struct PolishedRoot {
+    s: C,
+    /// `s − a_m`, full relative accuracy.
+    x: [C; 4],
+    /// `σ = √G(s)` on the branch where `f(s) = 0`.
+    sigma: C,
+    /// `F'(s) = f'(s) f̃(s) / (h1² − 4h0²)` with `f̃(s) = −4 h0 σ` (docs/kotter.md §3).
+    fprime: C,
+}
+
+/// Newton's method on `f(s) = P(s) + 2 h0 √G(s)` (15) itself, on the branch
+/// `√G = σ` that vanishes at the root (chosen from the starting value: the
+/// sign with the smaller `|f|`), in the offset `t = s − a_i` from the
+/// nearest `a_i`. `F = f f̃/(h1² − 4h0²)` merges the two branches: when two
+/// roots of `F` lie on different branches `δ` apart, `F'(s_p) ~ δ` and the
+/// quartic's root is good to `u/δ` only, while `f'(s_p)` is not small.
 ///
-/// When `s_p` is nearer to `a_i` than a tenth of the distance from `a_i` to the
-/// other `a`'s, `t = s_p − a_i` is re-solved by Newton's method on
-/// `(P(a_i) + P'(a_i) t + h1 t²)² − 4 h0² t Π_{m≠i}(a_i − a_m + t) = 0`
-/// (the numerator of (19) at `s = a_i + t`, using `G(a_i) = 0`), whose terms
-/// are all of the size of `t`; the other offsets are `(a_i − a_m) + t`.
-fn root_offsets(a: &[f64; 4], h: &[f64; 4], p_at_a: &[f64; 4], sp: C) -> ([C; 4], C) {
+/// Near `a_i`, where `√G ~ √t` is not smooth, the start is first refined on
+/// `(P(a_i) + P'(a_i) t + h1 t²)² − 4h0² t Π_{m≠i}(a_i − a_m + t)` (the
+/// numerator of (19) at `s = a_i + t`, all terms of the size of `t`).
+fn polish_root(lv: &Level, p_at_a: &[f64; 4], s0: C) -> PolishedRoot {
+    let a = lv.a;
+    let [h0, h1, h2, _] = *lv.h;
     let mut best = 0;
     for i in 1..4 {
-        if (sp - a[i]).norm() < (sp - a[best]).norm() {
+        if (s0 - a[i]).norm() < (s0 - a[best]).norm() {
             best = i;
         }
     }
@@ -533,42 +645,103 @@ fn root_offsets(a: &[f64; 4], h: &[f64; 4], p_at_a: &[f64; 4], sp: C) -> ([C; 4]
         .filter(|&m| m != best)
         .map(|m| (a[m] - ai).abs())
         .fold(f64::INFINITY, f64::min);
-    let plain = |s: C| -> ([C; 4], C) { (std::array::from_fn(|m| s - a[m]), p_poly(h, s)) };
-    if (sp - ai).norm() >= 0.1 * gap {
-        return plain(sp);
-    }
-    let [h0, h1, h2, _] = *h;
-    let pa = p_at_a[best];
-    let dpa = 2.0 * h1 * ai - h2;
-    let mut t = sp - ai;
-    for _ in 0..4 {
-        let pt = pa + (h1 * t + dpa) * t;
-        let dpt = dpa + 2.0 * h1 * t;
-        let mut prod = ONE;
-        let mut dprod = ZERO;
-        for m in (0..4).filter(|&m| m != best) {
-            let f = ai - a[m] + t;
-            dprod = dprod * f + prod;
-            prod *= f;
-        }
-        let val = pt * pt - 4.0 * h0 * h0 * t * prod;
-        let der = 2.0 * pt * dpt - 4.0 * h0 * h0 * (prod + t * dprod);
-        if der == ZERO {
-            break;
-        }
-        let step = val / der;
-        t -= step;
-        if step.norm() <= f64::EPSILON * t.norm() {
-            break;
+    let mut t = s0 - ai;
+    if t.norm() < 0.1 * gap {
+        let pa = p_at_a[best];
+        let dpa = 2.0 * h1 * ai - h2;
+        for _ in 0..4 {
+            let pt = pa + (h1 * t + dpa) * t;
+            let dpt = dpa + 2.0 * h1 * t;
+            let mut prod = ONE;
+            let mut dprod = ZERO;
+            for m in (0..4).filter(|&m| m != best) {
+                let f = ai - a[m] + t;
+                dprod = dprod * f + prod;
+                prod *= f;
+            }
+            let val = pt * pt - 4.0 * h0 * h0 * t * prod;
+            let der = 2.0 * pt * dpt - 4.0 * h0 * h0 * (prod + t * dprod);
+            if der == ZERO || !(val / der).norm().is_finite() {
+                break;
+            }
+            let step = val / der;
+            t -= step;
+            if step.norm() <= f64::EPSILON * t.norm() {
+                break;
+            }
         }
     }
-    let diffs = std::array::from_fn(|m| if m == best { t } else { (ai - a[m]) + t });
-    (diffs, pa + (h1 * t + dpa) * t)
+    // the branch: of ±√G(s0), the one on which f is the smaller
+    let x0 = offsets_at(a, best, t);
+    let g0 = sqrt_principal(x0.iter().product());
+    let (fp, _) = lv.f(ai + t, &x0, g0);
+    let (fm, _) = lv.f(ai + t, &x0, -g0);
+    let mut sigma = if fp.norm() <= fm.norm() { g0 } else { -g0 };
+    let mut cur = (t, x0, sigma);
+    let (f_cur, size) = lv.f(ai + t, &x0, sigma);
+    let mut res_best = f_cur.norm() / size.max(f64::MIN_POSITIVE);
+    let mut best_state = cur;
+    for _ in 0..8 {
+        let (t, x, sg) = cur;
+        let s = ai + t;
+        let (f, _) = lv.f(s, &x, sg);
+        let (_, dp) = lv.p_dp(s, &x);
+        // f' = P' + h0 G'/√G = P' + h0 σ Σ_m 1/(s − a_m)
+        let df = dp + h0 * sg * x.iter().map(|&xm| ONE / xm).sum::<C>();
+        let step = f / df;
+        if !(step.re.is_finite() && step.im.is_finite()) {
+            break;
+        }
+        let tn = t - step;
+        let xn = offsets_at(a, best, tn);
+        sigma = sqrt_g_near(&xn, sg);
+        cur = (tn, xn, sigma);
+        let (fn_, size) = lv.f(ai + tn, &xn, sigma);
+        let res = fn_.norm() / size.max(f64::MIN_POSITIVE);
+        if res < res_best {
+            res_best = res;
+            best_state = cur;
+        }
+        if step.norm() <= 2.0 * f64::EPSILON * (ai + tn).norm().max(tn.norm()) || res == 0.0 {
+            break;
+        }
+    }
+    let (t, x, sigma) = best_state;
+    let s = ai + t;
+    let (_, dp) = lv.p_dp(s, &x);
+    let df = dp + h0 * sigma * x.iter().map(|&xm| ONE / xm).sum::<C>();
+    PolishedRoot {
+        s,
+        x,
+        sigma,
+        fprime: df * (-4.0 * h0 * sigma) / lv.den,
+    }
 }
 
-fn constants_impl(a: &[f64; 4], h: &[f64; 4], p_at_a: &[f64; 4]) -> Result<KotterConstants> {
+/// `h1² − 4h0² = |m − n|² |m + n|²` from the state: the difference of squares
+/// in `h` loses all its digits near the singular set `m = ±n`, this product
+/// does not.
+fn den_from_state(m: &[f64; 3], n: &[f64; 3]) -> f64 {
+    let (mut dm, mut dp) = (0.0, 0.0);
+    for j in 0..3 {
+        dm += (m[j] - n[j]) * (m[j] - n[j]);
+        dp += (m[j] + n[j]) * (m[j] + n[j]);
+    }
+    dm * dp
+}
+
+fn constants_impl(
+    a: &[f64; 4],
+    h: &[f64; 4],
+    p_at_a: &[f64; 4],
+    mn: Option<([f64; 3], [f64; 3])>,
+) -> Result<KotterConstants> {
     check_a(a)?;
-    let f = quartic_f(a, h)?;
+    let den = match mn {
+        Some((m, n)) => den_from_state(&m, &n),
+        None => h[1] * h[1] - 4.0 * h[0] * h[0],
+    };
+    let f = quartic_f_den(a, h, den)?;
     if h[0] == 0.0 || h[0].abs() <= DEGENERATE_RTOL * h[1] {
         return Err(Error::InvalidArgument {
             what: "state l",
@@ -579,17 +752,46 @@ fn constants_impl(a: &[f64; 4], h: &[f64; 4], p_at_a: &[f64; 4]) -> Result<Kotte
             ),
         });
     }
-    let s = quartic_roots(&f)?;
+    let s0 = quartic_roots(&f)?;
+    let lv = Level { a, h, mn, den };
+    let mut roots: Vec<PolishedRoot> = Vec::with_capacity(4);
+    for p in 0..4 {
+        // the partner of a conjugate pair is polished as the exact conjugate
+        if p % 2 == 1 && s0[p] == s0[p - 1].conj() && s0[p].im != 0.0 {
+            let r = &roots[p - 1];
+            roots.push(PolishedRoot {
+                s: r.s.conj(),
+                x: r.x.map(|v| v.conj()),
+                sigma: r.sigma.conj(),
+                fprime: r.fprime.conj(),
+            });
+        } else {
+            roots.push(polish_root(&lv, p_at_a, s0[p]));
+        }
+    }
+    check_repeated(&roots.iter().map(|r| r.s).collect::<Vec<_>>())?;
+    let s: [C; 4] = std::array::from_fn(|p| roots[p].s);
     let scale_a = a.iter().fold(1.0f64, |m, v| m.max(v.abs()));
     let mut sigma = [ZERO; 4];
     let mut sqrt_fp = [ZERO; 4];
     let mut u = [[ZERO; 3]; 4];
     let mut v = [[ZERO; 3]; 4];
     for p in 0..4 {
-        // (conjugate roots give exactly conjugate offsets: the arithmetic is symmetric)
-        let (diff, p_sp) = root_offsets(a, h, p_at_a, s[p]);
-        sigma[p] = -p_sp / (2.0 * h[0]);
-        sqrt_fp[p] = sqrt_principal(horner(&f, s[p]).1);
+        let diff = roots[p].x;
+        sigma[p] = roots[p].sigma;
+        sqrt_fp[p] = sqrt_principal(roots[p].fprime);
+        if !(sqrt_fp[p].norm().is_finite() && sqrt_fp[p].norm() > 0.0) {
+            return Err(Error::InvalidArgument {
+                what: "state l",
+                reason: format!(
+                    "F'(s_{}) = {} (19) at the root s_{} = {} is zero or not finite",
+                    p + 1,
+                    roots[p].fprime,
+                    p + 1,
+                    s[p]
+                ),
+            });
+        }
         for (j, &aj) in a.iter().enumerate() {
             // the offsets are accurate to a few ulps relative (root_offsets):
             // only a root indistinguishable from a_j in double precision is 0/0
