@@ -355,21 +355,25 @@ impl KotterCurve {
         eps: Option<[i8; 5]>,
     ) -> Result<Wurzel> {
         let (z1, z2) = (p1.z, p2.z);
-        if z1 == z2 {
-            return Err(Error::InvalidArgument {
-                what: "points (z1, z2)",
-                reason: format!(
-                    "z1 == z2 == {z1}: P_jk (28) divides by z1 - z2 and is undefined \
-                     (a pole, or a 0/0 when y1 == y2)"
-                ),
-            });
-        }
         let eps = match eps {
             None => [1.0; 5],
             Some(e) => check_eps(e)?,
         };
         let r1 = self.roots_from_offsets(&p1.zd, p1.y);
         let r2 = self.roots_from_offsets(&p2.zd, p2.y);
+        // z1 == z2: the telescoped (28) is the tangent limit when the two points
+        // are the same point of the curve (same roots, none zero); with
+        // y1 = -y2 it is a pole, at a branch point 0/0.
+        if z1 == z2 && (r1 != r2 || r1.iter().any(|&v| v == Complex64::new(0.0, 0.0))) {
+            return Err(Error::InvalidArgument {
+                what: "points (z1, z2)",
+                reason: format!(
+                    "z1 == z2 == {z1} on different sheets or at a branch point: P_jk (28) \
+                     divides by z1 - z2 (a pole, or 0/0 at a branch point); the same point \
+                     twice (y1 == y2) is its tangent limit"
+                ),
+            });
+        }
         Ok(wurzel_from_roots(&r1, &r2, z1 - z2, &eps))
     }
 
@@ -852,7 +856,29 @@ fn quadratic_roots(s: Complex64, p: Complex64) -> Result<(Complex64, Complex64)>
     Ok((z1, p / z1))
 }
 
+/// `(A − B)/(z1 − z2)` for one factor of (28), `A − B = ±(r1 − r2)` with
+/// `r_i² = z_i − d_j`: telescoped, `(r1 − r2)/(z1 − z2) = 1/(r1 + r2)`, when
+/// the two roots lie on the same side (`|r1 + r2| ≥ |r1 − r2|`: no
+/// cancellation, and finite at `z1 = z2`); the plain quotient otherwise
+/// (then `r1 − r2` does not cancel).
+fn factor_quotient(r1: Complex64, r2: Complex64, dz: Complex64) -> Complex64 {
+    let sum = r1 + r2;
+    if sum.norm() >= (r1 - r2).norm() && sum != Complex64::new(0.0, 0.0) {
+        1.0 / sum
+    } else {
+        (r1 - r2) / dz
+    }
+}
+
 /// (27)–(28) from the canonical roots of the two points, in the branch `eps`.
+///
+/// `P_jk = eps_j eps_k (a − b)/(z1 − z2)` with `a = Π_i A_i`, `b = Π_i B_i`,
+/// `A = (r_j(z2), r_k(z2), r_m(z1) …)`, `B = (r_j(z1), r_k(z1), r_m(z2) …)`
+/// (`m ∉ {j, k}`), is evaluated as the telescoped sum
+/// `Σ_i A_1 … A_{i−1} · (A_i − B_i)/(z1 − z2) · B_{i+1} … B_5`, each quotient
+/// by [`factor_quotient`]: for two points on one sheet with `z1 ≈ z2` the
+/// difference `a − b` loses `u/|z1 − z2|`, the telescoped form does not, and
+/// at `z1 = z2` (same `y`) it is the tangent limit (`dz` is not used then).
 fn wurzel_from_roots(
     r1: &[Complex64; 5],
     r2: &[Complex64; 5],
@@ -860,18 +886,43 @@ fn wurzel_from_roots(
     eps: &[f64; 5],
 ) -> Wurzel {
     let zero = Complex64::new(0.0, 0.0);
+    let one = Complex64::new(1.0, 0.0);
     let p: [Complex64; 5] = std::array::from_fn(|j| eps[j] * r1[j] * r2[j]);
     let mut pjk = [[zero; 5]; 5];
     for j in 0..5 {
         for k in (j + 1)..5 {
-            let (mut rho1, mut rho2) = (Complex64::new(1.0, 0.0), Complex64::new(1.0, 0.0));
+            // factors in the order j, k, then the complement
+            let mut idx = [j, k, 0, 0, 0];
+            let mut n = 2;
             for m in (0..5).filter(|&m| m != j && m != k) {
-                rho1 *= r1[m];
-                rho2 *= r2[m];
+                idx[n] = m;
+                n += 1;
             }
-            let a = r2[j] * r2[k] * rho1;
-            let b = r1[j] * r1[k] * rho2;
-            let v = eps[j] * eps[k] * (a - b) / dz;
+            let fa: [Complex64; 5] =
+                std::array::from_fn(|i| if i < 2 { r2[idx[i]] } else { r1[idx[i]] });
+            let fb: [Complex64; 5] =
+                std::array::from_fn(|i| if i < 2 { r1[idx[i]] } else { r2[idx[i]] });
+            // (A_i − B_i)/(z1 − z2): for i < 2, A − B = r2 − r1 = −(r1 − r2)
+            let q: [Complex64; 5] = std::array::from_fn(|i| {
+                let m = idx[i];
+                let v = factor_quotient(r1[m], r2[m], dz);
+                if i < 2 {
+                    -v
+                } else {
+                    v
+                }
+            });
+            let mut suffix = [one; 6];
+            for i in (0..5).rev() {
+                suffix[i] = suffix[i + 1] * fb[i];
+            }
+            let mut prefix = one;
+            let mut sum = zero;
+            for i in 0..5 {
+                sum += prefix * q[i] * suffix[i + 1];
+                prefix *= fa[i];
+            }
+            let v = eps[j] * eps[k] * sum;
             pjk[j][k] = v;
             pjk[k][j] = v;
         }

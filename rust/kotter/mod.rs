@@ -838,7 +838,15 @@ fn constants_impl(
                 ),
             });
         }
-        sqrt_d[j] = (dd[0][j] - I * dd[1][j]) / d3;
+        // (26) both halves: √d_j = (Δ1 − iΔ2)/Δ3 = −Δ3/(Δ1 + iΔ2), since
+        // (Δ1 − iΔ2)(Δ1 + iΔ2) = −Δ3². A small (or large) d_j is a cancellation
+        // in one of Δ1 ∓ iΔ2; the other, larger one keeps full accuracy.
+        let (minus, plus) = (dd[0][j] - I * dd[1][j], dd[0][j] + I * dd[1][j]);
+        sqrt_d[j] = if minus.norm() >= plus.norm() {
+            minus / d3
+        } else {
+            -d3 / plus
+        };
         d[j] = sqrt_d[j] * sqrt_d[j];
         let (u1, v1, u2, v2) = (u[0][j], v[0][j], u[1][j], v[1][j]);
         alpha[j] = (v2 + I * v1) / (2.0 * d3);
