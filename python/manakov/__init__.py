@@ -8,7 +8,7 @@ Equation numbers in docstrings are the paper's.
 from ._core import ConvergenceError, __version__
 from .curve import CurvePoints, KotterCurve, Wurzel
 from .problems import Problem, benchmark_setup, problem, problem_names
-from .reduction import Kotter, from_kotter, kotter
+from .reduction import Kotter, LevelSet, from_kotter, kotter
 from .theta import (
     CHARACTERISTICS,
     PAPER_CHARACTERISTICS,
@@ -42,6 +42,7 @@ __all__ = [
     "from_matrix",
     "kotter",
     "Kotter",
+    "LevelSet",
     "KotterCurve",
     "ManakovTop",
     "METHODS",

@@ -154,7 +154,10 @@ def kotter_quartic(
     a: npt.NDArray[np.float64], h: npt.NDArray[np.float64]
 ) -> npt.NDArray[np.float64]: ...
 def kotter_batch(
-    a: npt.NDArray[np.float64], l: npt.NDArray[np.float64]
+    a: npt.NDArray[np.float64],
+    l: npt.NDArray[np.float64],
+    l0: npt.NDArray[np.float64] | None = None,
+    mask: bool = False,
 ) -> dict[str, npt.NDArray[np.generic]]: ...
 def kotter_from_points(
     alpha: npt.NDArray[np.complex128],

@@ -35,6 +35,7 @@ from .curve import KotterCurve
 
 __all__ = [
     "Kotter",
+    "LevelSet",
     "from_kotter",
     "integrals",
     "kotter",
@@ -303,6 +304,13 @@ class Kotter:
     curve : KotterCurve or ndarray of KotterCurve
         The curve (8) with these ``d_j``; for a batch an object array of
         shape ``S`` (``None`` entries if ``manakov.KotterCurve`` is unavailable).
+    ok : bool or ndarray of bool
+        Which states were reduced (all ``True`` unless ``errors="mask"`` was
+        passed to :func:`kotter`; the fields of a failed row are NaN and its
+        ``curve`` is ``None``).
+    a, b : ndarray (4,) or None
+        The top the states belong to; :func:`from_kotter` refuses a ``Kotter``
+        of another top.
     zd : ndarray (2, 5) complex or None
         The offsets of the points from the branch points,
         ``zd[i-1, j] = z_i - d_j`` (``d_0 = 0``, ``d_4 = d1 d2 d3``), to full
@@ -342,6 +350,9 @@ class Kotter:
     branch: np.ndarray
     curve: Any
     zd: Any = None
+    ok: Any = True
+    a: Any = None
+    b: Any = None
 
     def __post_init__(self) -> None:
         # Read-only like the curve's outputs: a Kotter describes one level set and
@@ -384,44 +395,17 @@ _FIELD_SHAPES = {
     "y2": (),
     "branch": (5,),
     "zd": (2, 5),
+    "ok": (),
 }
 
 
 def _make_curve(d: np.ndarray) -> Any:
+    if not np.all(np.isfinite(d)):
+        return None  # a row that failed with errors="mask"
     return KotterCurve(complex(d[0]), complex(d[1]), complex(d[2]))
 
 
-def kotter(a: Any, b: Any, l: Any) -> Kotter:
-    """Schottky-Kötter coordinates of states ``l`` of the top ``(a, b)``.
-
-    Computes (12)-(26), (38)-(42) and the points of the curve (37) for each
-    state; see :class:`Kotter` for the fields and ``docs/kotter.md`` for every
-    convention. Only ``a`` and the state enter: ``b`` (checked) fixes the
-    time evolution, not the reduction.
-
-    Parameters
-    ----------
-    a, b : array_like, shape (4,)
-        Manakov parameters (2), ``a`` distinct.
-    l : array_like, shape (..., 6)
-        States ``(l12, l13, l14, l23, l24, l34)``.
-
-    Returns
-    -------
-    Kotter
-
-    Raises
-    ------
-    ValueError
-        Non-finite input; ``max |l_ij|`` outside :data:`STATE_RANGE` (rescale
-        l); repeated ``a_i``; ``h0 = 0`` or ``h1^2 = 4 h0^2``
-        (``F`` (19) undefined or with double roots); repeated roots of ``F``;
-        a root of ``F`` at some ``a_j``; coinciding branch points ``d_j`` of
-        the curve (its genus drops); ``z1 = z2``; ``1 - eps P_0 = 0``.
-    """
-    a = _check_a(a)
-    _check_b(b)
-    flat, shape = _states(l)
+def _check_range(flat: np.ndarray) -> None:
     size = np.max(np.abs(flat), axis=1, initial=0.0)
     bad = (size > 0) & ((size < STATE_RANGE[0]) | (size > STATE_RANGE[1]))
     if np.any(bad):
@@ -430,7 +414,17 @@ def kotter(a: Any, b: Any, l: Any) -> Kotter:
             f"{STATE_RANGE[1]:e}] where the integrals (~|l|^2) and the coefficients of "
             "F (19) (~|l|^4) neither overflow nor underflow: rescale l"
         )
-    raw = _core.kotter_batch(a, flat)
+
+
+def _errors_mask(errors: str) -> bool:
+    if errors not in ("raise", "mask"):
+        raise ValueError(f'errors must be "raise" or "mask", got {errors!r}')
+    return errors == "mask"
+
+
+def _build(
+    a: np.ndarray, b: np.ndarray, flat: np.ndarray, shape: tuple[int, ...], raw: Any
+) -> Kotter:
     fields: dict[str, Any] = {}
     for name, fshape in _FIELD_SHAPES.items():
         arr = np.asarray(raw[name]).reshape(shape + fshape)
@@ -449,7 +443,174 @@ def kotter(a: Any, b: Any, l: Any) -> Kotter:
         carr = carr.reshape(shape)
         carr.setflags(write=False)
         fields["curve"] = carr
+    fields["a"] = a.copy()
+    fields["b"] = b.copy()
+    if shape == ():
+        fields["ok"] = bool(fields["ok"])
     return Kotter(**fields)
+
+
+def kotter(a: Any, b: Any, l: Any, *, errors: str = "raise") -> Kotter:
+    """Schottky-Kötter coordinates of states ``l`` of the top ``(a, b)``.
+
+    Computes (12)-(26), (38)-(42) and the points of the curve (37) for each
+    state; see :class:`Kotter` for the fields and ``docs/kotter.md`` for every
+    convention. Only ``a`` and the state enter: ``b`` (checked, and recorded
+    in the result with ``a``) fixes the time evolution, not the reduction.
+
+    For one-off use: each state gets the constants of its own level set, with
+    the branch choices documented in docs/kotter.md (roots of F ordered as in
+    :class:`Kotter`, principal ``sqrt(F'(s_p))``, ``sqrt(c_j)`` and
+    ``sqrt(h0/K)``). Along a trajectory these choices can flip between samples
+    (the divisor then jumps to its hyperelliptic-involution image); use
+    :class:`LevelSet` there, which fixes them once per level set.
+
+    Parameters
+    ----------
+    a, b : array_like, shape (4,)
+        Manakov parameters (2), ``a`` distinct.
+    l : array_like, shape (..., 6)
+        States ``(l12, l13, l14, l23, l24, l34)``.
+    errors : {"raise", "mask"}, keyword-only
+        ``"raise"`` (default): the first state that cannot be reduced raises,
+        with its row index (in the flattened batch) in the message. ``"mask"``:
+        such rows get NaN fields, ``curve`` ``None`` and ``Kotter.ok`` false.
+
+    Returns
+    -------
+    Kotter
+
+    Raises
+    ------
+    ValueError
+        Non-finite input; ``max |l_ij|`` outside :data:`STATE_RANGE` (rescale
+        l); repeated ``a_i``; ``h0 = 0`` or ``h1^2 = 4 h0^2``
+        (``F`` (19) undefined or with double roots); repeated roots of ``F``;
+        a root of ``F`` at some ``a_j``; coinciding branch points ``d_j`` of
+        the curve (its genus drops); ``z1 = z2``; ``1 - eps P_0 = 0``.
+    """
+    a = _check_a(a)
+    b = _check_b(b)
+    mask = _errors_mask(errors)
+    flat, shape = _states(l)
+    _check_range(flat)
+    raw = _core.kotter_batch(a, flat, None, mask)
+    return _build(a, b, flat, shape, raw)
+
+
+class LevelSet:
+    """One level set of the top ``(a, b)``: Kötter's constants fixed once, from ``l0``.
+
+    The constants of the reduction (the roots ``s_p`` of F (19) and their
+    order, ``sigma_p``, ``sqrt(F'(s_p))``, ``d_j`` (26), ``alpha_j .. delta_j``
+    (24), ``K``, ``eps`` (40)-(41)) depend only on ``a`` and the integrals, so
+    they belong to the level set, not to the state. :func:`kotter` recomputes
+    them (and makes its branch choices) state by state; on curves whose
+    ``c_j`` are negative reals carrying a rounding-noise imaginary part, those
+    choices flip between neighbouring samples of a trajectory and the divisor
+    jumps to its hyperelliptic-involution image. ``LevelSet.kotter`` computes
+    them once from ``l0`` and maps every state with the same ones: ``xi, eta``
+    (22) are then linear in ``l`` and ``g = sqrt(h0/K)/(1 - eps P_0)`` (42)
+    a fixed branch, so the divisor moves continuously along a trajectory.
+
+    Parameters
+    ----------
+    a, b : array_like, shape (4,)
+        Manakov parameters (2), ``a`` distinct.
+    l0 : array_like, shape (6,)
+        A state on the level set (its integrals ``h`` fix it).
+
+    Raises
+    ------
+    ValueError
+        As :func:`kotter` for ``l0``.
+
+    Examples
+    --------
+    >>> import manakov
+    >>> p = manakov.problem("generic")
+    >>> ls = manakov.LevelSet(p.a, p.b, p.l0)
+    >>> k = ls.kotter(p.l0)
+    >>> bool(abs(k.z1 - k.z2) > 0)
+    True
+    """
+
+    def __init__(self, a: Any, b: Any, l0: Any) -> None:
+        self._a = _check_a(a)
+        self._b = _check_b(b)
+        flat, shape = _states(l0)
+        if shape != ():
+            raise ValueError(f"l0 must have shape (6,), got {shape + (6,)}")
+        _check_range(flat)
+        self._l0 = flat[0].copy()
+        self._l0.setflags(write=False)
+        # the constants once (also validates l0); kept as the Kotter of l0
+        self._k0 = _build(
+            self._a, self._b, flat[0], (), _core.kotter_batch(self._a, flat, self._l0, False)
+        )
+
+    @property
+    def a(self) -> np.ndarray:
+        """The top's ``a``."""
+        return self._a.copy()
+
+    @property
+    def b(self) -> np.ndarray:
+        """The top's ``b``."""
+        return self._b.copy()
+
+    @property
+    def l0(self) -> np.ndarray:
+        """The state that fixed the constants (read-only)."""
+        return self._l0
+
+    @property
+    def h(self) -> np.ndarray:
+        """The integrals ``(h0, h1, h2, h3)`` of the level set."""
+        return np.asarray(self._k0.h)
+
+    @property
+    def d(self) -> np.ndarray:
+        """The branch points ``d_1, d_2, d_3`` (26) of the level set's curve (8)."""
+        return np.asarray(self._k0.d)
+
+    @property
+    def curve(self) -> KotterCurve:
+        """The level set's curve (8)."""
+        c: KotterCurve = self._k0.curve
+        return c
+
+    def kotter(self, l: Any, *, errors: str = "raise") -> Kotter:
+        """Kötter coordinates of states ``l`` on this level set, with its fixed constants.
+
+        Same fields as :func:`manakov.kotter`; every constant field equals that
+        of ``l0``. For a batch, the rows are taken as consecutive samples (of a
+        trajectory, in time order): each row's pair of points is ordered to
+        follow the previous successful row (the pair is unordered; ``xi, eta``,
+        ``g`` and ``branch`` do not depend on the order).
+
+        Parameters
+        ----------
+        l : array_like, shape (..., 6)
+            States on the level set.
+        errors : {"raise", "mask"}, keyword-only
+            ``"raise"``: the first failing row raises (its index in the
+            message); ``"mask"``: failing rows are NaN and ``Kotter.ok`` false.
+
+        Raises
+        ------
+        ValueError
+            A state not on the level set (integrals differing by more than
+            1e-6 relative), or as :func:`manakov.kotter`.
+        """
+        mask = _errors_mask(errors)
+        flat, shape = _states(l)
+        _check_range(flat)
+        raw = _core.kotter_batch(self._a, flat, self._l0, mask)
+        return _build(self._a, self._b, flat, shape, raw)
+
+    def __repr__(self) -> str:
+        return f"LevelSet(a={self._a.tolist()}, b={self._b.tolist()}, l0={self._l0.tolist()})"
 
 
 def from_kotter(a: Any, b: Any, k: Kotter) -> np.ndarray:
@@ -480,10 +641,18 @@ def from_kotter(a: Any, b: Any, k: Kotter) -> np.ndarray:
     TypeError
         ``k`` is not a :class:`Kotter`.
     """
-    _check_a(a)
-    _check_b(b)
+    a = _check_a(a)
+    b = _check_b(b)
     if not isinstance(k, Kotter):
         raise TypeError(f"k must be a manakov.Kotter, got {type(k).__name__}")
+    for name, mine, theirs in (("a", a, k.a), ("b", b, k.b)):
+        if theirs is not None and not np.array_equal(np.asarray(theirs, dtype=float), mine):
+            raise ValueError(
+                f"k comes from another top: its {name} = {np.asarray(theirs).tolist()}, "
+                f"this top's {name} = {mine.tolist()}"
+            )
+    if not np.all(np.asarray(k.ok)):
+        raise ValueError("k has rows that failed (Kotter.ok is False): nothing to invert there")
     if np.any(np.asarray(k.g) == 0):
         raise ValueError("g = 0: g = 1/(1 - eps P_0) (42) never vanishes")
     z1 = np.asarray(k.z1, dtype=complex)

@@ -443,6 +443,8 @@ fn order_roots(z: [C; 4], scale: f64) -> [C; 4] {
 /// constant along a trajectory; `ξ, η` ([`xi_eta`]) carry the time dependence.
 #[derive(Debug, Clone, PartialEq)]
 pub struct KotterConstants {
+    /// The top's `a` (2): the constants belong to the level set of `(a, h)`.
+    pub a: [f64; 4],
     /// `(h0, h1, h2, h3)` ([`integrals`]).
     pub h: [f64; 4],
     /// Roots `s_1 … s_4` of `F` (19), in the documented order.
@@ -862,6 +864,7 @@ fn constants_impl(
     }
     let (a_coef, b_coef, abgd39, eps, k) = h0_structure(&alpha, &beta, &gamma, &delta, &d)?;
     Ok(KotterConstants {
+        a: *a,
         h: *h,
         s,
         sigma,
@@ -1184,6 +1187,75 @@ pub fn kotter_with(constants: KotterConstants, l: &[f64; 6]) -> Result<KotterSta
         p0,
         points,
     })
+}
+
+/// States whose integrals differ from the level set's by more than
+/// `LEVEL_SET_RTOL` (relative to `h1` and its powers, see [`on_level_set`])
+/// are not on it: a trajectory integrated at `rtol = 1e-10` drifts by
+/// ~1e-10 over long runs, a state of another level set by O(1).
+pub const LEVEL_SET_RTOL: f64 = 1e-6;
+
+/// Checks that `l` lies on the level set of `constants` (to [`LEVEL_SET_RTOL`]):
+/// `|h_i(l) − h_i| ≤ LEVEL_SET_RTOL · h1 · A^{max(i−1, 0)}`, `A = max(1, max|a_j|)`
+/// (`h0`, `h1` are quadratic in `l`; `h2`, `h3` carry one and two powers of `a`).
+pub fn on_level_set(constants: &KotterConstants, l: &[f64; 6]) -> Result<()> {
+    check_finite("l", l)?;
+    let h = integrals(&constants.a, l);
+    let amax = constants.a.iter().fold(1.0f64, |m, v| m.max(v.abs()));
+    let h1 = constants.h[1].abs().max(h[1].abs());
+    for i in 0..4 {
+        let scale = h1 * amax.powi((i as i32 - 1).max(0));
+        let miss = (h[i] - constants.h[i]).abs();
+        if miss.is_nan() || miss > LEVEL_SET_RTOL * scale {
+            return Err(Error::InvalidArgument {
+                what: "state l",
+                reason: format!(
+                    "it is not on this level set: h{i}(l) = {:e} differs from the level set's \
+                     h{i} = {:e} by {miss:e} > {LEVEL_SET_RTOL:e} * {scale:e}",
+                    h[i], constants.h[i]
+                ),
+            });
+        }
+    }
+    Ok(())
+}
+
+/// Exchanges the two points of `cur` when that brings them nearer to those
+/// of `prev` (the pair is unordered; (27)–(28) and with them `ξ, η`, `g`,
+/// `eps` are symmetric in the two points).
+pub fn follow_order(prev: &WurzelPoints, cur: &mut WurzelPoints) {
+    let same = (cur.z1 - prev.z1).norm() + (cur.z2 - prev.z2).norm();
+    let swapped = (cur.z1 - prev.z2).norm() + (cur.z2 - prev.z1).norm();
+    if swapped < same {
+        std::mem::swap(&mut cur.z1, &mut cur.z2);
+        std::mem::swap(&mut cur.y1, &mut cur.y2);
+        std::mem::swap(&mut cur.zd1, &mut cur.zd2);
+    }
+}
+
+/// One branch per level set: the states `l` (e.g. samples of a trajectory,
+/// in time order) mapped with the constants of one level set, fixed once
+/// (`kotter_constants(a, l0)`), by [`kotter_with`]. The roots' order, `σ_p`,
+/// `√F'(s_p)`, `√c_j`, `K` and with them `ξ, η` (linear in `l`) and
+/// `g = √(h0/K)/(1 − εP_0)` (42) are then the same functions of `l` at every
+/// sample, so the divisor moves continuously along a trajectory and never
+/// jumps to its hyperelliptic-involution image. Each row's point pair is
+/// ordered to follow the previous successful row ([`follow_order`]).
+///
+/// Per row: the error of [`on_level_set`] or [`kotter_with`].
+pub fn kotter_along(constants: &KotterConstants, rows: &[[f64; 6]]) -> Vec<Result<KotterState>> {
+    let mut prev: Option<WurzelPoints> = None;
+    rows.iter()
+        .map(|l| {
+            on_level_set(constants, l)?;
+            let mut st = kotter_with(constants.clone(), l)?;
+            if let Some(p) = &prev {
+                follow_order(p, &mut st.points);
+            }
+            prev = Some(st.points);
+            Ok(st)
+        })
+        .collect()
 }
 
 /// The inverse of [`kotter`]: the state `l` from the curve's points, `g`

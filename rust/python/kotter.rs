@@ -91,20 +91,106 @@ fn kotter_quartic_py<'py>(
     Ok(stack(res?)?.into_pyarray(py).into_any())
 }
 
+/// A state whose every field is NaN (the rows that failed, with `errors="mask"`).
+fn nan_state() -> PyResult<kotter::KotterState> {
+    let n = C::new(f64::NAN, f64::NAN);
+    let constants = kotter::KotterConstants {
+        a: [f64::NAN; 4],
+        h: [f64::NAN; 4],
+        s: [n; 4],
+        sigma: [n; 4],
+        sqrt_fprime: [n; 4],
+        u: [[n; 3]; 4],
+        v: [[n; 3]; 4],
+        delta_det: [[n; 3]; 3],
+        sqrt_d: [n; 3],
+        d: [n; 3],
+        alpha: [n; 3],
+        beta: [n; 3],
+        gamma: [n; 3],
+        delta: [n; 3],
+        a_coef: [n; 3],
+        b_coef: [n; 3],
+        abgd39: [n; 4],
+        eps: n,
+        k: n,
+    };
+    // any regular curve: the rows' curves are rebuilt from their (NaN) d_j in Python
+    let curve =
+        crate::curve::KotterCurve::new(C::new(1.0, 1.0), C::new(2.0, 1.0), C::new(3.0, 1.0))?;
+    Ok(kotter::KotterState {
+        constants,
+        l_p: [[n; 3]; 4],
+        xi: [n; 3],
+        eta: [n; 3],
+        curve,
+        p0: n,
+        points: crate::curve::WurzelPoints {
+            z1: n,
+            y1: n,
+            z2: n,
+            y2: n,
+            g: n,
+            eps: [0; 5],
+            residual: f64::NAN,
+            zd1: [n; 5],
+            zd2: [n; 5],
+        },
+    })
+}
+
 /// Kötter's reduction and the uniformization for states `l` of shape (n, 6):
-/// a dict of arrays with leading axis n (see `manakov.kotter`).
-#[pyfunction(name = "kotter_batch")]
+/// a dict of arrays with leading axis n (see `manakov.kotter`), and `ok`, the
+/// rows that succeeded. With `l0`, every row is mapped with the constants of
+/// `l0`'s level set (`kotter::kotter_along`); otherwise each row with its own
+/// (`kotter::kotter`). `mask = false`: the first failing row raises, its
+/// index in the message; `mask = true`: failing rows are NaN and `ok` false.
+#[pyfunction(name = "kotter_batch", signature = (a, l, l0=None, mask=false))]
 fn kotter_batch_py<'py>(
     py: Python<'py>,
     a: PyReadonlyArray1<'py, f64>,
     l: PyReadonlyArray2<'py, f64>,
+    l0: Option<PyReadonlyArray1<'py, f64>>,
+    mask: bool,
 ) -> PyResult<Bound<'py, PyDict>> {
     let a: [f64; 4] = array1(&a, "a")?;
     let rows = rows::<f64, 6>(&l, "l", None)?;
+    let l0: Option<[f64; 6]> = match l0 {
+        Some(v) => Some(array1(&v, "l0")?),
+        None => None,
+    };
     let n = rows.len();
-    let res: Result<Vec<kotter::KotterState>, Error> =
-        py.detach(|| rows.iter().map(|r| kotter::kotter(&a, r)).collect());
-    let res = res?;
+    let all: Result<Vec<Result<kotter::KotterState, Error>>, Error> = py.detach(|| match l0 {
+        Some(l0) => {
+            let constants = kotter::kotter_constants(&a, &l0)?;
+            Ok(kotter::kotter_along(&constants, &rows))
+        }
+        None => Ok(rows.iter().map(|r| kotter::kotter(&a, r)).collect()),
+    });
+    let all = all?;
+    let mut ok = Vec::with_capacity(n);
+    let mut res = Vec::with_capacity(n);
+    for (i, r) in all.into_iter().enumerate() {
+        match r {
+            Ok(st) => {
+                ok.push(true);
+                res.push(st);
+            }
+            Err(e) if mask => {
+                let _ = e;
+                ok.push(false);
+                res.push(nan_state()?);
+            }
+            Err(e) => {
+                let err: PyErr = e.into();
+                if n == 1 {
+                    return Err(err);
+                }
+                let msg = format!("row {i} of {n}: {}", err.value(py));
+                return Err(PyErr::from_type(err.get_type(py), msg));
+            }
+        }
+    }
     let dict = PyDict::new(py);
     let c2 = |f: &dyn Fn(&kotter::KotterState) -> Vec<C>, m: usize| -> PyResult<Array2<C>> {
         let v: Vec<C> = res.iter().flat_map(f).collect();
@@ -183,6 +269,7 @@ fn kotter_batch_py<'py>(
             .map_err(out_shape_err)?
             .into_pyarray(py),
     )?;
+    dict.set_item("ok", Array1::from_vec(ok).into_pyarray(py))?;
     Ok(dict)
 }
 
