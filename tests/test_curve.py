@@ -901,3 +901,83 @@ def test_bad_offsets():
     zd_copy = zd.copy()
     k.xi_eta(z1, y1, z2, y2, 1.0, zd=zd)
     np.testing.assert_array_equal(zd, zd_copy)
+
+
+# Close points on one sheet (issue 9): the telescoped (28) against 50-digit mpmath;
+# the issue's claim, relative to max |P_jk|.
+CLOSE_POINTS_TOL = 1e-13
+
+
+def _mp_pjk(d: tuple[complex, complex, complex], z1: complex, y1, z2: complex, y2) -> np.ndarray:
+    """(28) at 50 digits with the canonical roots (module docs of rust/curve)."""
+    D = [mpmath.mpc(0)] + [mpmath.mpc(x) for x in d]
+    D.append(D[1] * D[2] * D[3])
+
+    def roots(z, y):
+        r = [mpmath.sqrt(mpmath.mpc(z) - dj) for dj in D]
+        if mpmath.re(mpmath.conj(mpmath.fprod(r)) * y) < 0:
+            r[4] = -r[4]
+        return r
+
+    r1, r2 = roots(z1, y1), roots(z2, y2)
+    out = np.zeros((5, 5), dtype=complex)
+    for j, k in itertools.combinations(range(5), 2):
+        rest = [m for m in range(5) if m not in (j, k)]
+        a = r2[j] * r2[k] * mpmath.fprod(r1[m] for m in rest)
+        b = r1[j] * r1[k] * mpmath.fprod(r2[m] for m in rest)
+        out[j, k] = out[k, j] = complex((a - b) / (mpmath.mpc(z1) - mpmath.mpc(z2)))
+    return out
+
+
+@pytest.mark.parametrize("gap", [1e-8, 1e-12])
+def test_wurzel_close_points_same_sheet_against_mpmath(gap: float) -> None:
+    mpmath.mp.dps = 50
+    d = (1.3 + 0.4j, -0.7 + 0.2j, 0.5 - 1.1j)
+    curve = KotterCurve(*d)
+    rng = np.random.default_rng(11)
+    worst = 0.0
+    for _ in range(20):
+        z1 = complex(*rng.normal(size=2))
+        z2 = z1 + gap * np.exp(2j * np.pi * rng.random())
+        y1 = complex(curve.y(z1))
+        # y2 continued from y1 along the segment (at 50 digits)
+        D = [0] + list(d) + [d[0] * d[1] * d[2]]
+        y2mp = mpmath.mpc(y1) * mpmath.fprod(
+            mpmath.sqrt(1 + (mpmath.mpc(z2) - mpmath.mpc(z1)) / (mpmath.mpc(z1) - dj)) for dj in D
+        )
+        y2 = complex(y2mp)
+        ref = _mp_pjk(d, z1, mpmath.mpc(y1), z2, mpmath.mpc(y2))
+        got = curve.wurzel(z1, y1, z2, y2).Pjk
+        worst = max(worst, np.abs(got - ref).max() / np.abs(ref).max())
+    print(f"gap {gap:.0e}: worst relative error {worst:.1e}")
+    assert worst <= CLOSE_POINTS_TOL
+
+
+def test_wurzel_same_point_is_tangent_limit() -> None:
+    mpmath.mp.dps = 50
+    d = (1.3 + 0.4j, -0.7 + 0.2j, 0.5 - 1.1j)
+    curve = KotterCurve(*d)
+    z = 0.3 - 0.8j
+    y = complex(curve.y(z))
+    got = curve.wurzel(z, y, z, y).Pjk
+    # the limit: (28) at a gap of 1e-30 in 50 digits (the O(gap) term is far below 1e-16)
+    D = [0] + list(d) + [d[0] * d[1] * d[2]]
+    z2 = mpmath.mpc(z) + mpmath.mpf(10) ** -30
+    y2 = mpmath.mpc(y) * mpmath.fprod(mpmath.sqrt(1 + (z2 - mpmath.mpc(z)) / (z - dj)) for dj in D)
+    mpmath.mp.dps = 50
+    ref = np.zeros((5, 5), dtype=complex)
+    r1 = [mpmath.sqrt(mpmath.mpc(z) - dj) for dj in [mpmath.mpc(x) for x in D]]
+    if mpmath.re(mpmath.conj(mpmath.fprod(r1)) * y) < 0:
+        r1[4] = -r1[4]
+    r2 = [mpmath.sqrt(z2 - dj) for dj in [mpmath.mpc(x) for x in D]]
+    if mpmath.re(mpmath.conj(mpmath.fprod(r2)) * y2) < 0:
+        r2[4] = -r2[4]
+    for j, k in itertools.combinations(range(5), 2):
+        rest = [m for m in range(5) if m not in (j, k)]
+        a = r2[j] * r2[k] * mpmath.fprod(r1[m] for m in rest)
+        b = r1[j] * r1[k] * mpmath.fprod(r2[m] for m in rest)
+        ref[j, k] = ref[k, j] = complex((a - b) / (mpmath.mpc(z) - z2))
+    assert np.abs(got - ref).max() / np.abs(ref).max() <= CLOSE_POINTS_TOL
+    # the same z on the other sheet is a pole of (28)
+    with pytest.raises(ValueError, match="different sheets"):
+        curve.wurzel(z, y, z, -y)

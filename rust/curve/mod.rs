@@ -726,6 +726,13 @@ impl KotterCurve {
                 jac[(i, 2)] = w * f[i] / g;
                 rhs[i] = w * (target[i] - f[i]);
             }
+            // nalgebra's SVD never returns on a NaN entry and panics on an
+            // infinite one (curves of scale 1e27 and beyond overflow here):
+            // only finite systems are solved.
+            let finite = |v: &Complex64| v.re.is_finite() && v.im.is_finite();
+            if !(jac.iter().all(finite) && rhs.iter().all(finite)) {
+                break;
+            }
             let Ok(step) = jac.svd(true, true).solve(&rhs, 1e-14) else {
                 break;
             };

@@ -1,0 +1,249 @@
+# ruff: noqa: E741  (l is the paper's name for the state)
+"""Issue 9: roots of F on their own branch, one branch per level set, batch errors.
+
+Reference values: roots of F (19) and F'(s_p) from mpmath at 50 digits
+(``mpmath.polyroots`` on the quartic formed in mpmath from the state); the
+trajectories from the package's integrator are only the *input* of the
+continuity checks, whose bounds (|z'| dt) come from finite differences of the
+map along the vector field, not from the samples themselves.
+"""
+
+from __future__ import annotations
+
+from functools import cache
+
+import mpmath
+import numpy as np
+import pytest
+
+import manakov
+
+from conftest import PROBLEM_NAMES
+
+# Neighbouring samples of a smooth curve t -> z(t) differ by |z'| dt up to the
+# second-order term (dt = 0.01 here); 2 leaves room for it, while a jump to another
+# branch (the involution image, a swapped or sign-flipped constant) is O(|z|), i.e.
+# hundreds of |z'| dt.
+JUMP_FACTOR = 2.0
+# Kötter's quadrics (11) relative to |xi|^2 + |eta|^2 (and |d||xi|^2 + |eta|^2/|d| for
+# the third): the issue's claim.
+QUADRIC_TOL = 1e-13
+# F'(s_p) and s_p against mpmath: the issue's claim for the reduction is 1e-12 on the
+# round trip; roots polished on their own branch carry a few ulps times the
+# conditioning of f (not of the merged quartic).
+ROOT_TOL = 1e-13
+FPRIME_TOL = 1e-12
+# Round trip l -> Kötter -> l on random tops and states (issue 9): the claim.
+ROUND_TRIP_MAX = 1e-12
+ROUND_TRIP_BULK = 1e-13
+
+T_END = 200.0
+N_SAMPLES = 20001
+
+
+@cache
+def _trajectory(name: str, t_end: float, n: int) -> tuple[np.ndarray, np.ndarray]:
+    p = manakov.problem(name)
+    top = manakov.ManakovTop(p.a, p.b)
+    t = np.linspace(0.0, t_end, n)
+    x = np.asarray(top.integrate(p.l0, t_end, t_eval=t).l)
+    return t, x
+
+
+def _divisor_rates(ls: manakov.LevelSet, x: np.ndarray, v: np.ndarray):
+    """d/dt of z1 + z2, z1 z2 and g by central differences of the map along the flow."""
+    h = 1e-6 * np.abs(x).max() / np.abs(v).max()
+    kp, km = ls.kotter(x + h * v), ls.kotter(x - h * v)
+    ds1 = ((kp.z1 + kp.z2) - (km.z1 + km.z2)) / (2 * h)
+    ds2 = (kp.z1 * kp.z2 - km.z1 * km.z2) / (2 * h)
+    dg = (kp.g - km.g) / (2 * h)
+    return ds1, ds2, dg
+
+
+def _max_jump_ratio(x: np.ndarray, dx: np.ndarray, dt: float) -> float:
+    jump = np.abs(np.diff(x))
+    bound = np.maximum(np.abs(dx[1:]), np.abs(dx[:-1])) * dt
+    return float(np.max(jump / bound))
+
+
+@pytest.mark.parametrize(
+    "name, t_end, n",
+    [(nm, 20.0, 2001) for nm in PROBLEM_NAMES]
+    + [pytest.param(nm, T_END, N_SAMPLES, marks=pytest.mark.slow) for nm in PROBLEM_NAMES],
+)
+def test_level_set_divisor_continuous_along_trajectory(name: str, t_end: float, n: int) -> None:
+    p = manakov.problem(name)
+    t, x = _trajectory(name, t_end, n)
+    dt = t[1] - t[0]
+    v = manakov.ManakovTop(p.a, p.b).vector_field(x)
+    ls = manakov.LevelSet(p.a, p.b, p.l0)
+    k = ls.kotter(x)
+    assert np.all(k.ok)
+    ds1, ds2, dg = _divisor_rates(ls, x, v)
+    # the rates of each point from those of the symmetric functions
+    dz1 = (ds1 * k.z1 - ds2) / (k.z1 - k.z2)
+    dz2 = (ds2 - ds1 * k.z2) / (k.z1 - k.z2)
+    d5 = np.concatenate([[0], ls.d, [np.prod(ls.d)]])
+    dy1 = k.y1 * np.sum(0.5 / (k.z1[:, None] - d5), -1) * dz1
+    dy2 = k.y2 * np.sum(0.5 / (k.z2[:, None] - d5), -1) * dz2
+    ratios = {
+        "z1": _max_jump_ratio(k.z1, dz1, dt),
+        "z2": _max_jump_ratio(k.z2, dz2, dt),
+        "y1": _max_jump_ratio(k.y1, dy1, dt),
+        "y2": _max_jump_ratio(k.y2, dy2, dt),
+        "g": _max_jump_ratio(k.g, dg, dt),
+    }
+    print(name, {kk: f"{vv:.4f}" for kk, vv in ratios.items()})
+    assert max(ratios.values()) <= JUMP_FACTOR, ratios
+    # the involution image (g, y) -> (-g, -y) is never the nearer neighbour
+    assert np.all(np.abs(np.diff(k.g)) < np.abs(k.g[1:] + k.g[:-1]))
+    # quadrics (11)
+    s2 = np.sum(np.abs(k.xi) ** 2 + np.abs(k.eta) ** 2, -1)
+    s3 = np.sum(np.abs(k.d) * np.abs(k.xi) ** 2 + np.abs(k.eta) ** 2 / np.abs(k.d), -1)
+    q1 = np.abs(np.sum(k.xi**2 + k.eta**2, -1)) / s2
+    q2 = np.abs(np.sum(k.xi * k.eta, -1)) / s2
+    q3 = np.abs(np.sum(k.d * k.xi**2 + k.eta**2 / k.d, -1)) / s3
+    assert max(q1.max(), q2.max(), q3.max()) <= QUADRIC_TOL
+
+
+def test_per_state_kotter_jumps_where_level_set_does_not() -> None:
+    """The one-off ``kotter`` orders and normalises state by state: on 'generic' its
+    ``z1`` leaves the |z'| dt bound (the two points trade places), so the continuity
+    test above can fail. The bound uses the larger rate of the two points."""
+    p = manakov.problem("generic")
+    t, x = _trajectory("generic", 20.0, 2001)
+    v = manakov.ManakovTop(p.a, p.b).vector_field(x)
+    ls = manakov.LevelSet(p.a, p.b, p.l0)
+    kl = ls.kotter(x)
+    ds1, ds2, _ = _divisor_rates(ls, x, v)
+    dz1 = (ds1 * kl.z1 - ds2) / (kl.z1 - kl.z2)
+    dz2 = (ds2 - ds1 * kl.z2) / (kl.z1 - kl.z2)
+    rate = np.maximum(np.abs(dz1), np.abs(dz2))
+    k = manakov.kotter(p.a, p.b, x)
+    ratio = _max_jump_ratio(k.z1, rate, t[1] - t[0])
+    print(f"per-state kotter: largest jump of z1 = {ratio:.1f} |z'| dt")
+    assert ratio > 10 * JUMP_FACTOR
+
+
+def _mp_roots(a: np.ndarray, l: np.ndarray) -> list:
+    """Roots of F (19) and F'(s_p) = prod_{q != p} (s_p - s_q) in mpmath from the state."""
+    mpmath.mp.dps = 50
+    A = [mpmath.mpf(float(x)) for x in a]
+    L = [mpmath.mpf(float(x)) for x in l]
+    m = [L[3], -L[1], L[0]]
+    n = [L[2], L[4], L[5]]
+    h0 = sum(m[j] * n[j] for j in range(3))
+    h1 = sum(x * x for x in L)
+    cyc = [(0, 1, 2), (1, 2, 0), (2, 0, 1)]
+    # P(s) = sum_j s_j4 m_j^2 + s_kl n_j^2 as polynomial coefficients
+    P = [mpmath.mpf(0)] * 3
+    for j, k_, l_ in cyc:
+        for (u, w), c in (((j, 3), m[j] ** 2), ((k_, l_), n[j] ** 2)):
+            P[0] += c
+            P[1] += -c * (A[u] + A[w])
+            P[2] += c * A[u] * A[w]
+    G = [mpmath.mpf(1)]
+    for x in A:
+        G = [*G, mpmath.mpf(0)]
+        for i in range(len(G) - 1, 0, -1):
+            G[i] -= x * G[i - 1]
+    P2 = [sum(P[i] * P[k - i] for i in range(3) if 0 <= k - i <= 2) for k in range(5)]
+    num = [P2[i] - 4 * h0**2 * G[i] for i in range(5)]
+    assert abs(num[0] - (h1**2 - 4 * h0**2)) < mpmath.mpf(10) ** -40
+    roots = mpmath.polyroots(num, maxsteps=200, extraprec=200)
+    out = []
+    for r in roots:
+        fp = mpmath.fprod(r - q for q in roots if q is not r)
+        out.append((complex(r), complex(fp)))
+    return out
+
+
+def test_roots_and_fprime_on_own_branch_against_mpmath() -> None:
+    """s_p and F'(s_p) (from f' f~/(h1^2 - 4h0^2)) against 50-digit mpmath, on random
+    tops and states including clustered roots (the merged quartic loses u/delta there)."""
+    rng = np.random.default_rng(97)
+    worst_s = worst_fp = 0.0
+    for _ in range(60):
+        a = np.sort(rng.normal(size=4))
+        l = rng.normal(size=6)
+        k = manakov.kotter(a, rng.normal(size=4), l)
+        ref = _mp_roots(a, l)
+        for sp, fp in zip(k.s, k.sqrt_fprime**2):
+            r, rfp = min(ref, key=lambda rr: abs(rr[0] - sp))
+            worst_s = max(worst_s, abs(sp - r) / max(abs(r), 1.0))
+            worst_fp = max(worst_fp, abs(fp - rfp) / abs(rfp))
+    print(f"roots {worst_s:.1e}, F' {worst_fp:.1e}")
+    assert worst_s <= ROOT_TOL
+    assert worst_fp <= FPRIME_TOL
+
+
+def test_round_trip_random_tops_distribution() -> None:
+    """A smaller version of ``tests/data/kotter_roundtrip_random10k.py`` (another seed)."""
+    rng = np.random.default_rng(4242)
+    errs = []
+    for _ in range(1000):
+        a = np.sort(rng.normal(size=4))
+        b = rng.normal(size=4)
+        l = rng.normal(size=6)
+        k = manakov.kotter(a, b, l)
+        back = manakov.from_kotter(a, b, k)
+        errs.append(np.max(np.abs(back - l)) / np.max(np.abs(l)))
+    e = np.array(errs)
+    print(f"median {np.median(e):.1e}, 99.9% {np.percentile(e, 99.9):.1e}, max {e.max():.1e}")
+    assert np.mean(e <= ROUND_TRIP_BULK) >= 0.995
+    assert e.max() <= 1e2 * ROUND_TRIP_MAX  # the state of the code: see the xfail below
+
+
+@pytest.mark.xfail(
+    strict=True,
+    reason="issue 9 target not met yet: worst round trip 4.2e-12 on this draw, on curves "
+    "with |d_1| ~ 1e5..1e6 whose d_j (26) carry ~1e-12 relative error (docs/kotter.md)",
+)
+def test_round_trip_random_tops_max_claim() -> None:
+    rng = np.random.default_rng(4242)
+    worst = 0.0
+    for _ in range(1000):
+        a = np.sort(rng.normal(size=4))
+        b = rng.normal(size=4)
+        l = rng.normal(size=6)
+        back = manakov.from_kotter(a, b, manakov.kotter(a, b, l))
+        worst = max(worst, np.max(np.abs(back - l)) / np.max(np.abs(l)))
+    assert worst <= ROUND_TRIP_MAX
+
+
+def test_batch_error_names_the_row_and_mask_gives_status() -> None:
+    p = manakov.problem("generic")
+    m = np.array([0.3, -0.2, 0.5])
+    self_dual = np.array([m[2], -m[1], m[0], m[0], m[1], m[2]])  # n = m
+    x = np.stack([p.l0, self_dual, p.l0])
+    with pytest.raises(ValueError, match="row 1 of 3"):
+        manakov.kotter(p.a, p.b, x)
+    k = manakov.kotter(p.a, p.b, x, errors="mask")
+    assert k.ok.tolist() == [True, False, True]
+    assert np.all(np.isnan(k.d[1])) and k.curve[1] is None
+    assert np.all(np.isfinite(k.d[[0, 2]]))
+    with pytest.raises(ValueError, match="errors must be"):
+        manakov.kotter(p.a, p.b, x, errors="ignore")
+    with pytest.raises(ValueError, match="failed"):
+        manakov.from_kotter(p.a, p.b, k)
+
+
+def test_from_kotter_refuses_another_top() -> None:
+    p, q = manakov.problem("generic"), manakov.problem("physical")
+    k = manakov.kotter(p.a, p.b, p.l0)
+    with pytest.raises(ValueError, match="another top"):
+        manakov.from_kotter(q.a, q.b, k)
+    with pytest.raises(ValueError, match="another top"):
+        manakov.from_kotter(p.a, q.b, k)
+    np.testing.assert_allclose(manakov.from_kotter(p.a, p.b, k), p.l0, rtol=0, atol=1e-12)
+
+
+def test_level_set_refuses_states_off_it() -> None:
+    p = manakov.problem("generic")
+    ls = manakov.LevelSet(p.a, p.b, p.l0)
+    with pytest.raises(ValueError, match="not on this level set"):
+        ls.kotter(p.l0 * 1.01)
+    k = ls.kotter(p.l0)
+    np.testing.assert_array_equal(k.d, manakov.kotter(p.a, p.b, p.l0).d)
+    with pytest.raises(ValueError, match="shape"):
+        manakov.LevelSet(p.a, p.b, np.stack([p.l0, p.l0]))
