@@ -900,10 +900,8 @@ fn wurzel_from_roots(
         for k in (j + 1)..5 {
             // factors in the order j, k, then the complement
             let mut idx = [j, k, 0, 0, 0];
-            let mut n = 2;
-            for m in (0..5).filter(|&m| m != j && m != k) {
+            for (n, m) in (2..).zip((0..5).filter(|&m| m != j && m != k)) {
                 idx[n] = m;
-                n += 1;
             }
             let fa: [Complex64; 5] =
                 std::array::from_fn(|i| if i < 2 { r2[idx[i]] } else { r1[idx[i]] });

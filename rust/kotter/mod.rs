@@ -1203,16 +1203,16 @@ pub fn on_level_set(constants: &KotterConstants, l: &[f64; 6]) -> Result<()> {
     let h = integrals(&constants.a, l);
     let amax = constants.a.iter().fold(1.0f64, |m, v| m.max(v.abs()));
     let h1 = constants.h[1].abs().max(h[1].abs());
-    for i in 0..4 {
+    for (i, (&hi, &ci)) in h.iter().zip(constants.h.iter()).enumerate() {
         let scale = h1 * amax.powi((i as i32 - 1).max(0));
-        let miss = (h[i] - constants.h[i]).abs();
+        let miss = (hi - ci).abs();
         if miss.is_nan() || miss > LEVEL_SET_RTOL * scale {
             return Err(Error::InvalidArgument {
                 what: "state l",
                 reason: format!(
                     "it is not on this level set: h{i}(l) = {:e} differs from the level set's \
-                     h{i} = {:e} by {miss:e} > {LEVEL_SET_RTOL:e} * {scale:e}",
-                    h[i], constants.h[i]
+                     h{i} = {ci:e} by {miss:e} > {LEVEL_SET_RTOL:e} * {scale:e}",
+                    hi
                 ),
             });
         }
