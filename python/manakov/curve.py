@@ -75,6 +75,18 @@ def _finite(values: np.ndarray) -> np.ndarray:
     return _finite_result(values, "this x: |x| is too large")
 
 
+#: Why a curve's constant or a point evaluation is not representable.
+_RANGE = (
+    "this curve or these points: the value does not fit in a double (the curve's "
+    "scale, with d_4 = d1 d2 d3 and products of up to five differences z - d_j, must "
+    "keep every such product between ~1e-308 and ~1e308)"
+)
+
+
+def _in_range(values: np.ndarray) -> np.ndarray:
+    return _finite_result(np.asarray(values), _RANGE)
+
+
 def _zd_rows(zd: Any, shape: tuple[int, ...]) -> np.ndarray | None:
     """Offsets of shape (..., 2, 5) broadcast to ``shape`` and flattened to rows of 10."""
     if zd is None:
@@ -223,19 +235,28 @@ class KotterCurve:
     def c(self) -> np.ndarray:
         """``c_j = (d_j - d_4)/((d_j - d_k)(d_j - d_l))`` (33), ``j = 1, 2, 3``.
 
-        The curve's constants, not the top's ``c_ij`` of (2).
+        The curve's constants, not the top's ``c_ij`` of (2). Raises
+        ``ValueError`` when a value does not fit in a double.
         """
-        return self._c
+        return _in_range(self._c)
 
     @property
     def c_tilde(self) -> np.ndarray:
-        """``c~_j = 1/((d_j - d_k)(d_j - d_l))`` (33), ``j = 1, 2, 3``."""
-        return self._ct
+        """``c~_j = 1/((d_j - d_k)(d_j - d_l))`` (33), ``j = 1, 2, 3``.
+
+        Raises ``ValueError`` when a value does not fit in a double (it is
+        evaluated as ``1/(d_j - d_k) * 1/(d_j - d_l)``, so ``|d| ~ 1e-100`` is fine).
+        """
+        return _in_range(self._ct)
 
     @property
     def kappa(self) -> complex:
-        """``kappa = prod_{m=1}^3 (d_m - d_4) = -R'(d_4)/d_4``, the factor of (29) corrected."""
-        return self._kappa
+        """``kappa = prod_{m=1}^3 (d_m - d_4) = -R'(d_4)/d_4``, the factor of (29) corrected.
+
+        Raises ``ValueError`` when it does not fit in a double (``|kappa| ~ |d_4|^3``
+        overflows once ``|d1 d2 d3|`` passes ~1e102).
+        """
+        return complex(_in_range(np.asarray(self._kappa)))
 
     def __repr__(self) -> str:
         d1, d2, d3 = self.d
@@ -330,11 +351,14 @@ class KotterCurve:
         ValueError
             Non-finite input, a point off the curve (``|y**2 - R(z)|`` above
             1e-8 of the size of the terms of ``R``), ``z1 == z2`` where (28)
-            divides by zero, an invalid ``eps``, or offsets ``zd`` of the wrong
-            shape or inconsistent with ``z1, z2``.
+            divides by zero (the same ``z`` on different sheets or at a branch
+            point; the same point twice is the tangent limit), an invalid ``eps``,
+            offsets ``zd`` of the wrong shape or inconsistent with ``z1, z2``, or a
+            result outside the double range.
         """
         shape, (z1f, y1f, z2f, y2f), e, zr = _point_rows((z1, y1, z2, y2), eps, zd)
         p, pjk = _core.curve_wurzel(self._d123(), z1f, y1f, z2f, y2f, e, zr)
+        p, pjk = _in_range(p), _in_range(pjk)
         return Wurzel(P=_frozen(p.reshape(*shape, 5)), Pjk=_frozen(pjk.reshape(*shape, 5, 5)))
 
     def xi_eta(
@@ -373,11 +397,13 @@ class KotterCurve:
         Raises
         ------
         ValueError
-            As :meth:`wurzel`, and a non-finite ``g`` or an invalid ``sqrt_c``.
+            As :meth:`wurzel`, and a non-finite ``g`` or an invalid ``sqrt_c``;
+            a result outside the double range (the curve's scale; see ``c``).
         """
         shape, (z1f, y1f, z2f, y2f, gf), e, zr = _point_rows((z1, y1, z2, y2, g), eps, zd)
         sc = None if sqrt_c is None else np.ascontiguousarray(_c(sqrt_c).reshape(-1))
         xi, eta = _core.curve_xi_eta(self._d123(), z1f, y1f, z2f, y2f, gf, e, sc, zr)
+        xi, eta = _in_range(xi), _in_range(eta)
         return _frozen(xi.reshape(*shape, 3)), _frozen(eta.reshape(*shape, 3))
 
     def points_from_wurzel(
@@ -408,6 +434,13 @@ class KotterCurve:
         ``(g, y1, y2)`` and ``(-g, -y1, -y2)`` give the same ``(xi, eta)``; the
         sign of ``g`` is that nearer ``g_ref`` if given, else that of the
         principal ``sqrt(g**2)``.
+
+        **The pair is unordered.** (27)-(28), and with them ``(xi, eta)``, are
+        symmetric in the two points, so the data cannot tell which point was
+        "first": ``(z1, y1)`` is the root of ``x**2 - (z1 + z2) x + z1 z2`` of
+        larger modulus (then polished), whatever order produced ``xi, eta``. Compare
+        pairs as sets (or use :class:`manakov.LevelSet`, which orders each sample's
+        pair to follow the previous one along a trajectory).
 
         Parameters
         ----------

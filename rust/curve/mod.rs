@@ -74,7 +74,8 @@ pub const OFFSET_RTOL: f64 = 16.0 * f64::EPSILON;
 /// `d_2 d_3 = 1` only up to a few ulps.
 const REPEATED_RTOL: f64 = 8.0 * f64::EPSILON;
 
-/// `|z1 − z2|` (relative to `max(|z1|, 1)`) below which the inverse reports
+/// `|z1 − z2|` (relative to `max(|z1|, |z2|)`, not to 1: the curve has no
+/// preferred scale) below which the inverse reports
 /// the double root `z1 == z2` instead of a pair: a discriminant `(z1 − z2)²`
 /// that is zero in exact arithmetic comes out ~1e-16 after rounding, i.e.
 /// `|z1 − z2|` ~1e-8, and the error of the recovered pair grows like
@@ -100,6 +101,24 @@ pub fn sqrt_principal(w: Complex64) -> Complex64 {
         Complex64::new(t, im / (2.0 * t))
     } else {
         Complex64::new(im.abs() / (2.0 * t), t.copysign(im))
+    }
+}
+
+/// `a / b` by Smith's algorithm: no intermediate `|b|²`, so quotients of
+/// numbers near the ends of the double range (`1/(1e-200)`, whose `|b|²`
+/// underflows to 0 in the textbook formula) stay finite when the result is.
+pub fn cdiv(a: Complex64, b: Complex64) -> Complex64 {
+    if b.re.abs() >= b.im.abs() {
+        if b.re == 0.0 {
+            return a / b; // b = 0: the IEEE result (inf/NaN), caught by the callers
+        }
+        let r = b.im / b.re;
+        let den = b.re + b.im * r;
+        Complex64::new((a.re + a.im * r) / den, (a.im - a.re * r) / den)
+    } else {
+        let r = b.re / b.im;
+        let den = b.re * r + b.im;
+        Complex64::new((a.re * r + a.im) / den, (a.im * r - a.re) / den)
     }
 }
 
@@ -226,14 +245,17 @@ impl KotterCurve {
     /// `c̃_j = 1/((d_j − d_k)(d_j − d_l))` (33), `j = 1, 2, 3`, `(j, k, l)` cyclic.
     pub fn c_tilde(&self) -> [Complex64; 3] {
         let d = &self.d;
-        CYCLIC.map(|(j, k, l)| 1.0 / ((d[j] - d[k]) * (d[j] - d[l])))
+        // as 1/(d_j − d_k) · 1/(d_j − d_l): the product of two differences can
+        // underflow (|d| ~ 1e-160) where c̃_j itself is representable
+        let one = Complex64::new(1.0, 0.0);
+        CYCLIC.map(|(j, k, l)| cdiv(one, d[j] - d[k]) * cdiv(one, d[j] - d[l]))
     }
 
     /// `c_j = (d_j − d_4)/((d_j − d_k)(d_j − d_l))` (33) — the curve's
     /// constants, not the top's `c_ij` of (2).
     pub fn c(&self) -> [Complex64; 3] {
         let d = &self.d;
-        CYCLIC.map(|(j, k, l)| (d[j] - d[4]) / ((d[j] - d[k]) * (d[j] - d[l])))
+        CYCLIC.map(|(j, k, l)| cdiv(cdiv(d[j] - d[4], d[j] - d[k]), d[j] - d[l]))
     }
 
     /// `κ = Π_{m=1}^{3} (d_m − d_4) = −R'(d_4)/d_4`, the factor missing from
@@ -589,7 +611,7 @@ impl KotterCurve {
         let mut b = self.refine(best, &target, &sc);
         b.g *= scale;
         b.residual *= scale;
-        if (b.z1 - b.z2).norm() <= NEAR_DOUBLE_ROOT * b.z1.norm().max(1.0) {
+        if (b.z1 - b.z2).norm() <= NEAR_DOUBLE_ROOT * b.z1.norm().max(b.z2.norm()) {
             // A discriminant that vanishes in exact arithmetic is ~1e-16 after
             // rounding, so z1 - z2 ~ 1e-8: the data sit at z1 == z2, and no
             // pair closer than NEAR_DOUBLE_ROOT can be resolved from them.
@@ -733,9 +755,26 @@ impl KotterCurve {
             if !(jac.iter().all(finite) && rhs.iter().all(finite)) {
                 break;
             }
-            let Ok(step) = jac.svd(true, true).solve(&rhs, 1e-14) else {
+            // Columns scaled to unit norm: the solve's cut-off 1e-14 is absolute
+            // on the singular values, and the columns differ by the curve's
+            // scale (|dP/dw| against |P/g|: 1e-20 against 1 at |d| ~ 1e4), so
+            // unscaled a whole direction was dropped and the polish stalled.
+            let mut colscale = [1.0f64; 3];
+            for (cidx, cs) in colscale.iter_mut().enumerate() {
+                let nrm = jac.column(cidx).norm();
+                if nrm > 0.0 && nrm.is_finite() {
+                    *cs = nrm;
+                    for i in 0..6 {
+                        jac[(i, cidx)] /= nrm;
+                    }
+                }
+            }
+            let Ok(mut step) = jac.svd(true, true).solve(&rhs, 1e-14) else {
                 break;
             };
+            for (cidx, cs) in colscale.iter().enumerate() {
+                step[cidx] /= *cs;
+            }
             let nr1 = moved(&r1, b1, &dd1, step[0]);
             let nr2 = moved(&r2, b2, &dd2, step[1]);
             let ng = g + step[2];
@@ -871,9 +910,9 @@ fn quadratic_roots(s: Complex64, p: Complex64) -> Result<(Complex64, Complex64)>
 fn factor_quotient(r1: Complex64, r2: Complex64, dz: Complex64) -> Complex64 {
     let sum = r1 + r2;
     if sum.norm() >= (r1 - r2).norm() && sum != Complex64::new(0.0, 0.0) {
-        1.0 / sum
+        cdiv(Complex64::new(1.0, 0.0), sum)
     } else {
-        (r1 - r2) / dz
+        cdiv(r1 - r2, dz)
     }
 }
 

@@ -133,7 +133,10 @@ fn bad_points_are_rejected() {
     let (z1, z2) = (c(0.3, 0.2), c(-1.0, 0.5));
     let (y1, y2) = (k.y(z1), k.y(z2));
     assert!(k.wurzel(z1, y1 * 1.01, z2, y2, None).is_err());
-    assert!(k.wurzel(z1, y1, z1, y1, None).is_err());
+    // the same point twice is the tangent limit of (28) (issue 9); the same z on
+    // the other sheet is a pole
+    assert!(k.wurzel(z1, y1, z1, y1, None).is_ok());
+    assert!(k.wurzel(z1, y1, z1, -y1, None).is_err());
     assert!(k.wurzel(z1, y1, c(f64::INFINITY, 0.0), y2, None).is_err());
     assert!(k.wurzel(z1, y1, z2, y2, Some([1, 1, 1, 1, -1])).is_err());
     assert!(k.wurzel(z1, y1, z2, y2, Some([1, 1, 1, 2, 2])).is_err());

@@ -137,6 +137,19 @@ pub fn schottky(a: &[f64; 4], l: &[f64; 6], s: C, sqrt_g: C) -> Result<([C; 3], 
         lv[j] = r * m[j] + q * n[j];
         mv[j] = q * m[j] + r * n[j];
     }
+    if lv
+        .iter()
+        .chain(mv.iter())
+        .any(|v| !(v.re.is_finite() && v.im.is_finite()))
+    {
+        return Err(Error::InvalidArgument {
+            what: "l, s",
+            reason: format!(
+                "l(s) (12) or m(s) (17) overflows at s = {s}: the supported range is \
+                 max|l_ij| * max|s - a_j| (and |sqrt G(s)|/|s - a_j|) below ~1e308"
+            ),
+        });
+    }
     Ok((lv, mv))
 }
 
@@ -161,7 +174,18 @@ pub fn cubic_interpolant(a: &[f64; 4], b: &[f64; 4]) -> Result<[f64; 4]> {
     let p2 = f012 - f0123 * (a[0] + a[1] + a[2]);
     let p1 = f01 - f012 * (a[0] + a[1]) + f0123 * (a[0] * a[1] + a[0] * a[2] + a[1] * a[2]);
     let p0 = b[0] - f01 * a[0] + f012 * a[0] * a[1] - f0123 * a[0] * a[1] * a[2];
-    Ok([p0, p1, p2, p3])
+    let p = [p0, p1, p2, p3];
+    if p.iter().any(|v| !v.is_finite()) {
+        return Err(Error::InvalidArgument {
+            what: "a, b",
+            reason: format!(
+                "the divided differences of b over a overflow (p = {p:?}): the a_i are too \
+                 close together for double precision (differences of a must keep \
+                 (b_i - b_j)/(a_i - a_j) and its higher quotients below ~1e308)"
+            ),
+        });
+    }
+    Ok(p)
 }
 
 /// `|sqrt_g² − G(s)| ≤ SQRT_G_RTOL · |G(s)|` is required of the branch passed
@@ -237,6 +261,15 @@ pub fn lax_m(a: &[f64; 4], b: &[f64; 4], l: &[f64; 6], s: C, sqrt_g: C) -> Resul
         for j in 0..3 {
             mb[j] += p[3] * (e2 * m[j] + m3[j]) / den;
         }
+    }
+    if mb.iter().any(|v| !(v.re.is_finite() && v.im.is_finite())) {
+        return Err(Error::InvalidArgument {
+            what: "a, b, l, s",
+            reason: format!(
+                "M_b(s) (18) overflows at s = {s}: the products of the cubic interpolant of b \
+                 with l(s) leave the double range (~1e308)"
+            ),
+        });
     }
     Ok(mb.map(|v| -tau * v))
 }
