@@ -981,3 +981,43 @@ def test_wurzel_same_point_is_tangent_limit() -> None:
     # the same z on the other sheet is a pole of (28)
     with pytest.raises(ValueError, match="different sheets"):
         curve.wurzel(z, y, z, -y)
+
+
+# Issue 11, fuzz items 1, 4, 5: extreme scales. The inverse map's round trip, relative
+# to the size of the points: what the closed form plus the Gauss-Newton polish reach at
+# every scale where the curve's products stay in the double range (measured <= 1.2e-13).
+SCALE_ROUND_TRIP_TOL = 1e-12
+
+
+@pytest.mark.parametrize("scale", [1e-5, 1e-2, 1.0, 1e2, 1e3, 1e4, 1e6])
+def test_points_from_wurzel_round_trip_at_every_scale(scale: float) -> None:
+    curve = KotterCurve(scale, (2 + 1j) * scale, 3 * scale)
+    rng = np.random.default_rng(3)
+    for _ in range(10):
+        z1, z2 = (rng.normal(size=2) + 1j * rng.normal(size=2)) * scale
+        g = 1.3 - 0.2j
+        xi, eta = curve.xi_eta(z1, curve.y(z1), z2, curve.y(z2), g)
+        r = curve.points_from_wurzel(xi, eta, g_ref=g)
+        # the pair is unordered (docstring): compare as sets
+        err = min(abs(r.z1 - z1) + abs(r.z2 - z2), abs(r.z1 - z2) + abs(r.z2 - z1))
+        assert err <= SCALE_ROUND_TRIP_TOL * max(abs(z1), abs(z2))
+        assert abs(r.g - g) <= SCALE_ROUND_TRIP_TOL * abs(g)
+
+
+@pytest.mark.parametrize("scale", [1e27, 1e40, 1e60])
+def test_points_from_wurzel_huge_curves_raise_not_hang(scale: float) -> None:
+    curve = KotterCurve(scale, 2 * scale, 3 * scale)
+    with pytest.raises(ValueError):
+        curve.points_from_wurzel([1, 1, 1], [1, 1, 1])
+
+
+def test_curve_constants_at_tiny_and_huge_scales() -> None:
+    # c~_j scales like 1/s^2: the value at d = s (1, 2+i, 3) from the unit curve's
+    c1 = KotterCurve(1.0, 2 + 1j, 3.0).c_tilde
+    tiny = KotterCurve(1e-100, 2e-100 + 1e-100j, 3e-100)
+    np.testing.assert_allclose(tiny.c_tilde, c1 * 1e200, rtol=1e-14)
+    xi, eta = tiny.xi_eta(1e-100, tiny.y(1.5e-100), 2.5e-100, tiny.y(2.5e-100), 1.0)
+    assert np.all(np.isfinite(xi)) and np.all(np.isfinite(eta))
+    huge = KotterCurve(1e34, (2 + 1j) * 1e34, 3e34)
+    with pytest.raises(ValueError, match="does not fit in a double"):
+        _ = huge.kappa

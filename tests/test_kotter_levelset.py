@@ -247,3 +247,23 @@ def test_level_set_refuses_states_off_it() -> None:
     np.testing.assert_array_equal(k.d, manakov.kotter(p.a, p.b, p.l0).d)
     with pytest.raises(ValueError, match="shape"):
         manakov.LevelSet(p.a, p.b, np.stack([p.l0, p.l0]))
+
+
+def test_extreme_scales_raise_or_stay_finite() -> None:
+    """Issue 11, fuzz item 4: no silent NaN/inf."""
+    from manakov import reduction
+
+    p = manakov.problem("generic")
+    l = np.array([-0.715, -0.715, -1.5, -1.5, -1.5, -9.726])
+    k = manakov.kotter(p.a, p.b, l * 1e40)
+    assert np.all(np.isfinite(k.sigma)) and np.all(np.isfinite(k.l_p))
+    # sigma and d are scale-free, l_p scales like l
+    k1 = manakov.kotter(p.a, p.b, l)
+    np.testing.assert_allclose(k.d, k1.d, rtol=1e-12)
+    np.testing.assert_allclose(k.l_p, k1.l_p * 1e40, rtol=1e-12)
+    with pytest.raises(ValueError, match="divided differences"):
+        reduction.lax_pair(
+            [8e-321, 0, 5.55e-320, 3.27e-320], [-2.69, 0.557, 0.557, 0], [1, 0, 0, 0, 0, 0], 9.86j
+        )
+    with pytest.raises(ValueError, match="overflows"):
+        reduction.schottky(p.a, np.full(6, 1e308), 1.0 + 1j)
