@@ -267,3 +267,15 @@ def test_extreme_scales_raise_or_stay_finite() -> None:
         )
     with pytest.raises(ValueError, match="overflows"):
         reduction.schottky(p.a, np.full(6, 1e308), 1.0 + 1j)
+
+
+def test_top_level_set_shorthand() -> None:
+    p = manakov.problem("wide")
+    top = manakov.ManakovTop(p.a, p.b)
+    ls = top.level_set(p.l0)
+    assert isinstance(ls, manakov.LevelSet)
+    np.testing.assert_array_equal(
+        ls.kotter(p.l0).d, manakov.LevelSet(p.a, p.b, p.l0).kotter(p.l0).d
+    )
+    k = top.kotter(np.stack([p.l0, p.l0]), errors="mask")
+    assert k.ok.tolist() == [True, True]

@@ -30,6 +30,7 @@ import numpy as np
 
 from . import _core
 from ._checks import _finite_result, _float_array, _n_from_dim, _out, _states, state_dim
+from .reduction import LevelSet as _LevelSet
 from .reduction import from_kotter as _from_kotter
 from .reduction import kotter as _kotter
 
@@ -707,7 +708,7 @@ class ManakovTop(FrahmTop):
         vals = _finite_result(_core.manakov_integrals(self._a, flat))
         return vals.reshape(lead + (vals.shape[1],))
 
-    def kotter(self, l: Any) -> Any:
+    def kotter(self, l: Any, *, errors: str = "raise") -> Any:
         """Schottky–Kötter coordinates of the state(s) ``l`` (n = 4 only).
 
         Shorthand for :func:`manakov.kotter` ``(self.a, self.b, l)``: the roots of
@@ -715,9 +716,16 @@ class ManakovTop(FrahmTop):
         points of the curve (8) with g, such that ξ_j = √c_j g P_kl, η_j = √c_j g P_j4
         (37), (42). See ``docs/kotter.md``.
 
+        For one-off use: each state gets its own level set's constants and
+        branch choices (documented root order, principal square roots, the
+        point of larger modulus first), which can change between samples of a
+        trajectory; there use :meth:`level_set`.
+
         Parameters
         ----------
         l : array_like, shape (..., 6)
+        errors : {"raise", "mask"}, keyword-only
+            As :func:`manakov.kotter`.
 
         Returns
         -------
@@ -729,7 +737,22 @@ class ManakovTop(FrahmTop):
             ``n != 4``, and as :func:`manakov.kotter`.
         """
         self._require_so4("kotter")
-        return _kotter(self._a, self._b, l)
+        return _kotter(self._a, self._b, l, errors=errors)
+
+    def level_set(self, l0: Any) -> Any:
+        """The level set of ``l0`` with Kötter's constants fixed once (n = 4 only).
+
+        Shorthand for :class:`manakov.LevelSet` ``(self.a, self.b, l0)``; its
+        ``kotter(l)`` maps states of the level set to divisors that move
+        continuously along a trajectory.
+
+        Raises
+        ------
+        ValueError
+            ``n != 4``, and as :class:`manakov.LevelSet`.
+        """
+        self._require_so4("level_set")
+        return _LevelSet(self._a, self._b, l0)
 
     def from_kotter(self, k: Any) -> np.ndarray:
         """Map Schottky–Kötter coordinates back to the state l (n = 4 only).

@@ -424,3 +424,39 @@ fn h0_38_39_closed_form_on_point_pairs() {
         assert!((lhs - rhs).norm() < 1e-11 * size, "{lhs} vs {rhs}");
     }
 }
+
+/// (19'): `F'(s_p) = −4 h0 σ_p f'(s_p)/(h1² − 4h0²)` equals `Π_{q≠p}(s_p − s_q)`
+/// (F monic) on well-separated roots, and `σ_p` is the branch where `f(s_p) = 0`.
+#[test]
+fn fprime_identity_19prime() {
+    let k = kotter_constants(&A, &L0).unwrap();
+    for p in 0..4 {
+        let prod: C = (0..4)
+            .filter(|&q| q != p)
+            .map(|q| k.s[p] - k.s[q])
+            .product();
+        let fp = k.sqrt_fprime[p] * k.sqrt_fprime[p];
+        assert_relative_eq!((fp - prod).norm() / prod.norm(), 0.0, epsilon = 1e-13);
+        let f = p_poly(&k.h, k.s[p]) + 2.0 * k.h[0] * k.sigma[p];
+        let scale = p_poly(&k.h, k.s[p]).norm() + (2.0 * k.h[0] * k.sigma[p]).norm();
+        assert!(f.norm() <= 1e-13 * scale);
+    }
+}
+
+/// One branch per level set: `kotter_along` keeps the constants of `l0`,
+/// refuses a state of another level set, and `follow_order` swaps a pair back.
+#[test]
+fn level_set_kotter_along() {
+    let k = kotter_constants(&A, &L0).unwrap();
+    let other: [f64; 6] = L0.map(|v| 1.01 * v);
+    let res = kotter_along(&k, &[L0, other, L0]);
+    assert!(res[0].is_ok() && res[2].is_ok());
+    assert!(res[1].is_err());
+    let st = res[0].as_ref().unwrap();
+    assert_eq!(st.constants.d, k.d);
+    let mut swapped = st.points;
+    std::mem::swap(&mut swapped.z1, &mut swapped.z2);
+    std::mem::swap(&mut swapped.y1, &mut swapped.y2);
+    follow_order(&st.points, &mut swapped);
+    assert_eq!((swapped.z1, swapped.y1), (st.points.z1, st.points.y1));
+}
