@@ -962,11 +962,24 @@ fn wurzel_from_roots(
             }
             let mut prefix = one;
             let mut sum = zero;
+            let mut size_t = 0.0;
             for i in 0..5 {
-                sum += prefix * q[i] * suffix[i + 1];
+                let term = prefix * q[i] * suffix[i + 1];
+                sum += term;
+                size_t += term.norm();
                 prefix *= fa[i];
             }
-            let v = eps[j] * eps[k] * sum;
+            // The plain difference (a − b)/(z1 − z2) rounds to u (|a| + |b|)/|z1 − z2|,
+            // the telescoped sum to u Σ|terms|: take the one with the smaller bound
+            // (far-apart points: the plain form, whose terms do not cancel).
+            let (a, b) = (prefix, suffix[0]);
+            let size_p = (a.norm() + b.norm()) / dz.norm();
+            let val = if dz != zero && size_p.is_finite() && size_p < size_t {
+                cdiv(a - b, dz)
+            } else {
+                sum
+            };
+            let v = eps[j] * eps[k] * val;
             pjk[j][k] = v;
             pjk[k][j] = v;
         }
