@@ -181,7 +181,9 @@ def main() -> None:
         rows_m = []
         for dt in DT_LADDER:
             tm, (_, ls) = median_time(
-                lambda dt=dt: top.integrate_many(l0s, t_end, t_eval=[t_end], dt=dt, parallel=False),
+                lambda dt=dt, l0s=l0s, t_end=t_end: top.integrate_many(
+                    l0s, t_end, t_eval=[t_end], dt=dt, parallel=False
+                ),
                 repeats,
             )
             e = rel_err(ls[:, -1], ref)
