@@ -59,8 +59,9 @@ DT_SCALE = {"gauss4": 0.01, "gauss6": 0.044, "gauss16": 1.5}
 #: Default number of samples when neither ``t_eval`` nor ``sample_every`` is given.
 DEFAULT_SAMPLES = 1001
 
-#: Most samples ``sample_every`` may ask for (10^9 samples of so(4) are 48 GB).
-MAX_SAMPLES = 10**9
+#: Most samples ``sample_every`` may ask for: 10^8 sample times are 0.8 GB, and
+#: the so(4) states at them 4.8 GB per trajectory.
+MAX_SAMPLES = 10**8
 
 #: Default step budget of one call to ``integrate``/``integrate_many`` (per
 #: trajectory): 10^8 steps bound a run to minutes (gauss16 ~1.3 µs a step on
@@ -653,8 +654,15 @@ class FrahmTop:
         times = self._sample_times(t_end, t_eval, sample_every)
         _check_method(method)
         if dt is None:
-            # One step for the whole batch: the smallest default over its members.
-            dtf = min((self.default_dt(x, method) for x in flat), default=1.0)
+            # One step for the whole batch: the smallest default over its members,
+            # that of the largest |l0| (the default is DT_SCALE / ((max c - min c) |l0|)).
+            if flat.shape[0] == 0:
+                dtf = 1.0
+            else:
+                big = np.max(np.abs(flat), axis=1, keepdims=True)
+                safe = np.where(big > 0, big, 1.0)
+                norms = big[:, 0] * np.linalg.norm(flat / safe, axis=1)
+                dtf = self.default_dt(flat[int(np.argmax(norms))], method)
         else:
             dtf = self._options(np.zeros(self.dim), method, dt)
         rt, at = self._tolerances(method, rtol, atol)
@@ -853,7 +861,7 @@ def _chunks(chunks: Any) -> int:
 
 def _scalar(x: Any, what: str) -> float:
     arr = np.asarray(x)
-    if arr.ndim != 0 or np.iscomplexobj(arr) or arr.dtype == object:
+    if arr.ndim != 0 or arr.dtype.kind not in "biuf":
         raise ValueError(f"{what} must be a real scalar, got {x!r}")
     v = float(arr)
     if not math.isfinite(v):
