@@ -50,14 +50,18 @@ SEED = 20261123
 DT_LADDER = (0.343, 0.3, 0.25, 0.2)
 TOL_LADDER = (EPS, 1e-15, 1e-14)
 BATCH = 4  # heyoka SIMD batch size: 4 doubles per AVX2 register
+CPU_TIME = False
 
 
 def median_time(fn, repeats: int):
+    """Median wall time, or process CPU time with --cpu-time (steadier on a shared
+    machine, where other jobs take turns on the cores; one thread only)."""
     times, out = [], None
+    clock = time.process_time if CPU_TIME else time.perf_counter
     for _ in range(repeats):
-        t0 = time.perf_counter()
+        t0 = clock()
         out = fn()
-        times.append(time.perf_counter() - t0)
+        times.append(clock() - t0)
     return statistics.median(times), out
 
 
@@ -129,9 +133,15 @@ def main() -> None:
     ap.add_argument("--ref-states", type=int, default=100)
     ap.add_argument("--threads", action="store_true", help="1 vs 2 threads on 1e4 states")
     ap.add_argument("--no-single", action="store_true")
+    ap.add_argument("--cpu-time", action="store_true", help="time one-thread runs in CPU time")
+    ap.add_argument("--sizes", default=None, help="comma-separated batch sizes")
     args = ap.parse_args()
+    global CPU_TIME
+    CPU_TIME = args.cpu_time
     repeats = 3 if args.quick else args.repeats
     sizes = (100, 1000) if args.quick else (100, 1000, 10_000)
+    if args.sizes:
+        sizes = tuple(int(x) for x in args.sizes.split(","))
     hy.llvm_state.set_diskcache_enabled(False)
 
     p = manakov.problem("generic")
@@ -201,6 +211,7 @@ def main() -> None:
         report(rows_m, rows_h, f"batch {n}")
 
     if args.threads:
+        CPU_TIME = False  # wall time: CPU time would add up the threads
         n = 10_000
         rng = np.random.default_rng(SEED + n)
         d = rng.standard_normal((n, 6))

@@ -593,3 +593,19 @@ def test_sigint_stops_a_long_run_within_half_a_second(what):
     assert extra_threads <= 0 and py_threads == 1  # nothing left running
     if what == "integrate":
         assert samples == 1  # the sample at t = 1 was reached and is kept
+
+
+# --- invariance under c_ij -> c_ij + k (issue 9) ------------------------------
+
+# Must-show: gauss16's error at t = 100 on 'generic' with every c_ij shifted by +100
+# is within 2x of the unshifted error, each against the exact flow of its own top.
+SHIFT_ERROR_RATIO = 2.0
+
+
+def test_nearly_equal_a_over_budget_names_the_cause():
+    p = manakov.problem("generic")
+    top = manakov.ManakovTop([0.3, 0.3 + 1e-6, 2.0, 3.7], p.b)  # c12 ~ -7e5
+    t0 = time.perf_counter()
+    with pytest.raises(ValueError, match=r"nearly equal a_i.*move the a_i apart"):
+        top.integrate(p.l0, 1000.0)
+    assert time.perf_counter() - t0 < REFUSAL_SECONDS

@@ -441,17 +441,36 @@ class FrahmTop:
     def _refuse_default_step(
         self, l0s: np.ndarray, method: str, dt: float, t_end: float, budget: int
     ) -> None:
-        """Name a huge ``|l0|`` as the cause when the *default* step needs too many steps."""
+        """Name the cause when the *default* step needs more than ``budget`` steps.
+
+        The default step is ``DT_SCALE / Ω``, ``Ω = (max c - min c) |l0|``: either a
+        huge ``|l0|`` or a large spread of the ``c_ij`` (for Manakov's top, nearly
+        equal ``a_i``) makes it small.
+        """
         if method in _EXPLICIT or not t_end / dt > budget:
             return
+        off = self._c[~np.eye(self.n, dtype=bool)]
+        spread = float(np.max(off) - np.min(off))
         big = float(np.max(np.abs(l0s), initial=0.0))
-        raise ValueError(
-            f"a huge |l0| (largest entry {big:.3g}): the default step {method} uses is "
-            f"DT_SCALE / Omega = {dt:.3g} with Omega = (max c - min c) |l0|, so t_end = "
-            f"{t_end:.3g} needs {t_end / dt:.3g} steps, more than max_steps = {budget}. "
-            "The motion's time scale is 1/|l0|: rescale the state (l -> l/s, t -> s t), "
-            "pass a larger dt, or raise max_steps"
+        need = (
+            f"the default {method} step is DT_SCALE / Omega = {dt:.3g}, Omega = "
+            f"(max c - min c) |l0| with max c - min c = {spread:.3g} and largest |l0| "
+            f"entry {big:.3g}, so t_end = {t_end:.3g} needs {t_end / dt:.3g} steps, more "
+            f"than max_steps = {budget}"
         )
+        if spread > big:
+            raise ValueError(
+                f"a large spread of the c_ij{self._spread_origin()}: {need}. The fast "
+                "motion this top carries needs steps of about 1/Omega: shorten t_end, "
+                "raise max_steps, pass a larger dt (less accurate), or move the a_i apart"
+            )
+        raise ValueError(
+            f"a huge |l0|: {need}. The motion's time scale is 1/|l0|: rescale the state "
+            "(l -> l/s, t -> s t), pass a larger dt, or raise max_steps"
+        )
+
+    def _spread_origin(self) -> str:
+        return ""
 
     def _options(self, l0: Any, method: str, dt: Any) -> float:
         _check_method(method)
@@ -839,6 +858,18 @@ class ManakovTop(FrahmTop):
         """
         self._require_so4("from_kotter")
         return _from_kotter(self._a, self._b, k)
+
+    def _spread_origin(self) -> str:
+        # The pair with the largest |c_ij| and how close its a_i are.
+        n = self.n
+        iu = np.triu_indices(n, 1)
+        k = int(np.argmax(np.abs(self._c[iu])))
+        i, j = int(iu[0][k]), int(iu[1][k])
+        gap = abs(float(self._a[i] - self._a[j]))
+        return (
+            f" (c{i + 1}{j + 1} = {self._c[i, j]:.3g} = (b{i + 1} - b{j + 1}) / "
+            f"(a{i + 1} - a{j + 1}) with a{i + 1} - a{j + 1} = {gap:.3g}: nearly equal a_i)"
+        )
 
     def _require_so4(self, what: str) -> None:
         if self.n != 4:
