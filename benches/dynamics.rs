@@ -5,7 +5,7 @@
 //! and report time per element = per step.
 
 use criterion::{black_box, criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
-use manakov::integrate::{integrate, Method, Options, MAX_STEPS};
+use manakov::integrate::{integrate, integrate_many, Method, Options, MAX_STEPS};
 use manakov::so4::{vector_field4_lanes, FrahmTop};
 
 const A: [f64; 4] = [0.3, 1.1, 2.0, 3.7];
@@ -111,5 +111,38 @@ fn steps(c: &mut Criterion) {
     g.finish();
 }
 
-criterion_group!(benches, rhs, steps);
+/// The trajectory-lane batch kernels (integrate_many, one thread): 64 states
+/// of the norm of 'generic''s l0 to t = 10; time per element = per trajectory-step.
+fn batch(c: &mut Criterion) {
+    let top = FrahmTop::manakov(&A, &B).unwrap();
+    let n0: f64 = L0.iter().map(|x| x * x).sum::<f64>().sqrt();
+    let rows = 64;
+    let mut y0s = seeded_state(11, rows * 6);
+    for y in y0s.chunks_mut(6) {
+        let n: f64 = y.iter().map(|x| x * x).sum::<f64>().sqrt();
+        y.iter_mut().for_each(|x| *x *= n0 / n);
+    }
+    let mut g = c.benchmark_group("batch");
+    g.sample_size(10);
+    for (method, dt, rtol) in [
+        (Method::Gauss16, 1.0 / 3.0, 0.0),
+        (Method::Dop853, 0.0, 1e-12),
+    ] {
+        let opts = Options {
+            method,
+            dt,
+            rtol,
+            atol: rtol,
+            max_steps: MAX_STEPS as u64,
+        };
+        let (_, steps) = integrate_many(&top, &y0s, 0.0, &[10.0], &opts, false).unwrap();
+        g.throughput(Throughput::Elements(steps));
+        g.bench_function(BenchmarkId::new("lanes_1thread", method.name()), |bch| {
+            bch.iter(|| integrate_many(&top, black_box(&y0s), 0.0, &[10.0], &opts, false).unwrap())
+        });
+    }
+    g.finish();
+}
+
+criterion_group!(benches, rhs, steps, batch);
 criterion_main!(benches);

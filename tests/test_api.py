@@ -178,7 +178,7 @@ def test_overflow_is_an_error_not_a_silent_nan(top):
     with pytest.raises(ValueError, match="overflow"):
         top.integrals(huge)
     # The default step scales as 1/|l0|: 1e200 steps would be needed.
-    with pytest.raises(ValueError, match="steps would be needed"):
+    with pytest.raises(ValueError, match=r"huge \|l0\|"):
         top.integrate(huge, 1.0)
     for method in ("gauss16", "gauss4", "dop853", "dopri5"):
         with pytest.raises(manakov.ConvergenceError):

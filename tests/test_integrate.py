@@ -4,6 +4,7 @@
 from __future__ import annotations
 
 import json
+import time
 from pathlib import Path
 
 import mpmath as mp
@@ -317,3 +318,294 @@ def test_bad_initial_state_raises_value_error(l0):
         top.integrate(l0, 1.0)
     with pytest.raises(ValueError):
         top.integrate_many(np.full((2, 5), 1.0), 1.0)
+
+
+# --- batch kernels (issue 12) -------------------------------------------------
+
+# Must-show: every trajectory's integrals drift <= 1e-13 relative at t = 1e4 with
+# gauss16 in batch mode (the single-trajectory claim, DRIFT_CLAIM, per member).
+BATCH_DRIFT_CLAIM = 1e-13
+
+
+def _random_states(n: int, seed: int, norm: float) -> np.ndarray:
+    d = np.random.default_rng(seed).standard_normal((n, 6))
+    return d / np.linalg.norm(d, axis=1)[:, None] * norm
+
+
+@pytest.mark.parametrize("method", ["gauss16", "dop853"])
+@pytest.mark.parametrize("rows", [1, 3, 7, 1001])
+def test_integrate_many_matches_integrate_bit_for_bit(method, rows):
+    """The trajectory-lane kernels (4 states per vector) give integrate's results
+    exactly, also for batch sizes that are not multiples of the lane width."""
+    p = manakov.problem("generic")
+    top = manakov.ManakovTop(p.a, p.b)
+    l0s = _random_states(rows, rows, 1.0) * np.random.default_rng(0).uniform(0.5, 2, (rows, 1))
+    te = [0.0, 0.4, 0.4, 1.0, 2.5]
+    kw = {"t_eval": te, "method": method}
+    for parallel in (False, True):
+        t, ls = top.integrate_many(l0s, 2.5, parallel=parallel, dt=0.3, **kw)
+        np.testing.assert_array_equal(t, te)
+        for i in range(rows) if rows < 50 else range(0, rows, 97):
+            tr = top.integrate(l0s[i], 2.5, dt=0.3, **kw)
+            np.testing.assert_array_equal(ls[i], tr.l)
+
+
+def _batch_drift(top, l0s, t_end):
+    _, ls = top.integrate_many(l0s, t_end, sample_every=t_end / 10)
+    a = top.a
+    # Each integral relative to the sum of the magnitudes of its terms, so that an
+    # integral that is small by cancellation (H0 of a random state) is not amplified.
+    ints = top.integrals(ls)
+    x2 = ls**2
+    pairs = [(0, 1), (0, 2), (0, 3), (1, 2), (1, 3), (2, 3)]
+    comp = [tuple(sorted({0, 1, 2, 3} - set(pq))) for pq in pairs]
+    scales = {
+        "H0": np.abs(ls[..., 0] * ls[..., 5])
+        + np.abs(ls[..., 3] * ls[..., 2])
+        + np.abs(ls[..., 1] * ls[..., 4]),
+        "H1": x2.sum(-1),
+        "H2": (x2 * np.array([abs(a[u] + a[v]) for u, v in comp])).sum(-1),
+        "H3": (x2 * np.array([abs(a[u] * a[v]) for u, v in comp])).sum(-1),
+        "H": 0.5 * (x2 * np.abs(top.c[np.triu_indices(4, 1)])).sum(-1),
+    }
+    return max(float(np.max(np.abs(v - v[..., :1]) / scales[k][..., :1])) for k, v in ints.items())
+
+
+def test_batch_drift_gauss16_to_1e4():
+    p = manakov.problem("generic")
+    top = manakov.ManakovTop(p.a, p.b)
+    l0s = _random_states(8, 5, float(np.linalg.norm(p.l0)))
+    assert _batch_drift(top, l0s, 1e4) <= BATCH_DRIFT_CLAIM
+
+
+@pytest.mark.slow
+def test_batch_drift_gauss16_to_1e4_many_states():
+    p = manakov.problem("generic")
+    top = manakov.ManakovTop(p.a, p.b)
+    l0s = _random_states(64, 6, float(np.linalg.norm(p.l0)))
+    assert _batch_drift(top, l0s, 1e4) <= BATCH_DRIFT_CLAIM
+
+
+# --- budgets, sizes and argument checks (issue 11) ----------------------------
+
+# A refused run must fail before doing the work: well under 0.1 s (the issue's bound).
+REFUSAL_SECONDS = 0.1
+
+
+def _refused(fn, match):
+    t0 = time.perf_counter()
+    with pytest.raises(ValueError, match=match):
+        fn()
+    return time.perf_counter() - t0
+
+
+@pytest.mark.parametrize("method", ["gauss16", "dop853"])
+def test_over_budget_sample_spacing_is_refused_at_once(method):
+    p = manakov.problem("generic")
+    top = manakov.ManakovTop(p.a, p.b)
+    dt = 0.3 if method == "gauss16" else None
+    el = _refused(
+        lambda: top.integrate(p.l0, 1e5, sample_every=1.0, max_steps=10**4, dt=dt, method=method),
+        "sample spacing",
+    )
+    assert el < REFUSAL_SECONDS
+    el = _refused(
+        lambda: top.integrate_many(
+            np.tile(p.l0, (8, 1)), 1e5, sample_every=1.0, max_steps=10**4, dt=dt, method=method
+        ),
+        "sample spacing",
+    )
+    assert el < REFUSAL_SECONDS
+    # Samples 0.1 apart at dt = 0.3: 1000 intervals need 1000 steps although
+    # t_end / dt is only 334.
+    el = _refused(
+        lambda: top.integrate(p.l0, 100.0, sample_every=0.1, dt=0.3, max_steps=500),
+        "sample spacing",
+    )
+    assert el < REFUSAL_SECONDS
+
+
+def test_over_budget_huge_l0_is_refused_at_once():
+    p = manakov.problem("generic")
+    top = manakov.ManakovTop(p.a, p.b)
+    big = p.l0 * 1e12
+    assert _refused(lambda: top.integrate(big, 100.0), r"huge \|l0\|") < REFUSAL_SECONDS
+    assert (
+        _refused(lambda: top.integrate_many(np.tile(big, (3, 1)), 100.0), r"huge \|l0\|")
+        < REFUSAL_SECONDS
+    )
+
+
+def test_over_budget_dt_is_refused_at_once_and_before_progress():
+    p = manakov.problem("generic")
+    top = manakov.ManakovTop(p.a, p.b)
+    seen = []
+    el = _refused(
+        lambda: top.integrate(
+            p.l0, 1000.0, dt=1e-3, chunks=10, progress=seen.append, max_steps=2000
+        ),
+        "dt:",
+    )
+    assert el < REFUSAL_SECONDS and seen == []
+
+
+def test_huge_batch_output_is_a_value_error_not_an_abort():
+    p = manakov.problem("generic")
+    top = manakov.ManakovTop(p.a, p.b)
+    # 10^5 states x 10^6 + 1 samples x 6 doubles = 4.8 TB: refused before allocating.
+    l0s = np.tile(p.l0, (10**5, 1))
+    el = _refused(
+        lambda: top.integrate_many(l0s, 1e6, sample_every=1.0, method="dop853", max_steps=10**11),
+        "cannot allocate",
+    )
+    assert el < 1.0  # includes building the 8 MB sample grid
+
+
+def test_explicit_run_out_of_budget_keeps_the_partial_trajectory():
+    p = manakov.problem("generic")
+    top = manakov.ManakovTop(p.a, p.b)
+    with pytest.raises(ValueError, match="max_steps") as info:
+        top.integrate(p.l0, 100.0, sample_every=1.0, method="dop853", max_steps=300)
+    part = info.value.partial
+    assert isinstance(part, manakov.Trajectory) and 0 < part.t.size < 101
+    full = top.integrate(p.l0, 100.0, sample_every=1.0, method="dop853")
+    np.testing.assert_array_equal(part.l, full.l[: part.t.size])
+    np.testing.assert_array_equal(part.t, full.t[: part.t.size])
+
+
+def test_trajectory_t_is_a_copy_of_t_eval():
+    p = manakov.problem("generic")
+    top = manakov.ManakovTop(p.a, p.b)
+    te = np.array([0.0, 0.5, 1.0])
+    tr = top.integrate(p.l0, 1.0, t_eval=te)
+    assert tr.t is not te and not np.shares_memory(tr.t, te)
+    np.testing.assert_array_equal(tr.t, te)
+
+
+@pytest.mark.parametrize("method", ["gauss16", "dop853", "dopri5"])
+def test_default_dt_refuses_non_finite_l0_for_every_method(method):
+    p = manakov.problem("generic")
+    top = manakov.ManakovTop(p.a, p.b)
+    with pytest.raises(ValueError, match="finite"):
+        top.default_dt(np.array([np.inf, 0, 0, 0, 0, 0]), method)
+
+
+def test_tiny_sample_every_is_a_value_error():
+    p = manakov.problem("generic")
+    top = manakov.ManakovTop(p.a, p.b)
+    with pytest.raises(ValueError, match="samples"):
+        top.integrate(p.l0, 1e300, sample_every=1e-300)
+
+
+@pytest.mark.parametrize("chunks", [0, -3, 1.5, True, "2"])
+def test_chunks_must_be_a_positive_integer(chunks):
+    p = manakov.problem("generic")
+    top = manakov.ManakovTop(p.a, p.b)
+    with pytest.raises(ValueError, match="chunks"):
+        top.integrate(p.l0, 1.0, chunks=chunks)
+
+
+@pytest.mark.parametrize("method", ["gauss4", "gauss6", "gauss16"])
+def test_gauss_methods_ignore_rtol_atol_as_documented(method):
+    p = manakov.problem("generic")
+    top = manakov.ManakovTop(p.a, p.b)
+    a = top.integrate(p.l0, 1.0, method=method, rtol=-5, atol=float("nan"))
+    b = top.integrate(p.l0, 1.0, method=method)
+    np.testing.assert_array_equal(a.l, b.l)
+    _, ls = top.integrate_many(p.l0[None], 1.0, method=method, rtol=-5)
+    np.testing.assert_array_equal(ls[0], b.l)
+
+
+def test_overflowing_a_difference_is_refused():
+    with pytest.raises(ValueError, match="overflows"):
+        manakov.ManakovTop([1e308, -1e308, 3, 4], [1, 2, 3, 4])
+
+
+@pytest.mark.parametrize("bad", [["1", "2", "3", "4"], [b"1", b"2", b"3", b"4"]])
+def test_strings_are_not_numbers(bad):
+    with pytest.raises(ValueError, match="numeric"):
+        manakov.ManakovTop(bad, [1.0, 2.0, 3.0, 4.0])
+    p = manakov.problem("generic")
+    top = manakov.ManakovTop(p.a, p.b)
+    with pytest.raises(ValueError):
+        top.integrate(p.l0, "10")
+
+
+# --- Ctrl-C (issue 11) --------------------------------------------------------
+
+# Must-show: a long integrate / integrate_many stops within 0.5 s of SIGINT.
+SIGINT_LATENCY = 0.5
+
+_CHILD = r"""
+import os, sys, threading, time
+import numpy as np
+import manakov
+
+p = manakov.problem("generic")
+top = manakov.ManakovTop(p.a, p.b)
+what = sys.argv[1]
+ntasks = lambda: len(os.listdir("/proc/self/task"))
+top.integrate_many(np.tile(p.l0, (8, 1)), 1.0)  # starts rayon's pool beforehand
+before = ntasks()
+print("READY", flush=True)
+try:
+    if what == "integrate":
+        top.integrate(p.l0, 1e9, t_eval=[1.0, 1e9], max_steps=10**11)
+    else:
+        parallel = what == "integrate_many"
+        l0s = np.tile(p.l0, (64, 1))
+        top.integrate_many(l0s, 1e7, t_eval=[1e7], max_steps=10**11, parallel=parallel)
+    print("FINISHED", flush=True)
+except KeyboardInterrupt as err:
+    t = time.monotonic()
+    samples = err.partial.t.size if hasattr(err, "partial") else -1
+    time.sleep(0.1)
+    print("INTERRUPTED", t, ntasks() - before, threading.active_count(), samples, flush=True)
+"""
+
+
+@pytest.mark.skipif(not Path("/proc/self/task").exists(), reason="needs Linux /proc")
+@pytest.mark.parametrize("what", ["integrate", "integrate_many", "integrate_many_serial"])
+def test_sigint_stops_a_long_run_within_half_a_second(what):
+    import signal
+    import subprocess
+    import sys
+
+    proc = subprocess.Popen([sys.executable, "-c", _CHILD, what], stdout=subprocess.PIPE, text=True)
+    try:
+        assert proc.stdout is not None
+        assert proc.stdout.readline().strip() == "READY"
+        time.sleep(0.5)
+        t_sig = time.monotonic()
+        proc.send_signal(signal.SIGINT)
+        out, _ = proc.communicate(timeout=30)
+    finally:
+        proc.kill()
+    fields = out.split()
+    assert fields[0] == "INTERRUPTED", out
+    t_stop, extra_threads, py_threads, samples = (
+        float(fields[1]),
+        int(fields[2]),
+        int(fields[3]),
+        int(fields[4]),
+    )
+    assert t_stop - t_sig < SIGINT_LATENCY
+    assert extra_threads <= 0 and py_threads == 1  # nothing left running
+    if what == "integrate":
+        assert samples == 1  # the sample at t = 1 was reached and is kept
+
+
+# --- invariance under c_ij -> c_ij + k (issue 9) ------------------------------
+
+# Must-show: gauss16's error at t = 100 on 'generic' with every c_ij shifted by +100
+# is within 2x of the unshifted error, each against the exact flow of its own top.
+SHIFT_ERROR_RATIO = 2.0
+
+
+def test_nearly_equal_a_over_budget_names_the_cause():
+    p = manakov.problem("generic")
+    top = manakov.ManakovTop([0.3, 0.3 + 1e-6, 2.0, 3.7], p.b)  # c12 ~ -7e5
+    t0 = time.perf_counter()
+    with pytest.raises(ValueError, match=r"nearly equal a_i.*move the a_i apart"):
+        top.integrate(p.l0, 1000.0)
+    assert time.perf_counter() - t0 < REFUSAL_SECONDS

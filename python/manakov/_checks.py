@@ -39,8 +39,10 @@ def _float_array(x: Any, what: str) -> np.ndarray:
     arr = np.asarray(x)
     if np.iscomplexobj(arr):
         raise ValueError(f"{what} must be real, got a complex array")
-    if arr.dtype == object:
-        raise ValueError(f"{what} must be a numeric array")
+    # Only booleans, integers and floats are numbers: numpy would also convert
+    # strings ('1' -> 1.0), bytes, datetimes and objects.
+    if arr.dtype.kind not in "biuf":
+        raise ValueError(f"{what} must be a real numeric array, got dtype {arr.dtype}")
     arr = arr.astype(np.float64, copy=False)
     if not np.all(np.isfinite(arr)):
         raise ValueError(f"{what} must be finite; it contains NaN or infinity")

@@ -6,6 +6,7 @@ from numpy.typing import NDArray
 
 __all__ = [
     "ConvergenceError",
+    "check_budget",
     "check_c",
     "curve_branch_points",
     "curve_constants",
@@ -101,7 +102,10 @@ def integrate(
     rtol: float,
     atol: float,
     max_steps: int,
-) -> tuple[NDArray[np.float64], int, int]: ...
+) -> tuple[NDArray[np.float64], int, int, BaseException | None]: ...
+def check_budget(
+    method: str, t0: float, times: NDArray[np.float64], dt: float, max_steps: int
+) -> None: ...
 def integrate_many(
     c: NDArray[np.float64],
     l0s: NDArray[np.float64],

@@ -60,11 +60,15 @@ DT_SCALE = {"gauss4": 0.01, "gauss6": 0.044, "gauss16": 1.5}
 #: Default number of samples when neither ``t_eval`` nor ``sample_every`` is given.
 DEFAULT_SAMPLES = 1001
 
+#: Most samples ``sample_every`` may ask for: 10^8 sample times are 0.8 GB, and
+#: the so(4) states at them 4.8 GB per trajectory.
+MAX_SAMPLES = 10**8
+
 #: Default step budget of one call to ``integrate``/``integrate_many`` (per
-#: trajectory). The core releases the GIL, so a run cannot be interrupted:
-#: 10^8 steps bound it to minutes (gauss16 ~1.7 µs a step on 'generic', dop853
-#: ~0.3 µs) while leaving a 10x margin over the 10^7-step runs of the issue.
-#: Pass ``max_steps`` (up to 10^11) for longer runs.
+#: trajectory): 10^8 steps bound a run to minutes (gauss16 ~1.3 µs a step on
+#: 'generic', dop853 ~0.3 µs) while leaving a 10x margin over the 10^7-step runs
+#: of the issue. Runs are interruptible (Ctrl-C). Pass ``max_steps`` (up to 10^11)
+#: for longer runs.
 DEFAULT_MAX_STEPS = 10**8
 
 #: The core's hard cap on ``max_steps`` (``integrate::MAX_STEPS``).
@@ -373,12 +377,13 @@ class FrahmTop:
         Raises
         ------
         ValueError
-            Unknown ``method``, complex or non-finite ``l0``, or a step that underflows.
+            Unknown ``method``, complex or non-finite ``l0`` (for every method), or a
+            step that underflows.
         """
         _check_method(method)
+        ts = self.time_scale(l0)  # checks l0 (real, finite) for every method
         if method in _EXPLICIT:
             return 0.0
-        ts = self.time_scale(l0)
         if not math.isfinite(ts):
             return 1.0
         dt = DT_SCALE[method] * ts
@@ -398,14 +403,20 @@ class FrahmTop:
                 raise ValueError(f"t_eval must be 1-d, got shape {te.shape}")
             if te.size and (np.any(np.diff(te) < 0) or te[0] < 0 or te[-1] > t_end_f):
                 raise ValueError("t_eval must be sorted and lie in [0, t_end]")
-            return np.ascontiguousarray(te)
+            # A copy: the trajectory never shares memory with the caller's array.
+            return np.array(te, dtype=np.float64, order="C", copy=True)
         if sample_every is not None:
             every = _scalar(sample_every, "sample_every")
             if every <= 0:
                 raise ValueError(f"sample_every must be > 0, got {every}")
-            k = math.floor(t_end_f / every * (1 + 1e-12))
-            if k > 10**9:
-                raise ValueError(f"sample_every = {every} gives more than 10^9 samples")
+            with np.errstate(over="ignore"):
+                ratio = float(np.float64(t_end_f) / np.float64(every)) * (1 + 1e-12)
+            if not ratio <= MAX_SAMPLES:
+                raise ValueError(
+                    f"sample_every = {every} gives more than {MAX_SAMPLES:.0e} samples "
+                    f"on [0, {t_end_f}]"
+                )
+            k = math.floor(ratio)
             times = np.arange(k + 1, dtype=float) * every
             times = times[times <= t_end_f]
             if times[-1] < t_end_f:
@@ -420,6 +431,47 @@ class FrahmTop:
         if not 1 <= max_steps <= _MAX_STEPS_CAP:
             raise ValueError(f"max_steps must be in [1, 10^11], got {max_steps}")
         return int(max_steps)
+
+    @staticmethod
+    def _tolerances(method: str, rtol: Any, atol: Any) -> tuple[float, float]:
+        """``rtol``, ``atol`` of an explicit method (checked); Gauss methods ignore them."""
+        if method not in _EXPLICIT:
+            return 0.0, 0.0
+        return _scalar(rtol, "rtol"), _scalar(atol, "atol")
+
+    def _refuse_default_step(
+        self, l0s: np.ndarray, method: str, dt: float, t_end: float, budget: int
+    ) -> None:
+        """Name the cause when the *default* step needs more than ``budget`` steps.
+
+        The default step is ``DT_SCALE / Ω``, ``Ω = (max c - min c) |l0|``: either a
+        huge ``|l0|`` or a large spread of the ``c_ij`` (for Manakov's top, nearly
+        equal ``a_i``) makes it small.
+        """
+        if method in _EXPLICIT or not t_end / dt > budget:
+            return
+        off = self._c[~np.eye(self.n, dtype=bool)]
+        spread = float(np.max(off) - np.min(off))
+        big = float(np.max(np.abs(l0s), initial=0.0))
+        need = (
+            f"the default {method} step is DT_SCALE / Omega = {dt:.3g}, Omega = "
+            f"(max c - min c) |l0| with max c - min c = {spread:.3g} and largest |l0| "
+            f"entry {big:.3g}, so t_end = {t_end:.3g} needs {t_end / dt:.3g} steps, more "
+            f"than max_steps = {budget}"
+        )
+        if spread > big:
+            raise ValueError(
+                f"a large spread of the c_ij{self._spread_origin()}: {need}. The fast "
+                "motion this top carries needs steps of about 1/Omega: shorten t_end, "
+                "raise max_steps, pass a larger dt (less accurate), or move the a_i apart"
+            )
+        raise ValueError(
+            f"a huge |l0|: {need}. The motion's time scale is 1/|l0|: rescale the state "
+            "(l -> l/s, t -> s t), pass a larger dt, or raise max_steps"
+        )
+
+    def _spread_origin(self) -> str:
+        return ""
 
     def _options(self, l0: Any, method: str, dt: Any) -> float:
         _check_method(method)
@@ -466,19 +518,23 @@ class FrahmTop:
             Default (neither given): 1001 evenly spaced samples.
         method : {"gauss16", "gauss6", "gauss4", "dopri5", "dop853"}
         rtol, atol : float
-            Tolerances of ``dopri5`` and ``dop853`` (ignored by Gauss methods):
-            each step keeps its error estimate below ``atol + rtol |l|``
-            componentwise. ``rtol`` must be at least ``100 eps`` (about 2.2e-14,
-            scipy's floor; a smaller relative target is below the rounding of a
-            step) and ``atol`` >= 0; otherwise ValueError.
+            Tolerances of ``dopri5`` and ``dop853``: each step keeps its error
+            estimate below ``atol + rtol |l|`` componentwise. ``rtol`` must be at
+            least ``100 eps`` (about 2.2e-14, scipy's floor; a smaller relative
+            target is below the rounding of a step) and ``atol`` >= 0; otherwise
+            ValueError. Gauss methods ignore both (they are neither used nor checked).
         progress : callable, optional
             Called with the fraction done after each chunk.
         chunks : int
-            Split the run into this many calls to the core (for ``progress``).
+            Split the run into this many calls to the core (for ``progress``); an
+            integer >= 1 (capped at the number of samples), else ValueError.
         max_steps : int
-            Step budget of the whole run (default :data:`DEFAULT_MAX_STEPS`,
-            at most 10^11): Gauss methods refuse a run that needs more before
-            taking a step, explicit methods stop when they exceed it.
+            Step budget of the whole run (default :data:`DEFAULT_MAX_STEPS`, at most
+            10^11). Checked before the first step: more sample intervals than
+            ``max_steps`` (each needs a step), or for Gauss methods more steps than
+            ``max_steps`` (known in advance), is refused with a ValueError naming
+            the cause (the sample spacing, a huge ``|l0|`` behind the default step,
+            or ``dt``). Explicit methods stop once they exceed it.
 
         Returns
         -------
@@ -489,45 +545,80 @@ class FrahmTop:
         ValueError
             Bad shapes, non-finite values, ``t_end`` < 0 or NaN, ``dt`` <= 0,
             an unknown ``method``, ``rtol`` below ``100 eps`` or ``atol`` < 0 for
-            an explicit method, or more than ``max_steps`` steps needed.
+            an explicit method, ``chunks`` not an integer >= 1, or a run over
+            ``max_steps`` (refused before any step, or for an explicit method when
+            it runs out).
         manakov.ConvergenceError
             A Gauss step whose stage equations do not converge (``dt`` too large).
+        KeyboardInterrupt
+            Ctrl-C (SIGINT) during the run: the call stops within a few
+            milliseconds.
+
+        Notes
+        -----
+        An error raised after the run started (KeyboardInterrupt, an explicit
+        method's ``max_steps``, ConvergenceError) carries the samples computed up
+        to that point as ``err.partial``, a :class:`Trajectory` (possibly with
+        zero samples)::
+
+            try:
+                tr = top.integrate(l0, 1e7)
+            except KeyboardInterrupt as err:
+                tr = err.partial  # the samples before Ctrl-C
         """
         l0a, _ = _states(l0, self.dim, "l0")
         if l0a.shape[0] != 1 or np.ndim(l0) != 1:
             raise ValueError(f"l0 must have shape ({self.dim},), got {np.shape(l0)}")
         times = self._sample_times(t_end, t_eval, sample_every)
         dtf = self._options(l0a[0], method, dt)
-        rt, at = _scalar(rtol, "rtol"), _scalar(atol, "atol")
+        rt, at = self._tolerances(method, rtol, atol)
         budget = self._max_steps(max_steps)
-        if times.size == 0:
-            ls = np.empty((0, self.dim))
-            steps = evals = 0
-        else:
-            pieces = np.array_split(times, max(1, min(int(chunks), times.size)))
+        n_chunks = _chunks(chunks)
+        if times.size and dt is None:
+            self._refuse_default_step(l0a, method, dtf, float(times[-1]), budget)
+        # The whole run's budget, before the first step of the first chunk.
+        _core.check_budget(method, 0.0, times, dtf, budget)
+        out: list[np.ndarray] = []
+        steps = evals = 0
+
+        def trajectory(partial: bool = False) -> Trajectory:
+            ls = np.concatenate(out) if out else np.empty((0, self.dim))
+            try:
+                integrals = self.integrals(ls)
+            except ValueError:
+                if not partial:
+                    raise
+                # The samples before a failure may overflow the integrals: keep the
+                # samples, without integrals.
+                integrals = {}
+            return Trajectory(
+                t=times[: ls.shape[0]].copy(),
+                l=ls,
+                integrals=integrals,
+                method=method,
+                dt=dtf,
+                steps=int(steps),
+                evals=int(evals),
+            )
+
+        if times.size:
+            pieces = np.array_split(times, min(n_chunks, times.size))
             y, t0 = l0a[0], 0.0
-            out, steps, evals = [], 0, 0
             for piece in pieces:
-                if steps >= budget:
-                    raise ValueError(f"more steps needed than max_steps = {budget}")
-                ys, s, e = _core.integrate(
+                ys, s, e, err = _core.integrate(
                     self._c, y, t0, piece, method, dtf, rt, at, budget - steps
                 )
                 out.append(ys)
                 steps, evals = steps + s, evals + e
+                if err is not None:
+                    # Ctrl-C, max_steps or a failed step: the samples reached so far
+                    # ride on the exception (documented as ``err.partial``).
+                    err.partial = trajectory(partial=True)  # type: ignore[attr-defined]
+                    raise err
                 y, t0 = ys[-1], float(piece[-1])
                 if progress is not None:
                     progress(t0 / float(times[-1]) if times[-1] > 0 else 1.0)
-            ls = np.concatenate(out)
-        return Trajectory(
-            t=times,
-            l=ls,
-            integrals=self.integrals(ls),
-            method=method,
-            dt=dtf,
-            steps=int(steps),
-            evals=int(evals),
-        )
+        return trajectory()
 
     def integrate_many(
         self,
@@ -554,7 +645,16 @@ class FrahmTop:
         parallel : bool
             Split the batch over threads (rayon).
         max_steps : int
-            Step budget of each trajectory, as in :meth:`integrate`.
+            Step budget of each trajectory, as in :meth:`integrate`; with the
+            output size, checked before any work or allocation.
+
+        Notes
+        -----
+        For so(4) with ``gauss16`` or ``dop853`` the batch runs on a kernel whose
+        vector lanes carry different trajectories (4 per AVX2 register); the
+        results equal :meth:`integrate` state by state, bit for bit (see
+        ``docs/dynamics.md``). The call is interruptible (Ctrl-C raises
+        KeyboardInterrupt; no thread outlives the call).
 
         Returns
         -------
@@ -564,29 +664,34 @@ class FrahmTop:
         Raises
         ------
         ValueError
-            As :meth:`integrate`.
+            As :meth:`integrate`, and an output too large to allocate.
         manakov.ConvergenceError
             As :meth:`integrate`.
+        KeyboardInterrupt
+            Ctrl-C during the run.
         """
         flat, lead = _states(l0s, self.dim, "l0s")
         times = self._sample_times(t_end, t_eval, sample_every)
         _check_method(method)
         if dt is None:
-            # One step for the whole batch: the smallest default over its members.
-            dtf = min((self.default_dt(x, method) for x in flat), default=1.0)
+            # One step for the whole batch: the smallest default over its members,
+            # that of the largest |l0| (the default is DT_SCALE / ((max c - min c) |l0|)).
+            if flat.shape[0] == 0:
+                dtf = 1.0
+            else:
+                big = np.max(np.abs(flat), axis=1, keepdims=True)
+                safe = np.where(big > 0, big, 1.0)
+                norms = big[:, 0] * np.linalg.norm(flat / safe, axis=1)
+                dtf = self.default_dt(flat[int(np.argmax(norms))], method)
         else:
             dtf = self._options(np.zeros(self.dim), method, dt)
+        rt, at = self._tolerances(method, rtol, atol)
+        budget = self._max_steps(max_steps)
+        if times.size and flat.shape[0] and dt is None:
+            self._refuse_default_step(flat, method, dtf, float(times[-1]), budget)
+        # The core checks the budget and the output size before allocating.
         ys, _ = _core.integrate_many(
-            self._c,
-            flat,
-            0.0,
-            times,
-            method,
-            dtf,
-            _scalar(rtol, "rtol"),
-            _scalar(atol, "atol"),
-            self._max_steps(max_steps),
-            bool(parallel),
+            self._c, flat, 0.0, times, method, dtf, rt, at, budget, bool(parallel)
         )
         return times, ys.reshape(lead + (times.size, self.dim))
 
@@ -777,6 +882,18 @@ class ManakovTop(FrahmTop):
         self._require_so4("from_kotter")
         return _from_kotter(self._a, self._b, k)
 
+    def _spread_origin(self) -> str:
+        # The pair with the largest |c_ij| and how close its a_i are.
+        n = self.n
+        iu = np.triu_indices(n, 1)
+        k = int(np.argmax(np.abs(self._c[iu])))
+        i, j = int(iu[0][k]), int(iu[1][k])
+        gap = abs(float(self._a[i] - self._a[j]))
+        return (
+            f" (c{i + 1}{j + 1} = {self._c[i, j]:.3g} = (b{i + 1} - b{j + 1}) / "
+            f"(a{i + 1} - a{j + 1}) with a{i + 1} - a{j + 1} = {gap:.3g}: nearly equal a_i)"
+        )
+
     def _require_so4(self, what: str) -> None:
         if self.n != 4:
             raise ValueError(f"{what} is defined for so(4) only (n = 4), this top has n = {self.n}")
@@ -790,9 +907,15 @@ def _check_method(method: Any) -> None:
         raise ValueError(f"unknown method {method!r}; known: {', '.join(METHODS)}")
 
 
+def _chunks(chunks: Any) -> int:
+    if isinstance(chunks, bool) or not isinstance(chunks, (int, np.integer)) or chunks < 1:
+        raise ValueError(f"chunks must be an integer >= 1, got {chunks!r}")
+    return int(chunks)
+
+
 def _scalar(x: Any, what: str) -> float:
     arr = np.asarray(x)
-    if arr.ndim != 0 or np.iscomplexobj(arr) or arr.dtype == object:
+    if arr.ndim != 0 or arr.dtype.kind not in "biuf":
         raise ValueError(f"{what} must be a real scalar, got {x!r}")
     v = float(arr)
     if not math.isfinite(v):

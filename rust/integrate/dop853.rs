@@ -14,6 +14,7 @@
 #![allow(clippy::excessive_precision)]
 
 use super::{scaled, starting_step, VectorField};
+use crate::cancel::Cancel;
 use crate::error::{Error, Result};
 
 /// Nodes `c_i`. The vector field is autonomous, so only the order-condition
@@ -35,7 +36,7 @@ const C: [f64; 12] = [
 ];
 
 /// Rows of the Runge–Kutta matrix, `A[i][j]`, `j < i` (zeros as published).
-const A: [[f64; 11]; 12] = [
+pub(super) const A: [[f64; 11]; 12] = [
     [0.0; 11],
     [
         5.26001519587677318785587544488e-02,
@@ -183,7 +184,7 @@ const A: [[f64; 11]; 12] = [
 ];
 
 /// 8th-order weights.
-const B: [f64; 12] = [
+pub(super) const B: [f64; 12] = [
     5.42937341165687622380535766363e-02,
     0.0,
     0.0,
@@ -199,14 +200,14 @@ const B: [f64; 12] = [
 ];
 
 /// 3rd-order embedded weights on stages 1, 9, 12.
-const BHH: [f64; 3] = [
+pub(super) const BHH: [f64; 3] = [
     0.244094488188976377952755905512,
     0.733846688281611857341361741547,
     0.220588235294117647058823529412e-01,
 ];
 
 /// 8th minus 5th-order weights (the 5th-order error estimate).
-const ER: [f64; 12] = [
+pub(super) const ER: [f64; 12] = [
     0.1312004499419488073250102996e-01,
     0.0,
     0.0,
@@ -258,9 +259,11 @@ impl Dop853 {
         t: &mut f64,
         t_target: f64,
         budget: u64,
+        cancel: &Cancel,
     ) -> Result<u64> {
         let m = self.m;
         let mut steps = 0u64;
+        let mut attempts = 0u32;
         if !self.k1_valid {
             f.eval(y, &mut self.k[0..m]);
             self.evals += 1;
@@ -273,6 +276,10 @@ impl Dop853 {
             let remaining = t_target - *t;
             let last = self.h >= remaining;
             let h = if last { remaining } else { self.h };
+            attempts = attempts.wrapping_add(1);
+            if attempts % super::CHECK_EVERY == 0 {
+                cancel.check()?;
+            }
             if h <= 1e-14 * t.abs().max(1.0) && !last {
                 return Err(Error::NoConvergence {
                     what: "dop853 step size underflow",

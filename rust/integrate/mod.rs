@@ -27,17 +27,36 @@
 //! consecutive sample times a Gauss method takes `n = ⌈Δt / dt⌉` equal steps of
 //! size `Δt / n ≤ dt`, so a sample lands exactly on its time and memory is
 //! `O(samples)`: a step allocates nothing (see `tests/alloc.rs`).
+//!
+//! **Batches.** [`integrate_many`] runs so(4) batches with gauss16 and dop853 on
+//! the lane kernels of `batch.rs` (each vector lane a different trajectory,
+//! [`LANES`] at a time), bit-for-bit equal to [`integrate`] state by state, in
+//! parallel over lane groups with rayon.
+//!
+//! **Budgets and cancellation.** Step budgets and output sizes are checked before
+//! any work or allocation ([`check_budget`]); the `_with` variants take a
+//! [`Cancel`] token and check it every [`CHECK_EVERY`] steps (well under a
+//! millisecond of work), returning `Error::Interrupted`.
 
 // Index loops mirror the subscripts of the formulas (i, j stages; k components).
 #![allow(clippy::needless_range_loop)]
 
+mod batch;
 mod dop853;
 #[rustfmt::skip]
 pub mod gauss_tables;
 
 use rayon::prelude::*;
 
+pub use crate::cancel::Cancel;
 use crate::error::{check_finite, Error, Result};
+
+/// Trajectories per vector group of the batch kernels (f64 lanes of AVX2).
+pub const LANES: usize = batch::W;
+
+/// Steps (or step attempts) between two checks of the [`Cancel`] token: 64
+/// steps are 0.02–0.2 ms of work, far below the 0.5 s promised for Ctrl-C.
+pub const CHECK_EVERY: u32 = 64;
 use crate::so4::FrahmTop;
 
 /// An autonomous vector field `ẏ = f(y)` on `R^dim`.
@@ -46,6 +65,12 @@ pub trait VectorField: Sync {
     fn dim(&self) -> usize;
     /// Writes `f(y)` into `dy`; both have length [`VectorField::dim`].
     fn eval(&self, y: &[f64], dy: &mut [f64]);
+
+    /// For the so(4) top (1), its six `c_ij` (`i < j`): batches then run on the
+    /// trajectory-lane kernels. `None` (the default) for any other field.
+    fn so4_coefficients(&self) -> Option<&[f64; 6]> {
+        None
+    }
 
     /// Evaluates `f` at `S` states at once, stored component-major:
     /// `y[k][i]` is component `k` of state `i`. The default gathers each state
@@ -78,6 +103,10 @@ impl VectorField for FrahmTop {
     #[inline(always)]
     fn eval(&self, y: &[f64], dy: &mut [f64]) {
         self.vector_field(y, dy)
+    }
+
+    fn so4_coefficients(&self) -> Option<&[f64; 6]> {
+        self.c4()
     }
 
     #[inline(always)]
@@ -800,9 +829,11 @@ impl Dopri5 {
         t: &mut f64,
         t_target: f64,
         budget: u64,
+        cancel: &Cancel,
     ) -> Result<u64> {
         let m = self.m;
         let mut steps = 0u64;
+        let mut attempts = 0u32;
         if !self.fsal_valid {
             f.eval(y, &mut self.k[0..m]);
             self.evals += 1;
@@ -815,6 +846,10 @@ impl Dopri5 {
             let remaining = t_target - *t;
             let last = self.h >= remaining;
             let h = if last { remaining } else { self.h };
+            attempts = attempts.wrapping_add(1);
+            if attempts % CHECK_EVERY == 0 {
+                cancel.check()?;
+            }
             if h <= 1e-14 * t.abs().max(1.0) && !last {
                 return Err(Error::NoConvergence {
                     what: "dopri5 step size underflow",
@@ -877,6 +912,84 @@ impl Dopri5 {
     }
 }
 
+/// Checks, before any work, that a run from `t0` through the sample `times` fits
+/// in `max_steps`, and names the cause when it does not.
+///
+/// Every sample interval of positive length needs at least one step, whatever the
+/// method: more such intervals than `max_steps` is refused as a matter of sample
+/// spacing. A Gauss method's step count is known in advance (`⌈Δt/dt⌉` per
+/// interval): over budget, the cause is `dt` when `(t_end − t0)/dt` alone exceeds
+/// the budget, else the sample spacing (intervals shorter than `dt` still cost a
+/// step each). The explicit methods' count depends on the error control; they are
+/// checked while stepping.
+pub fn check_budget(method: Method, t0: f64, times: &[f64], dt: f64, max_steps: u64) -> Result<()> {
+    let gauss = method.stages().is_some();
+    let (mut intervals, mut total, mut prev) = (0.0f64, 0.0f64, t0);
+    for &tk in times {
+        let span = tk - prev;
+        if span > 0.0 {
+            intervals += 1.0;
+            if gauss {
+                total += substeps(span, dt);
+            }
+        }
+        prev = tk;
+    }
+    let budget = max_steps as f64;
+    if intervals > budget {
+        return Err(Error::InvalidArgument {
+            what: "max_steps",
+            reason: format!(
+                "the sample spacing: {intervals:e} sample intervals each need at least one \
+                 step, more than max_steps = {max_steps}; sample less often (fewer t_eval \
+                 points or a larger sample_every) or raise max_steps"
+            ),
+        });
+    }
+    if gauss && total > budget {
+        let by_dt = (prev - t0) / dt;
+        let reason = if by_dt > budget {
+            format!(
+                "dt: (t_end - t0) / dt = {:e} / {dt:e} = {by_dt:e} steps, more than \
+                 max_steps = {max_steps}; increase dt, shorten t_end or raise max_steps",
+                prev - t0
+            )
+        } else {
+            format!(
+                "the sample spacing: {intervals:e} sample intervals at steps of at most \
+                 dt = {dt:e} need {total:e} steps (each interval at least one), more than \
+                 max_steps = {max_steps}, although (t_end - t0) / dt is only {by_dt:e}; \
+                 sample less often or raise max_steps"
+            )
+        };
+        return Err(Error::InvalidArgument {
+            what: "max_steps",
+            reason,
+        });
+    }
+    Ok(())
+}
+
+/// A zeroed output buffer of `n` doubles, allocated fallibly: a size the machine
+/// cannot hold is an `InvalidArgument` (ValueError), not an abort.
+fn alloc_output(n: Option<usize>) -> Result<Vec<f64>> {
+    let err = |n: Option<usize>| Error::InvalidArgument {
+        what: "output size",
+        reason: format!(
+            "cannot allocate {} bytes for the samples; sample less often or integrate \
+             fewer states per call",
+            n.map_or(f64::INFINITY, |n| n as f64 * 8.0)
+        ),
+    };
+    let n = n
+        .filter(|&n| n <= isize::MAX as usize / 8)
+        .ok_or_else(|| err(n))?;
+    let mut v = Vec::new();
+    v.try_reserve_exact(n).map_err(|_| err(Some(n)))?;
+    v.resize(n, 0.0);
+    Ok(v)
+}
+
 /// Integrates `ẏ = f(y)` from `y0` at time `t0`, recording the state at each of
 /// `times` (sorted, `≥ t0`); see the module docs for the methods and sampling.
 ///
@@ -890,6 +1003,34 @@ pub fn integrate<F: VectorField>(
     times: &[f64],
     opts: &Options,
 ) -> Result<Trajectory> {
+    integrate_with(f, y0, t0, times, opts, &Cancel::never())
+}
+
+/// [`integrate`], stopping with `Error::Interrupted` once `cancel` is cancelled.
+pub fn integrate_with<F: VectorField>(
+    f: &F,
+    y0: &[f64],
+    t0: f64,
+    times: &[f64],
+    opts: &Options,
+    cancel: &Cancel,
+) -> Result<Trajectory> {
+    let (tr, res) = integrate_partial(f, y0, t0, times, opts, cancel)?;
+    res.map(|()| tr)
+}
+
+/// [`integrate_with`] that keeps what was computed: the outer `Err` is a refused
+/// call (bad arguments, over budget: nothing was computed); otherwise the
+/// trajectory holds the samples reached (all of them when the inner result is
+/// `Ok`, those before the failure or interruption when it is `Err`).
+pub fn integrate_partial<F: VectorField>(
+    f: &F,
+    y0: &[f64],
+    t0: f64,
+    times: &[f64],
+    opts: &Options,
+    cancel: &Cancel,
+) -> Result<(Trajectory, Result<()>)> {
     let m = f.dim();
     if y0.len() != m {
         return Err(Error::Shape {
@@ -901,13 +1042,16 @@ pub fn integrate<F: VectorField>(
     check_finite("l0", y0)?;
     opts.validate()?;
     check_sample_times(t0, times)?;
+    check_budget(opts.method, t0, times, opts.dt, opts.max_steps)?;
+    let mut y = alloc_output(times.len().checked_mul(m))?;
+    y.clear();
     let mut out = Trajectory {
-        t: Vec::with_capacity(times.len()),
-        y: Vec::with_capacity(times.len() * m),
+        t: Vec::new(),
+        y,
         steps: 0,
         evals: 0,
     };
-    integrate_into(
+    let res = integrate_into(
         f,
         y0,
         t0,
@@ -916,9 +1060,10 @@ pub fn integrate<F: VectorField>(
         &mut out.y,
         &mut out.steps,
         &mut out.evals,
-    )?;
-    out.t.extend_from_slice(times);
-    Ok(out)
+        cancel,
+    );
+    out.t = times[..out.y.len() / m.max(1)].to_vec();
+    Ok((out, res))
 }
 
 /// The loop of [`integrate`], appending samples to `ys` (validated inputs).
@@ -932,89 +1077,85 @@ fn integrate_into<F: VectorField>(
     ys: &mut Vec<f64>,
     steps: &mut u64,
     evals: &mut u64,
+    cancel: &Cancel,
 ) -> Result<()> {
     let m = f.dim();
     let mut y = y0.to_vec();
     let mut t = t0;
     if opts.method.stages().is_some() {
-        let total = times
-            .iter()
-            .fold((t0, 0.0), |(prev, n), &tk| {
-                (tk, n + substeps(tk - prev, opts.dt))
-            })
-            .1;
-        if total > opts.max_steps as f64 {
-            return Err(Error::InvalidArgument {
-                what: "dt",
-                reason: format!(
-                    "{total:e} steps would be needed (max_steps = {}); increase dt or max_steps",
-                    opts.max_steps
-                ),
-            });
-        }
         use gauss_tables::*;
-        *evals += match (opts.method, m) {
+        let dt = opts.dt;
+        match (opts.method, m) {
             (Method::Gauss4, 6) => run_gauss(
                 GaussFixed::<2, 6>::new(&B2, &MU2, &E2),
                 f,
                 &mut y,
                 t0,
                 times,
-                opts.dt,
+                dt,
                 ys,
                 steps,
-            )?,
+                evals,
+                cancel,
+            ),
             (Method::Gauss6, 6) => run_gauss(
                 GaussFixed::<3, 6>::new(&B3, &MU3, &E3),
                 f,
                 &mut y,
                 t0,
                 times,
-                opts.dt,
+                dt,
                 ys,
                 steps,
-            )?,
+                evals,
+                cancel,
+            ),
             (Method::Gauss16, 6) => run_gauss(
                 GaussFixed::<8, 6>::new(&B8, &MU8, &E8),
                 f,
                 &mut y,
                 t0,
                 times,
-                opts.dt,
+                dt,
                 ys,
                 steps,
-            )?,
+                evals,
+                cancel,
+            ),
             (method, _) => {
                 let g = GaussDyn::new(method, m).ok_or_else(|| Error::InvalidArgument {
                     what: "method",
                     reason: "not a Gauss method".into(),
                 })?;
-                run_gauss(g, f, &mut y, t0, times, opts.dt, ys, steps)?
+                run_gauss(g, f, &mut y, t0, times, dt, ys, steps, evals, cancel)
             }
-        };
+        }
     } else if opts.method == Method::Dop853 {
         let mut d = dop853::Dop853::new(m, opts.dt, opts.rtol, opts.atol);
-        let mut taken = 0u64;
-        for &tk in times {
-            taken += d.advance(f, &mut y, &mut t, tk, opts.max_steps - taken)?;
-            ys.extend_from_slice(&y);
-        }
-        *steps += taken;
+        let res = (|| {
+            for &tk in times {
+                *steps += d.advance(f, &mut y, &mut t, tk, opts.max_steps - *steps, cancel)?;
+                ys.extend_from_slice(&y);
+            }
+            Ok(())
+        })();
         *evals += d.evals;
+        res
     } else {
         let mut d = Dopri5::new(m, opts);
-        let mut taken = 0u64;
-        for &tk in times {
-            taken += d.advance(f, &mut y, &mut t, tk, opts.max_steps - taken)?;
-            ys.extend_from_slice(&y);
-        }
-        *steps += taken;
+        let res = (|| {
+            for &tk in times {
+                *steps += d.advance(f, &mut y, &mut t, tk, opts.max_steps - *steps, cancel)?;
+                ys.extend_from_slice(&y);
+            }
+            Ok(())
+        })();
         *evals += d.evals;
+        res
     }
-    Ok(())
 }
 
-/// Steps a Gauss method through the sample times; returns the evaluation count.
+/// Steps a Gauss method through the sample times, counting steps and evaluations.
 #[allow(clippy::too_many_arguments)]
 fn run_gauss<S: Stepper, F: VectorField>(
     mut g: S,
@@ -1025,29 +1166,68 @@ fn run_gauss<S: Stepper, F: VectorField>(
     dt: f64,
     ys: &mut Vec<f64>,
     steps: &mut u64,
-) -> Result<u64> {
+    evals: &mut u64,
+    cancel: &Cancel,
+) -> Result<()> {
     let mut t = t0;
-    for &tk in times {
-        let span = tk - t;
-        if span > 0.0 {
-            let n = substeps(span, dt);
-            let h = span / n;
-            // n ≤ MAX_STEPS < 2^53, so the count is exact.
-            for _ in 0..n as u64 {
-                g.step(f, y, h)?;
+    let mut since_check = 0u32;
+    let res = (|| {
+        for &tk in times {
+            let span = tk - t;
+            if span > 0.0 {
+                let n = substeps(span, dt);
+                let h = span / n;
+                // n ≤ MAX_STEPS < 2^53, so the count is exact.
+                for _ in 0..n as u64 {
+                    g.step(f, y, h)?;
+                    *steps += 1;
+                    since_check += 1;
+                    if since_check == CHECK_EVERY {
+                        since_check = 0;
+                        cancel.check()?;
+                    }
+                }
+                t = tk;
             }
-            *steps += n as u64;
-            t = tk;
+            ys.extend_from_slice(y);
         }
-        ys.extend_from_slice(y);
-    }
-    Ok(g.evals())
+        Ok(())
+    })();
+    *evals += g.evals();
+    res
 }
 
-/// Integrates a batch of initial states `y0s` (row-major `(batch, dim)`) with
-/// the same options and sample times; returns the states row-major
-/// `(batch, samples, dim)` and the total number of steps. With `parallel`,
-/// the batch is split over rayon's thread pool.
+/// Runs `work` on a scoped thread while the calling thread polls `cancel` (whose
+/// poll function, e.g. Python's signal check, runs only on the thread that made
+/// it; a thread blocked in rayon would never poll). Joined before returning, so
+/// no thread outlives the call.
+fn poll_during<T: Send>(cancel: &Cancel, work: impl FnOnce() -> T + Send) -> T {
+    std::thread::scope(|s| {
+        let handle = s.spawn(work);
+        while !handle.is_finished() {
+            std::thread::sleep(std::time::Duration::from_millis(2));
+            // An Err here has set the shared flag; the workers see it and stop.
+            let _ = cancel.check();
+        }
+        match handle.join() {
+            Ok(v) => v,
+            Err(panic) => std::panic::resume_unwind(panic),
+        }
+    })
+}
+
+/// Trajectories per rayon task of the dop853 batch kernel: 8 lane groups, so a
+/// lane freed by a finished trajectory is refilled from the same task.
+const DOP853_TASK: usize = 8 * LANES;
+
+/// Integrates a batch of initial states `y0s` (row-major, `(batch, dim)`) with the
+/// same options and sample times; returns the states row-major
+/// `(batch, samples, dim)` and the total number of steps. With `parallel`, the
+/// batch is split over rayon's thread pool.
+///
+/// For the so(4) top with gauss16 or dop853 the batch runs on the trajectory-lane
+/// kernels (see the module docs); the results are those of [`integrate`] state by
+/// state, bit for bit. The budget and the output size are checked before any work.
 pub fn integrate_many<F: VectorField>(
     f: &F,
     y0s: &[f64],
@@ -1055,6 +1235,19 @@ pub fn integrate_many<F: VectorField>(
     times: &[f64],
     opts: &Options,
     parallel: bool,
+) -> Result<(Vec<f64>, u64)> {
+    integrate_many_with(f, y0s, t0, times, opts, parallel, &Cancel::never())
+}
+
+/// [`integrate_many`], stopping with `Error::Interrupted` once `cancel` is cancelled.
+pub fn integrate_many_with<F: VectorField>(
+    f: &F,
+    y0s: &[f64],
+    t0: f64,
+    times: &[f64],
+    opts: &Options,
+    parallel: bool,
+    cancel: &Cancel,
 ) -> Result<(Vec<f64>, u64)> {
     let m = f.dim();
     if m == 0 || y0s.len() % m != 0 {
@@ -1067,27 +1260,95 @@ pub fn integrate_many<F: VectorField>(
     check_finite("l0s", y0s)?;
     opts.validate()?;
     check_sample_times(t0, times)?;
+    check_budget(opts.method, t0, times, opts.dt, opts.max_steps)?;
+    let rows = y0s.len() / m;
     let per = times.len() * m;
-    let mut out = vec![0.0; y0s.len() / m * per];
-    let run = |(y0, chunk): (&[f64], &mut [f64])| -> Result<u64> {
-        let mut ys = Vec::with_capacity(per);
-        let (mut steps, mut evals) = (0, 0);
-        integrate_into(f, y0, t0, times, opts, &mut ys, &mut steps, &mut evals)?;
-        chunk.copy_from_slice(&ys);
-        Ok(steps)
+    let mut out = alloc_output(rows.checked_mul(per))?;
+    if out.is_empty() {
+        return Ok((out, 0));
+    }
+    let lanes = f
+        .so4_coefficients()
+        .filter(|_| matches!(opts.method, Method::Gauss16 | Method::Dop853));
+    let mut run = || -> Result<u64> {
+        let steps: Vec<u64> = match lanes {
+            Some(c) if opts.method == Method::Gauss16 => {
+                let group = |(y0, o): (&[f64], &mut [f64])| -> Result<u64> {
+                    let n = batch::gauss16_group(c, y0, t0, times, opts.dt, o, cancel)?;
+                    Ok(n * (y0.len() / m) as u64)
+                };
+                let (gy, go) = (LANES * m, LANES * per);
+                if parallel {
+                    y0s.par_chunks(gy)
+                        .zip(out.par_chunks_mut(go))
+                        .map(group)
+                        .collect::<Result<_>>()?
+                } else {
+                    y0s.chunks(gy)
+                        .zip(out.chunks_mut(go))
+                        .map(group)
+                        .collect::<Result<_>>()?
+                }
+            }
+            Some(c) => {
+                let o8 = batch::Dop853Opts {
+                    h0: opts.dt,
+                    rtol: opts.rtol,
+                    atol: opts.atol,
+                    max_steps: opts.max_steps,
+                };
+                let group = |(y0, o): (&[f64], &mut [f64])| {
+                    batch::dop853_group(c, y0, t0, times, o8, o, cancel)
+                };
+                let (gy, go) = (DOP853_TASK * m, DOP853_TASK * per);
+                if parallel {
+                    y0s.par_chunks(gy)
+                        .zip(out.par_chunks_mut(go))
+                        .map(group)
+                        .collect::<Result<_>>()?
+                } else {
+                    y0s.chunks(gy)
+                        .zip(out.chunks_mut(go))
+                        .map(group)
+                        .collect::<Result<_>>()?
+                }
+            }
+            None => {
+                let one = |(y0, chunk): (&[f64], &mut [f64])| -> Result<u64> {
+                    let mut ys = Vec::new();
+                    ys.try_reserve_exact(per)
+                        .map_err(|_| Error::InvalidArgument {
+                            what: "output size",
+                            reason: "cannot allocate the scratch of one trajectory".into(),
+                        })?;
+                    let (mut steps, mut evals) = (0, 0);
+                    integrate_into(
+                        f, y0, t0, times, opts, &mut ys, &mut steps, &mut evals, cancel,
+                    )?;
+                    chunk.copy_from_slice(&ys);
+                    Ok(steps)
+                };
+                if parallel {
+                    y0s.par_chunks(m)
+                        .zip(out.par_chunks_mut(per))
+                        .map(one)
+                        .collect::<Result<_>>()?
+                } else {
+                    y0s.chunks(m)
+                        .zip(out.chunks_mut(per))
+                        .map(one)
+                        .collect::<Result<_>>()?
+                }
+            }
+        };
+        Ok(steps.iter().sum())
     };
-    let steps: Result<Vec<u64>> = if parallel {
-        y0s.par_chunks(m)
-            .zip(out.par_chunks_mut(per.max(1)))
-            .map(run)
-            .collect()
+    let steps = if parallel {
+        poll_during(cancel, run)
     } else {
-        y0s.chunks(m)
-            .zip(out.chunks_mut(per.max(1)))
-            .map(run)
-            .collect()
-    };
-    Ok((out, steps?.iter().sum()))
+        run()
+    }?;
+    Ok((out, steps))
 }
 
 #[cfg(test)]
@@ -1299,6 +1560,95 @@ mod tests {
                 assert_eq!(&ys[b * 18..(b + 1) * 18], &tr.y[..]);
             }
         }
+    }
+
+    /// Pseudo-random states (seeded LCG), entries in [-1, 1).
+    fn states(seed: u64, rows: usize) -> Vec<f64> {
+        let mut s = seed;
+        (0..rows * 6)
+            .map(|_| {
+                s = s
+                    .wrapping_mul(6364136223846793005)
+                    .wrapping_add(1442695040888963407);
+                ((s >> 11) as f64 / (1u64 << 53) as f64) * 2.0 - 1.0
+            })
+            .collect()
+    }
+
+    /// The lane kernels (gauss16, dop853) give exactly the single-trajectory
+    /// results, for batch sizes that are not multiples of the lane width, with
+    /// repeated and zero-length sample intervals.
+    #[test]
+    fn lane_kernels_match_single_runs_bit_for_bit() {
+        let top = FrahmTop::manakov(&A, &B).unwrap();
+        let times = [0.0, 0.7, 0.7, 2.0, 3.5];
+        for rows in [1usize, 3, 7, 37] {
+            let y0s = states(rows as u64, rows);
+            for (m, dt) in [(Method::Gauss16, 0.3), (Method::Dop853, 0.0)] {
+                let o = opts(m, dt);
+                for parallel in [false, true] {
+                    let (ys, steps) =
+                        integrate_many(&top, &y0s, 0.0, &times, &o, parallel).unwrap();
+                    let mut want_steps = 0;
+                    for (b, y0) in y0s.chunks(6).enumerate() {
+                        let tr = integrate(&top, y0, 0.0, &times, &o).unwrap();
+                        let got = &ys[b * 30..(b + 1) * 30];
+                        let same = got
+                            .iter()
+                            .zip(&tr.y)
+                            .all(|(x, y)| x.to_bits() == y.to_bits());
+                        assert!(same, "{m:?} rows {rows} state {b}: {got:?} vs {:?}", tr.y);
+                        want_steps += tr.steps;
+                    }
+                    assert_eq!(steps, want_steps, "{m:?} rows {rows}");
+                }
+            }
+        }
+    }
+
+    /// A cancelled token stops every path with `Interrupted`.
+    #[test]
+    fn cancelled_runs_stop() {
+        let top = FrahmTop::manakov(&A, &B).unwrap();
+        let c = Cancel::never();
+        c.cancel();
+        let y0s = states(5, 9);
+        for (m, dt) in [
+            (Method::Gauss16, 0.3),
+            (Method::Dop853, 0.0),
+            (Method::Gauss6, 0.01),
+            (Method::Dopri5, 0.0),
+        ] {
+            let o = opts(m, dt);
+            let r = integrate_with(&top, &L0, 0.0, &[1e3], &o, &c);
+            assert_eq!(r.unwrap_err(), Error::Interrupted, "{m:?}");
+            for parallel in [false, true] {
+                let r = integrate_many_with(&top, &y0s, 0.0, &[1e3], &o, parallel, &c);
+                assert_eq!(r.unwrap_err(), Error::Interrupted, "{m:?}");
+            }
+        }
+    }
+
+    /// Over-budget runs are refused before any work, naming the cause.
+    #[test]
+    fn budget_is_checked_first_and_names_the_cause() {
+        let spacing: Vec<f64> = (1..=100).map(f64::from).collect();
+        let e = check_budget(Method::Dop853, 0.0, &spacing, 0.0, 50).unwrap_err();
+        assert!(e.to_string().contains("sample spacing"), "{e}");
+        let e = check_budget(Method::Gauss16, 0.0, &[1e6], 0.1, 1000).unwrap_err();
+        assert!(e.to_string().contains("dt:"), "{e}");
+        // 100 intervals of 1 at dt = 0.6: 200 steps, although 100 / 0.6 < 170.
+        let e = check_budget(Method::Gauss16, 0.0, &spacing, 0.6, 170).unwrap_err();
+        assert!(e.to_string().contains("sample spacing"), "{e}");
+        assert!(check_budget(Method::Gauss16, 0.0, &spacing, 0.6, 200).is_ok());
+    }
+
+    /// An output that cannot be allocated is an error, not an abort.
+    #[test]
+    fn huge_output_is_an_error() {
+        assert!(alloc_output(None).is_err());
+        assert!(alloc_output(Some(usize::MAX / 4)).is_err());
+        assert_eq!(alloc_output(Some(3)).unwrap(), vec![0.0; 3]);
     }
 
     #[test]

@@ -79,7 +79,8 @@ pub fn to_matrix(n: usize, l: &[f64]) -> Vec<f64> {
 /// `|a_i| / |a_i - a_j|`).
 ///
 /// Errors: `Shape` unless `a`, `b` have the same length `n ≥ 3`; `NonFinite`;
-/// `RepeatedA { i, j }` if `a_i == a_j`; `NonFinite` if a quotient overflows.
+/// `RepeatedA { i, j }` if `a_i == a_j`; `InvalidArgument` if a difference
+/// `a_i - a_j` overflows; `NonFinite` if a quotient overflows.
 pub fn manakov_c(a: &[f64], b: &[f64]) -> Result<Vec<f64>> {
     let n = a.len();
     if b.len() != n {
@@ -104,6 +105,17 @@ pub fn manakov_c(a: &[f64], b: &[f64]) -> Result<Vec<f64>> {
             let da = a[i] - a[j];
             if da == 0.0 {
                 return Err(Error::RepeatedA { i, j, value: a[i] });
+            }
+            // An overflowed difference would make c_ij = 0 silently.
+            if !da.is_finite() {
+                return Err(Error::InvalidArgument {
+                    what: "a",
+                    reason: format!(
+                        "a[{i}] - a[{j}] = {} - {} overflows; rescale a and b \
+                         (c_ij is invariant under a, b -> s a, s b)",
+                        a[i], a[j]
+                    ),
+                });
             }
             let v = (b[i] - b[j]) / da;
             if !v.is_finite() {
