@@ -251,8 +251,8 @@ def _prepare(
     if tau_a.ndim != 2 or tau_a.shape[0] != tau_a.shape[1]:
         raise ValueError(f"tau must have shape (g, g), got {tau_a.shape}")
     g = tau_a.shape[0]
-    if g == 0:
-        raise ValueError("tau has shape (0, 0): the genus must be in 1..6")
+    if not 1 <= g <= 6:
+        raise ValueError(f"tau has shape {tau_a.shape}: the genus must be in 1..6")
     if isinstance(z, np.ndarray):
         _check_batch_fits(z.shape, g)  # before the conversion copies z
     z_a = _as_complex("z", z)
