@@ -35,10 +35,10 @@ from hypothesis import strategies as st
 import manakov
 from manakov import reduction
 
-#: Cases per entry point in the default run (~30 entry points: a few seconds each).
+#: Cases per entry point in the default run (20 properties, ~1 s each).
 DEFAULT_EXAMPLES = 40
-#: Cases per entry point in the slow run: 30 entry points x 4000 > 10^5.
-SLOW_EXAMPLES = 4000
+#: Cases per entry point in the slow run: 20 entry points x 5000 = 10^5.
+SLOW_EXAMPLES = 5000
 SLOW = bool(os.environ.get("MANAKOV_FUZZ_SLOW"))
 
 #: Magnitudes of the curve's d_j and the reduction's states in the default run.
