@@ -123,8 +123,9 @@ def characteristics(g: int = 2) -> list[Characteristic]:
 CHARACTERISTICS: list[Characteristic] = characteristics(2)
 
 #: The paper's table (35) exactly as printed: label -> the 2 x 2 array
-#: ``((x1, x2), (y1, y2))`` written under theta[...]. Not verified against the
-#: curve here (a later issue does that).
+#: ``((x1, x2), (y1, y2))`` written under theta[...]. Verified against the curve
+#: in tests/test_theta_quotients.py: it holds in a suitable canonical basis
+#: (docs/errata.md, row (34)-(35); docs/theta_quotients.md).
 PAPER_TABLE_35: dict[str, tuple[tuple[int, int], tuple[int, int]]] = {
     "theta23": ((0, 0), (1, 1)),
     "theta31": ((1, 0), (1, 1)),
