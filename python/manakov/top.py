@@ -30,6 +30,7 @@ import numpy as np
 
 from . import _core
 from ._checks import _finite_result, _float_array, _n_from_dim, _out, _states, state_dim
+from .reduction import Kotter
 from .reduction import from_kotter as _from_kotter
 from .reduction import kotter as _kotter
 
@@ -707,7 +708,7 @@ class ManakovTop(FrahmTop):
         vals = _finite_result(_core.manakov_integrals(self._a, flat))
         return vals.reshape(lead + (vals.shape[1],))
 
-    def kotter(self, l: Any) -> Any:
+    def kotter(self, l: Any) -> Kotter:
         """Schottky–Kötter coordinates of the state(s) ``l`` (n = 4 only).
 
         Shorthand for :func:`manakov.kotter` ``(self.a, self.b, l)``: the roots of
@@ -731,7 +732,7 @@ class ManakovTop(FrahmTop):
         self._require_so4("kotter")
         return _kotter(self._a, self._b, l)
 
-    def from_kotter(self, k: Any) -> np.ndarray:
+    def from_kotter(self, k: Kotter) -> np.ndarray:
         """Map Schottky–Kötter coordinates back to the state l (n = 4 only).
 
         Shorthand for :func:`manakov.from_kotter` ``(self.a, self.b, k)``: rebuilds
