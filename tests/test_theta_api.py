@@ -255,7 +255,7 @@ def test_truncation_error_within_tol_against_flint(tol):
             tau = u @ tau @ u.T
         z = rng.uniform(-0.5, 0.5, 2) + tau.imag @ rng.uniform(-0.45, 0.45, 2) * 1j
         om, _ = theta_all(z, tau, tol=tol, log_scale=True)
-        radius, rho, bound, _ = _core.theta_plan_info(np.ascontiguousarray(tau), tol, 0)
+        radius, rho, bound, _, _ = _core.theta_plan_info(np.ascontiguousarray(tau), tol, 0)
         assert bound <= tol
         ref = normalised_flint(z, tau)
         if not np.all(np.isfinite(ref)):

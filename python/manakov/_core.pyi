@@ -34,8 +34,6 @@ __all__ = [
     "__version__",
 ]
 
-__all__ = ["ConvergenceError", "__version__", "theta_jet", "theta_plan_info"]
-
 __version__: str
 
 class ConvergenceError(RuntimeError): ...
@@ -137,7 +135,7 @@ def theta_jet(
 ]: ...
 def theta_plan_info(
     tau: npt.NDArray[np.complex128], tol: float, order: int
-) -> tuple[float, float, float, float]: ...
+) -> tuple[float, float, float, float, float]: ...
 
 # --- kotter (rust/python/kotter.rs) ---
 

@@ -1,38 +1,95 @@
+# The state is called l, as in the paper: E741 does not apply.
+# ruff: noqa: E741
 """The ``manakov`` command line.
 
-``manakov simulate generic`` integrates a built-in reference top (see
-``manakov.problem_names()``); ``manakov simulate --a ... --b ... --l0 ...``
-integrates any Manakov top (2) on so(n). The trajectory is written to ``.npz``
-(arrays ``t``, ``l``, ``a``, ``b`` and one array per integral) or ``.csv``
-(columns t, l.., integrals..), and, when matplotlib is importable, a PNG with
-l(t) and the relative drift of every integral is written next to it.
+Subcommands (``manakov <command> --help`` shows each with an example):
+
+``simulate``
+    Integrate a built-in reference top (``manakov.problem_names()``) or any
+    Manakov top (2) on so(n); write the trajectory to ``.npz`` (arrays ``t``,
+    ``l``, ``a``, ``b`` and one array per integral), ``.csv`` (columns t, l..,
+    integrals..) or, with ``-o -``, CSV on standard output; and, when matplotlib
+    is importable, a PNG with l(t) and the relative drift of every integral.
+``kotter``
+    The reduction of a state of a top on so(4) (equations (11)-(42)): the
+    curve (8) with its branch points d_j, the divisor (z1, y1), (z2, y2), eps, g,
+    and the round trip l -> Kötter -> l; a PNG of the branch points and the
+    divisor in the complex x-plane.
+``theta``
+    Values of the theta functions (34)-(36) at a point.
+
+Ctrl-C stops any command: ``simulate`` writes the samples computed so far
+(to ``<output stem>.partial<suffix>``, marked partial), prints one line and
+exits with status 130; other commands exit with 130 at once. A closed output
+pipe (``manakov ... | head``) ends the command quietly.
+
+Adding a subcommand: write ``_add_<name>(parser)`` and ``_run_<name>(args) -> int``
+and add one :class:`Command` to :data:`COMMANDS` (description, example and the
+two functions); errors raised as ValueError, RuntimeError or OSError become
+``manakov: error: ...`` and status 2.
 """
 
 from __future__ import annotations
 
 import argparse
 import math
+import os
 import sys
 import time
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import Any, TextIO
 
 import numpy as np
 
-from . import problem, problem_names
+from . import __version__, problem, problem_names
 from ._progress import ProgressBar
-from .top import DEFAULT_MAX_STEPS, METHODS, ManakovTop, Trajectory, state_dim
+from .top import DEFAULT_MAX_STEPS, METHODS, ManakovTop, state_dim
 
 #: Default t_end of ``manakov simulate``: 1000 time units of 'generic' run in
 #: about 10 ms of integration.
 DEFAULT_T_END = 1000.0
+#: Default number of samples of ``manakov simulate``, at most: fewer when the
+#: step is longer than ``t_end / (samples - 1)``, so that the samples never force
+#: a smaller step than the method's (they did: 20001 samples of 'physical' cut
+#: its step from 0.1 to 0.05).
+DEFAULT_SAMPLES = 20001
 #: The l(t) panel of the PNG shows at most this initial stretch (oscillations
 #: have periods of a few time units; a longer window is a solid band).
 PLOT_WINDOW = 40.0
-#: Runs longer than this many steps are split into chunks to drive the progress bar.
+#: Runs longer than this many steps show the progress bar (on a terminal).
 PROGRESS_MIN_STEPS = 200_000
-PROGRESS_CHUNKS = 50
+#: Steps per segment of a run. The run is integrated segment by segment (each
+#: segment a whole number of sample intervals), so that Ctrl-C leaves the
+#: finished segments to write and the progress bar moves; 3·10^4 Gauss steps take
+#: 30–90 ms (1–3 µs a step on a loaded machine), so a segment boundary (where
+#: Python sees the signal) comes well within 0.5 s even before the core checks
+#: signals itself.
+SEGMENT_STEPS = 30_000
+#: Explicit (adaptive) methods: their step is not known before the run; the
+#: first sample interval is integrated alone to measure it.
+EXPLICIT_METHODS = ("dopri5", "dop853")
+#: Exit status after Ctrl-C (128 + SIGINT, as a shell reports it).
+EXIT_INTERRUPTED = 130
+#: Exit status when the reader of standard output went away (128 + SIGPIPE).
+EXIT_BROKEN_PIPE = 141
+
+
+class Interrupted(Exception):
+    """Ctrl-C during a run, with the line to print (partial output already written)."""
+
+
+@dataclass(frozen=True)
+class Command:
+    """One subcommand: its help line, description, example and two functions."""
+
+    name: str
+    help: str
+    description: str
+    example: str
+    add_arguments: Callable[[argparse.ArgumentParser], None]
+    run: Callable[[argparse.Namespace], int]
 
 
 def _floats(text: str) -> list[float]:
@@ -42,95 +99,23 @@ def _floats(text: str) -> list[float]:
         raise argparse.ArgumentTypeError(f"expected numbers separated by commas: {e}") from e
 
 
-def _parser() -> argparse.ArgumentParser:
-    ap = argparse.ArgumentParser(
-        prog="manakov", description="The four-dimensional free rigid body (Manakov's top)."
-    )
-    sub = ap.add_subparsers(dest="command", required=True)
-    sim = sub.add_parser(
-        "simulate",
-        help="integrate a top and write its trajectory",
-        description="Integrate Frahm's equations (1) for Manakov's top (2). State order "
-        "(l12, l13, l14, l23, l24, l34) for n = 4 (upper triangle, row by row, in general).",
-    )
-    sim.add_argument("problem", nargs="?", help=f"built-in problem: {', '.join(problem_names())}")
-    sim.add_argument("--a", type=_floats, help="a_1..a_n, comma separated")
-    sim.add_argument("--b", type=_floats, help="b_1..b_n, comma separated")
-    sim.add_argument("--l0", type=_floats, help="initial state, n(n-1)/2 numbers")
-    sim.add_argument(
-        "--t-end", type=float, default=DEFAULT_T_END, help="final time (default %(default)s)"
-    )
-    sim.add_argument("--dt", type=float, default=None, help="step (default: the method's default)")
-    sim.add_argument("--method", choices=METHODS, default="gauss16")
-    sim.add_argument(
-        "--max-steps",
-        type=int,
-        default=DEFAULT_MAX_STEPS,
-        help="step budget of the run (default %(default)s)",
-    )
-    sim.add_argument(
-        "--samples", type=int, default=20001, help="number of samples (default %(default)s)"
-    )
-    sim.add_argument(
-        "-o",
-        "--output",
-        type=Path,
-        default=None,
-        help="output file, .npz or .csv (default: <problem>.npz)",
-    )
-    sim.add_argument("--no-plot", action="store_true", help="do not write the PNG")
-    sim.add_argument("--progress", action="store_true", help="always show the progress bar")
-    sim.add_argument("-q", "--quiet", action="store_true", help="print nothing but errors")
-    return ap
-
-
-def _write(path: Path, tr: Trajectory, a: np.ndarray, b: np.ndarray) -> None:
-    if path.suffix == ".npz":
-        arrays: dict[str, Any] = {"t": tr.t, "l": tr.l, "a": a, "b": b}
-        arrays.update(tr.integrals)
-        np.savez(path, **arrays)
-    elif path.suffix == ".csv":
-        n = len(a)
-        names = [f"l{i + 1}{j + 1}" for i in range(n) for j in range(i + 1, n)]
-        cols = ["t", *names, *tr.integrals]
-        data = np.column_stack([tr.t, tr.l, *tr.integrals.values()])
-        np.savetxt(path, data, delimiter=",", header=",".join(cols), comments="", fmt="%.17g")
-    else:
-        raise ValueError(f"output must end in .npz or .csv, got {path.name!r}")
-
-
-def _plot(path: Path, tr: Trajectory, title: str) -> bool:
+def _complexes(text: str) -> list[complex]:
     try:
-        import matplotlib
-
-        matplotlib.use("Agg")
-        import matplotlib.pyplot as plt
-    except ImportError:
-        return False
-    n = int(round((1 + math.sqrt(1 + 8 * tr.l.shape[1])) / 2))
-    names = [f"$l_{{{i + 1}{j + 1}}}$" for i in range(n) for j in range(i + 1, n)]
-    fig, (ax1, ax2) = plt.subplots(2, 1, figsize=(10, 7), constrained_layout=True)
-    window = tr.t <= tr.t[0] + PLOT_WINDOW
-    for k in range(tr.l.shape[1]):
-        ax1.plot(tr.t[window], tr.l[window, k], lw=0.9, label=names[k])
-    ax1.set_ylabel("angular momentum l(t)")
-    ax1.set_xlabel("t" + (f" (first {PLOT_WINDOW:g} time units)" if not window.all() else ""))
-    ax1.legend(ncol=min(6, len(names)), fontsize=8, loc="upper right")
-    ax1.set_title(title)
-    floor = np.finfo(float).eps / 4
-    for name, d in tr.relative_drift().items():
-        ax2.semilogy(tr.t[1:], np.maximum(np.maximum.accumulate(d[1:]), floor), lw=1, label=name)
-    ax2.axhline(np.finfo(float).eps, color="gray", ls=":", lw=0.8)
-    ax2.text(tr.t[-1], np.finfo(float).eps, " machine eps", va="bottom", ha="right", fontsize=8)
-    ax2.set_ylabel("max over [0, t] of |I - I(0)| / |I(0)|")
-    ax2.set_xlabel("t")
-    ax2.legend(ncol=5, fontsize=8, loc="upper left")
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-    return True
+        return [complex(x.replace("i", "j")) for x in text.replace(",", " ").split()]
+    except ValueError as e:
+        raise argparse.ArgumentTypeError(
+            f"expected complex numbers separated by commas (like 0.3+1.1j): {e}"
+        ) from e
 
 
-def simulate(args: argparse.Namespace) -> int:
+def _add_top_arguments(p: argparse.ArgumentParser, n_hint: str) -> None:
+    p.add_argument("problem", nargs="?", help=f"built-in problem: {', '.join(problem_names())}")
+    p.add_argument("--a", type=_floats, help="a_1..a_n, comma separated")
+    p.add_argument("--b", type=_floats, help="b_1..b_n, comma separated")
+    p.add_argument("--l0", type=_floats, help=f"initial state, {n_hint} numbers")
+
+
+def _top_from_args(args: argparse.Namespace) -> tuple[ManakovTop, np.ndarray, str]:
     if args.problem is not None:
         if args.a is not None or args.b is not None:
             raise ValueError("give either a problem name or --a/--b/--l0, not both")
@@ -148,68 +133,509 @@ def simulate(args: argparse.Namespace) -> int:
         raise ValueError(
             f"--l0 must have {state_dim(top.n)} numbers for n = {top.n}, got {l0.size}"
         )
-    if not (args.samples >= 2):
-        raise ValueError(f"--samples must be >= 2, got {args.samples}")
-    t_end = float(args.t_end)
-    dt = args.dt if args.dt is not None else top.default_dt(l0, args.method)
-    if not (dt > 0) and args.method != "dopri5":
-        raise ValueError(f"--dt must be > 0, got {dt}")
-    if not (t_end >= 0) or not math.isfinite(t_end):
-        raise ValueError(f"--t-end must be finite and >= 0, got {t_end}")
-    t_eval = np.linspace(0.0, t_end, args.samples)
-    est_steps = t_end / dt if dt > 0 else t_end * 100
-    long_run = est_steps >= PROGRESS_MIN_STEPS or args.progress
-    bar = ProgressBar(f"simulate {name}", force=args.progress and not args.quiet)
-    if args.quiet:
-        bar.enabled = False
-    out = args.output if args.output is not None else Path(f"{name}.npz")
-    # Fail before a long run, not after it.
-    if not out.parent.is_dir():
-        raise ValueError(f"cannot write {out}: {out.parent} is not a directory")
-    start = time.perf_counter()
-    tr = top.integrate(
-        l0,
-        t_end,
-        t_eval=t_eval,
-        dt=args.dt,
-        method=args.method,
-        chunks=PROGRESS_CHUNKS if long_run else 1,
-        progress=bar.update if long_run else None,
-        max_steps=args.max_steps,
+    return top, l0, name
+
+
+# --------------------------------------------------------------------- simulate
+
+
+def _add_simulate(sim: argparse.ArgumentParser) -> None:
+    _add_top_arguments(sim, "n(n-1)/2")
+    sim.add_argument(
+        "--t-end", type=float, default=DEFAULT_T_END, help="final time, > 0 (default %(default)s)"
     )
+    sim.add_argument(
+        "--dt",
+        type=float,
+        default=None,
+        help="largest step of a Gauss method, initial step of dopri5/dop853 "
+        "(default: the method's default; adaptive for dopri5/dop853)",
+    )
+    sim.add_argument("--method", choices=METHODS, default="gauss16")
+    sim.add_argument(
+        "--max-steps",
+        type=int,
+        default=DEFAULT_MAX_STEPS,
+        help="step budget of the run (default %(default)s)",
+    )
+    sim.add_argument(
+        "--samples",
+        type=int,
+        default=None,
+        help=f"number of samples, >= 2 (default: {DEFAULT_SAMPLES}, or fewer so that "
+        "the sample spacing is at least the step)",
+    )
+    sim.add_argument(
+        "-o",
+        "--output",
+        type=Path,
+        default=None,
+        help="output file, .npz or .csv, or '-' for CSV on standard output "
+        "(default: <problem>.npz)",
+    )
+    sim.add_argument("--no-plot", action="store_true", help="do not write the PNG")
+    sim.add_argument("--progress", action="store_true", help="always show the progress bar")
+    sim.add_argument("-q", "--quiet", action="store_true", help="print nothing but errors")
+
+
+def _columns(n: int, integrals: Sequence[str]) -> list[str]:
+    names = [f"l{i + 1}{j + 1}" for i in range(n) for j in range(i + 1, n)]
+    return ["t", *names, *integrals]
+
+
+def _write(
+    path: Path | None,
+    t: np.ndarray,
+    l: np.ndarray,
+    integrals: dict[str, np.ndarray],
+    a: np.ndarray,
+    b: np.ndarray,
+    *,
+    partial: bool = False,
+    stream: TextIO | None = None,
+) -> None:
+    """Write the samples: ``path`` .npz or .csv, or CSV to ``stream`` when ``path`` is None."""
+    if path is not None and path.suffix == ".npz":
+        arrays: dict[str, Any] = {"t": t, "l": l, "a": a, "b": b, "partial": np.array(partial)}
+        arrays.update(integrals)
+        np.savez(path, **arrays)
+        return
+    if path is not None and path.suffix != ".csv":
+        raise ValueError(f"output must end in .npz or .csv, got {path.name!r}")
+    cols = _columns(len(a), list(integrals))
+    header = ",".join(cols)
+    if partial:
+        header = "# partial: interrupted, samples up to t = " + f"{t[-1]:.17g}\n" + header
+    data = np.column_stack([t, l, *integrals.values()])
+    target: TextIO | Path = path if path is not None else (stream or sys.stdout)
+    np.savetxt(target, data, delimiter=",", header=header, comments="", fmt="%.17g")
+
+
+def _plot(
+    path: Path,
+    t: np.ndarray,
+    l: np.ndarray,
+    drift: dict[str, np.ndarray],
+    title: str,
+) -> bool:
+    try:
+        import matplotlib
+
+        matplotlib.use("Agg")
+        import matplotlib.pyplot as plt
+    except ImportError:
+        return False
+    n = int(round((1 + math.sqrt(1 + 8 * l.shape[1])) / 2))
+    names = [f"$l_{{{i + 1}{j + 1}}}$" for i in range(n) for j in range(i + 1, n)]
+    fig, (ax1, ax2) = plt.subplots(2, 1, figsize=(10, 7), constrained_layout=True)
+    window = t <= t[0] + PLOT_WINDOW
+    for k in range(l.shape[1]):
+        ax1.plot(t[window], l[window, k], lw=0.9, label=names[k])
+    ax1.set_ylabel("angular momentum l(t)")
+    ax1.set_xlabel("t" + (f" (first {PLOT_WINDOW:g} time units)" if not window.all() else ""))
+    ax1.legend(ncol=min(6, len(names)), fontsize=8, loc="upper right")
+    ax1.set_title(title)
+    floor = np.finfo(float).eps / 4
+    for name, d in drift.items():
+        ax2.semilogy(t[1:], np.maximum(np.maximum.accumulate(d[1:]), floor), lw=1, label=name)
+    ax2.axhline(np.finfo(float).eps, color="gray", ls=":", lw=0.8)
+    ax2.text(t[-1], np.finfo(float).eps, " machine eps", va="bottom", ha="right", fontsize=8)
+    ax2.set_ylabel("max over [0, t] of |I - I(0)| / |I(0)|")
+    ax2.set_xlabel("t")
+    ax2.legend(ncol=5, fontsize=8, loc="upper left")
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return True
+
+
+@dataclass
+class _Run:
+    """Samples of a run integrated segment by segment (the finished part so far)."""
+
+    t: list[np.ndarray]
+    l: list[np.ndarray]
+    steps: int = 0
+    method: str = ""
+
+    def arrays(self) -> tuple[np.ndarray, np.ndarray]:
+        return np.concatenate(self.t), np.concatenate(self.l)
+
+
+def _sample_times(t_end: float, samples: int | None, dt: float, explicit: bool) -> np.ndarray:
+    if samples is None:
+        samples = DEFAULT_SAMPLES
+        if not explicit:
+            # never more sample intervals than steps: one step of at most dt per
+            # interval, as close to dt as the equal spacing allows
+            samples = max(2, min(samples, math.ceil(t_end / dt * (1 - 1e-12)) + 1))
+    elif samples < 2:
+        raise ValueError(f"--samples must be >= 2, got {samples}")
+    return np.linspace(0.0, t_end, samples)
+
+
+def _integrate_segments(
+    top: ManakovTop,
+    l0: np.ndarray,
+    times: np.ndarray,
+    args: argparse.Namespace,
+    dt: float,
+    run: _Run,
+    progress: Callable[[float], None] | None,
+) -> None:
+    """Integrate through ``times`` in segments of about :data:`SEGMENT_STEPS` steps,
+    appending each finished segment to ``run`` (Ctrl-C keeps what is in ``run``).
+
+    Every segment starts at a sample time from the last sample, so a Gauss run
+    takes the same steps (between consecutive samples) as one call would.
+    """
+    explicit = args.method in EXPLICIT_METHODS
+    nint = times.size - 1
+    spacing = times[-1] / nint
+    if explicit:
+        per_interval = 1.0  # measured after the first segment
+        per_segment = 1
+    else:
+        per_interval = math.ceil(spacing / dt * (1 - 1e-12))
+        need = per_interval * nint
+        if need > args.max_steps:
+            raise ValueError(
+                f"the run needs {need} steps (t_end / dt = {times[-1]:g} / {dt:.4g}, at "
+                f"least one step per sample interval of {spacing:.4g}), more than "
+                f"--max-steps {args.max_steps}: increase --dt or --max-steps, or shorten "
+                f"--t-end"
+            )
+        per_segment = max(1, SEGMENT_STEPS // per_interval)
+    run.t.append(times[:1])
+    run.l.append(l0[None, :])
+    i = 0
+    state = l0
+    while i < nint:
+        j = min(nint, i + per_segment)
+        seg = times[i : j + 1]
+        tr = top.integrate(
+            state,
+            seg[-1] - seg[0],
+            t_eval=seg - seg[0],
+            dt=args.dt,
+            method=args.method,
+            max_steps=max(1, args.max_steps - run.steps),
+        )
+        run.t.append(seg[1:])
+        run.l.append(tr.l[1:])
+        run.steps += tr.steps
+        run.method = tr.method
+        state = tr.l[-1]
+        if explicit:
+            per_interval = max(1.0, run.steps / j)
+            per_segment = max(1, int(SEGMENT_STEPS / per_interval))
+        i = j
+        if progress is not None:
+            progress(i / nint)
+
+
+def _run_simulate(args: argparse.Namespace) -> int:
+    top, l0, name = _top_from_args(args)
+    a, b = top.a, top.b
+    t_end = float(args.t_end)
+    if not (math.isfinite(t_end) and t_end > 0):
+        raise ValueError(
+            f"--t-end must be finite and > 0, got {t_end} (the state at t = 0 is --l0)"
+        )
+    explicit = args.method in EXPLICIT_METHODS
+    if args.dt is not None and not (args.dt > 0 and math.isfinite(args.dt)):
+        raise ValueError(f"--dt must be finite and > 0, got {args.dt}")
+    dt = args.dt if args.dt is not None else top.default_dt(l0, args.method)
+    times = _sample_times(t_end, args.samples, dt, explicit)
+    to_stdout = args.output is not None and str(args.output) == "-"
+    out = None if to_stdout else (args.output or Path(f"{name}.npz"))
+    if out is not None:
+        if out.suffix not in (".npz", ".csv"):
+            raise ValueError(f"output must end in .npz or .csv, got {out.name!r}")
+        # Fail before a long run, not after it.
+        if not out.parent.is_dir():
+            raise ValueError(f"cannot write {out}: {out.parent} is not a directory")
+    # With CSV on stdout, the report goes to stderr.
+    report = sys.stderr if to_stdout else sys.stdout
+    est_steps = t_end / dt if dt > 0 else 0.0
+    bar = ProgressBar(f"simulate {name}", force=args.progress and not args.quiet)
+    if args.quiet or not (est_steps >= PROGRESS_MIN_STEPS or args.progress):
+        bar.enabled = False
+    run = _Run(t=[], l=[])
+    start = time.perf_counter()
+    try:
+        _integrate_segments(top, l0, times, args, dt, run, bar.update)
+    except KeyboardInterrupt:
+        bar.close()
+        t, l = run.arrays()
+        where = "no samples" if t.size == 0 else f"{t.size} samples up to t = {t[-1]:.6g}"
+        if out is None or t.size == 0:
+            if to_stdout and t.size:
+                _write(None, t, l, top.integrals(l), a, b, partial=True, stream=sys.stdout)
+            raise Interrupted(f"interrupted: {where}") from None
+        part = out.with_name(out.stem + ".partial" + out.suffix)
+        _write(part, t, l, top.integrals(l), a, b, partial=True)
+        raise Interrupted(f"interrupted: wrote {where} to {part} (partial)") from None
     elapsed = time.perf_counter() - start
     bar.close()
-    _write(out, tr, a, b)
-    png = out.with_suffix(".png")
+    t, l = run.arrays()
+    integrals = top.integrals(l)
+    _write(out, t, l, integrals, a, b, stream=sys.stdout)
+    drift = _relative_drift(integrals)
+    step = t_end / run.steps if run.steps else float("nan")
+    kind = "mean step" if explicit else "step"
+    png = out.with_suffix(".png") if out is not None else None
     plotted = (
-        False
-        if args.no_plot
-        else _plot(png, tr, f"{name}: {tr.method}, dt = {tr.dt:.3g}, {tr.steps} steps")
+        png is not None
+        and not args.no_plot
+        and _plot(png, t, l, drift, f"{name}: {run.method}, {kind} {step:.3g}, {run.steps} steps")
     )
     if not args.quiet:
-        print(f"{name}: a = {a.tolist()}, b = {b.tolist()}")
+        print(f"{name}: a = {a.tolist()}, b = {b.tolist()}", file=report)
         print(
-            f"integrated to t = {t_end:g} with {tr.method} (dt = {tr.dt:.4g}): "
-            f"{tr.steps} steps in {elapsed:.3f} s"
+            f"integrated to t = {t_end:g} with {run.method}: {run.steps} steps, "
+            f"{kind} {step:.4g} ({t.size} samples), in {elapsed:.3f} s",
+            file=report,
         )
-        for k, v in tr.max_drift().items():
-            print(f"  max relative drift of {k:>2}: {v:.2e}")
-        print(f"wrote {out}" + (f" and {png}" if plotted else ""))
+        for k, v in drift.items():
+            print(f"  max relative drift of {k:>2}: {float(np.max(v)):.2e}", file=report)
+        if out is not None:
+            print(f"wrote {out}" + (f" and {png}" if plotted else ""), file=report)
     return 0
+
+
+def _relative_drift(integrals: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
+    """As :meth:`Trajectory.relative_drift`: ``|I - I(0)| / |I(0)|`` (absolute if ``I(0) = 0``)."""
+    return {k: np.abs(v - v[0]) / (abs(v[0]) if v[0] != 0 else 1.0) for k, v in integrals.items()}
+
+
+# ----------------------------------------------------------------------- kotter
+
+
+def _add_kotter(p: argparse.ArgumentParser) -> None:
+    _add_top_arguments(p, "6")
+    p.add_argument("--plot", type=Path, default=None, help="write a PNG of the curve's data")
+
+
+def _fmt(z: Any) -> str:
+    z = complex(z)
+    if z.imag == 0:
+        return f"{z.real:.10g}"
+    return f"{z.real:.10g}{z.imag:+.10g}j"
+
+
+def _run_kotter(args: argparse.Namespace) -> int:
+    from .reduction import from_kotter, kotter
+
+    top, l0, name = _top_from_args(args)
+    if top.n != 4:
+        raise ValueError(f"the reduction is for tops on so(4) (n = 4), got n = {top.n}")
+    k = kotter(top.a, top.b, l0)
+    back = from_kotter(top.a, top.b, k)
+    err = float(np.max(np.abs(back - l0)) / max(float(np.max(np.abs(l0))), 1e-300))
+    lines = [
+        f"{name}: a = {top.a.tolist()}, b = {top.b.tolist()}",
+        f"l = {l0.tolist()}",
+        "integrals (6)-(7): h0..h3 = " + ", ".join(f"{x:.10g}" for x in k.h),
+        "roots of F (19): s = " + ", ".join(_fmt(x) for x in k.s),
+        "curve (8): y^2 = x (x - d1)(x - d2)(x - d3)(x - d4), d4 = d1 d2 d3",
+        "  d = " + ", ".join(_fmt(x) for x in k.d) + f", d4 = {_fmt(np.prod(k.d))}",
+        "divisor (37): (z1, y1) = " + f"({_fmt(k.z1)}, {_fmt(k.y1)})",
+        "              (z2, y2) = " + f"({_fmt(k.z2)}, {_fmt(k.y2)})",
+        f"eps (41) = {_fmt(k.eps)}, g (42) = {_fmt(k.g)}, P0 = {_fmt(k.P0)}",
+        "xi (22) = " + ", ".join(_fmt(x) for x in k.xi),
+        "eta (22) = " + ", ".join(_fmt(x) for x in k.eta),
+        f"round trip l -> Kotter -> l: max relative error {err:.2e}",
+    ]
+    print("\n".join(lines))
+    if args.plot is not None:
+        if _plot_kotter(args.plot, k, name):
+            print(f"wrote {args.plot}")
+        else:
+            print("matplotlib is not installed: no plot", file=sys.stderr)
+    return 0
+
+
+def _plot_kotter(path: Path, k: Any, name: str) -> bool:
+    try:
+        import matplotlib
+
+        matplotlib.use("Agg")
+        import matplotlib.pyplot as plt
+    except ImportError:
+        return False
+    d = np.concatenate([[0.0], k.d, [np.prod(k.d)]])
+    fig, ax = plt.subplots(figsize=(7, 5), constrained_layout=True)
+    ax.scatter(d.real, d.imag, marker="x", s=60, label="branch points $d_0 .. d_4$")
+    for j, dj in enumerate(d):
+        ax.annotate(f"$d_{j}$", (dj.real, dj.imag), textcoords="offset points", xytext=(5, 5))
+    zs = np.array([k.z1, k.z2])
+    ax.scatter(zs.real, zs.imag, marker="o", s=40, label="divisor $z_1, z_2$")
+    ax.set_xlabel("Re x")
+    ax.set_ylabel("Im x")
+    ax.set_title(f"{name}: the curve (8) of the state and its divisor")
+    ax.legend()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return True
+
+
+# ------------------------------------------------------------------------ theta
+
+
+def _add_theta(p: argparse.ArgumentParser) -> None:
+    p.add_argument(
+        "--tau",
+        type=_complexes,
+        required=True,
+        help="period matrix, g*g complex entries row by row (symmetric, Im tau > 0)",
+    )
+    p.add_argument("--z", type=_complexes, required=True, help="the point, g complex numbers")
+    p.add_argument(
+        "--char",
+        default=None,
+        help="one characteristic: a FLINT index, a label of (35) such as theta12, or "
+        "'a1 a2;b1 b2' (default: all 4^g)",
+    )
+    p.add_argument(
+        "--log-scale",
+        action="store_true",
+        help="print Omega and L with theta = exp(L) Omega (never overflows)",
+    )
+
+
+def _parse_char(text: str | None) -> Any:
+    if text is None:
+        return None
+    if text.strip().isdigit():
+        return int(text)
+    if ";" in text:
+        a, b = text.split(";")
+        return (tuple(int(x) for x in a.replace(",", " ").split()),) + (
+            tuple(int(x) for x in b.replace(",", " ").split()),
+        )
+    return text
+
+
+def _run_theta(args: argparse.Namespace) -> int:
+    from .theta import characteristics, theta, theta_all
+
+    m = len(args.tau)
+    g = math.isqrt(m)
+    if g * g != m:
+        raise ValueError(f"--tau needs g*g entries (row by row), got {m}")
+    tau = np.array(args.tau, dtype=complex).reshape(g, g)
+    z = np.array(args.z, dtype=complex)
+    if args.char is not None:
+        char = _parse_char(args.char)
+        if args.log_scale:
+            om, log = theta(z, tau, char, log_scale=True)
+            print(f"Omega = {_fmt(om)}, L = {float(log):.17g}")
+        else:
+            print(_fmt(theta(z, tau, char)))
+        return 0
+    if args.log_scale:
+        vals, log = theta_all(z, tau, log_scale=True)
+        print(f"# theta = exp(L) Omega, L = {float(log):.17g}")
+    else:
+        vals = theta_all(z, tau)
+    print("# index  a  b  value")
+    for idx, ((a, b), v) in enumerate(zip(characteristics(g), vals)):
+        print(f"{idx:>3}  {''.join(map(str, a))} {''.join(map(str, b))}  {_fmt(v)}")
+    return 0
+
+
+# --------------------------------------------------------------------- registry
+
+COMMANDS: tuple[Command, ...] = (
+    Command(
+        "simulate",
+        "integrate a top and write its trajectory",
+        "Integrate Frahm's equations (1) for Manakov's top (2). State order "
+        "(l12, l13, l14, l23, l24, l34) for n = 4 (upper triangle, row by row, in general). "
+        "Ctrl-C writes the samples computed so far to <output stem>.partial<suffix> and "
+        "exits with status 130.",
+        "manakov simulate generic --t-end 100 -o generic.npz\n"
+        "  manakov simulate --a 1,2,3 --b 0.5,-1,2 --l0 1,0.5,-0.2 --method dop853 -o - | head",
+        _add_simulate,
+        _run_simulate,
+    ),
+    Command(
+        "kotter",
+        "reduce a state of an so(4) top to its curve and divisor",
+        "The Schottky-Kötter reduction (11)-(42) of a state: the integrals h0..h3, the "
+        "roots s_p of F (19), the curve (8) with branch points d_j, the divisor "
+        "(z1, y1), (z2, y2), eps (41) and g (42), Kötter's xi, eta (22), and the error of "
+        "the round trip l -> Kötter -> l. --plot draws the branch points and the divisor.",
+        "manakov kotter generic --plot generic-curve.png\n"
+        "  manakov kotter --a 0,1,2,3.5 --b 0,1,4,12.25 --l0 1,0.2,0.3,-0.4,0.5,0.6",
+        _add_kotter,
+        _run_kotter,
+    ),
+    Command(
+        "theta",
+        "theta functions with half-integer characteristics at a point",
+        "theta[a;b](z, tau) = sum_n exp(i pi (n+a/2)^T tau (n+a/2) + 2 pi i (n+a/2)^T (z+b/2)) "
+        "((34)-(36)), all 4^g characteristics in FLINT's order or one of them.",
+        "manakov theta --tau '0.3+1.1j,0.1+0.4j,0.1+0.4j,-0.2+1.3j' --z '0.2+0.1j,0.7-0.3j'\n"
+        "  manakov theta --tau ... --z ... --char theta12",
+        _add_theta,
+        _run_theta,
+    ),
+)
+
+
+def _parser() -> argparse.ArgumentParser:
+    ap = argparse.ArgumentParser(
+        prog="manakov",
+        description="The four-dimensional free rigid body (Manakov's top).",
+        epilog="Run 'manakov <command> --help' for each command's options and an example.",
+    )
+    ap.add_argument("--version", action="version", version=f"manakov {__version__}")
+    sub = ap.add_subparsers(dest="command", required=True, metavar="command")
+    for cmd in COMMANDS:
+        p = sub.add_parser(
+            cmd.name,
+            help=cmd.help,
+            description=cmd.description,
+            epilog="example:\n  " + cmd.example,
+            formatter_class=argparse.RawDescriptionHelpFormatter,
+        )
+        cmd.add_arguments(p)
+    return ap
+
+
+def _quiet_broken_pipe() -> int:
+    # The reader closed the pipe (e.g. `| head`): send what is still buffered to
+    # /dev/null, so that the interpreter's flush at exit does not complain.
+    try:
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())
+    except (OSError, ValueError):
+        pass
+    return EXIT_BROKEN_PIPE
 
 
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of the ``manakov`` console script; returns the exit status."""
-    ap = _parser()
-    args = ap.parse_args(argv)
     try:
-        if args.command == "simulate":
-            return simulate(args)
-    except (ValueError, RuntimeError, OSError) as e:
-        print(f"manakov: error: {e}", file=sys.stderr)
-        return 2
-    ap.error(f"unknown command {args.command!r}")
-    return 2  # pragma: no cover
+        ap = _parser()
+        args = ap.parse_args(argv)
+        run = {c.name: c.run for c in COMMANDS}[args.command]
+        try:
+            status = run(args)
+            sys.stdout.flush()
+            return status
+        except Interrupted as e:
+            print(f"manakov: {e}", file=sys.stderr)
+            return EXIT_INTERRUPTED
+        except BrokenPipeError:
+            return _quiet_broken_pipe()
+        except (ValueError, RuntimeError, OSError) as e:
+            print(f"manakov: error: {e}", file=sys.stderr)
+            return 2
+    except KeyboardInterrupt:
+        print("manakov: interrupted", file=sys.stderr)
+        return EXIT_INTERRUPTED
 
 
 if __name__ == "__main__":

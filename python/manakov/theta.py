@@ -31,7 +31,7 @@ from __future__ import annotations
 import math
 import operator
 from collections.abc import Sequence
-from typing import Any, Union
+from typing import Any, Literal, Union, overload
 
 import numpy as np
 import numpy.typing as npt
@@ -41,6 +41,7 @@ from . import _core
 __all__ = [
     "CHARACTERISTICS",
     "DEFAULT_TOL",
+    "MAX_SECONDS_PER_POINT",
     "PAPER_CHARACTERISTICS",
     "PAPER_TABLE_35",
     "char_index",
@@ -58,10 +59,22 @@ __all__ = [
 #: value) dominates the total error.
 DEFAULT_TOL = 1e-15
 
+#: Largest estimated cost of one point in seconds (Rust ``MAX_SECONDS_PER_POINT``):
+#: above it ``tau`` is refused with a ValueError that gives the estimate. The
+#: estimate is ``terms * t_term + rows * t_row`` with per-genus constants fitted on
+#: this package's timings (docs/theta.md, "Cost budget"); it errs high.
+MAX_SECONDS_PER_POINT = 1.0
+
 #: Largest exponent whose exp is a finite double.
 _LOG_MAX = math.log(np.finfo(np.float64).max)
 
 Characteristic = tuple[tuple[int, ...], tuple[int, ...]]
+#: A complex array of theta values (or derivatives).
+ComplexArray = npt.NDArray[np.complex128]
+#: ``L`` of ``theta = exp(L) * Omega``: a float for one point, else an array.
+LogScale = Union[float, npt.NDArray[np.float64]]
+#: One value per point: a Python complex for a single point, else an array.
+ComplexOut = Union[complex, ComplexArray]
 CharLike = Union[None, int, str, Sequence[Sequence[int]]]
 
 
@@ -110,8 +123,9 @@ def characteristics(g: int = 2) -> list[Characteristic]:
 CHARACTERISTICS: list[Characteristic] = characteristics(2)
 
 #: The paper's table (35) exactly as printed: label -> the 2 x 2 array
-#: ``((x1, x2), (y1, y2))`` written under theta[...]. Not verified against the
-#: curve here (a later issue does that).
+#: ``((x1, x2), (y1, y2))`` written under theta[...]. Verified against the curve
+#: in tests/test_theta_quotients.py: it holds in a suitable canonical basis
+#: (docs/errata.md, row (34)-(35); docs/theta_quotients.md).
 PAPER_TABLE_35: dict[str, tuple[tuple[int, int], tuple[int, int]]] = {
     "theta23": ((0, 0), (1, 1)),
     "theta31": ((1, 0), (1, 1)),
@@ -238,14 +252,36 @@ def _prepare(
     if tau_a.ndim != 2 or tau_a.shape[0] != tau_a.shape[1]:
         raise ValueError(f"tau must have shape (g, g), got {tau_a.shape}")
     g = tau_a.shape[0]
-    if g == 0:
-        raise ValueError("tau has shape (0, 0): the genus must be in 1..6")
+    if not 1 <= g <= 6:
+        raise ValueError(f"tau has shape {tau_a.shape}: the genus must be in 1..6")
+    if isinstance(z, np.ndarray):
+        _check_batch_fits(z.shape, g)  # before the conversion copies z
     z_a = _as_complex("z", z)
     if z_a.ndim == 0 or z_a.shape[-1] != g:
         raise ValueError(f"z must have shape (..., {g}) for tau of genus {g}, got {z_a.shape}")
     lead = z_a.shape[:-1]
-    z2 = np.ascontiguousarray(z_a.reshape(-1, g))
+    # The binding reads any strides (and copies z itself): no contiguous copy here.
+    z2 = z_a.reshape(-1, g)
     return z2, np.ascontiguousarray(tau_a), lead, g
+
+
+def _check_batch_fits(shape: tuple[int, ...], g: int) -> None:
+    """MemoryError before any copy if the ``4^g`` values of every point cannot be held.
+
+    A ``numpy.empty`` of the output's size only reserves address space (freed at
+    once), so this costs nothing when it fits; it spares converting a huge ``z``
+    to complex first and then failing on the output.
+    """
+    if len(shape) == 0 or shape[-1] != g:
+        return  # the shape error is raised by the caller
+    npts = math.prod(shape[:-1])
+    try:
+        np.empty((npts, 4**g), dtype=np.complex128)
+    except (MemoryError, ValueError) as exc:
+        raise MemoryError(
+            f"{npts} points of genus {g} need {npts * 4**g * 16 / 2**30:.3g} GiB for the "
+            f"values alone: {exc}"
+        ) from None
 
 
 def _as_complex(what: str, x: npt.ArrayLike) -> npt.NDArray[np.complex128]:
@@ -301,6 +337,24 @@ def _out(x: np.ndarray, lead: tuple[int, ...]) -> Any:
     return x
 
 
+@overload
+def theta_all(
+    z: npt.ArrayLike,
+    tau: npt.ArrayLike,
+    *,
+    tol: float = ...,
+    log_scale: Literal[False] = ...,
+    parallel: bool = ...,
+) -> ComplexArray: ...
+@overload
+def theta_all(
+    z: npt.ArrayLike,
+    tau: npt.ArrayLike,
+    *,
+    tol: float = ...,
+    log_scale: Literal[True],
+    parallel: bool = ...,
+) -> tuple[ComplexArray, LogScale]: ...
 def theta_all(
     z: npt.ArrayLike,
     tau: npt.ArrayLike,
@@ -308,7 +362,7 @@ def theta_all(
     tol: float = DEFAULT_TOL,
     log_scale: bool = False,
     parallel: bool = True,
-) -> Any:
+) -> ComplexArray | tuple[ComplexArray, LogScale]:
     r"""All ``4^g`` theta functions with half-integer characteristics at once.
 
     .. math:: \theta[a;b](z,\tau)=\sum_{n\in\mathbb Z^g}
@@ -345,11 +399,18 @@ def theta_all(
         non-finite entries; non-symmetric tau; ``Im tau`` not positive definite
         (the message gives the smallest eigenvalue) or not factorisable in
         double precision; ``Im tau`` so ill-conditioned that more than 2e8
-        terms would be needed; ``|Re z|`` or ``|(Im tau)^-1 Im z|`` beyond
+        terms, or an estimated 1 s of work, would be needed per point
+        (:data:`MAX_SECONDS_PER_POINT`; large genus); ``|Re z|`` or ``|(Im tau)^-1 Im z|`` beyond
         4.5e15 (no fractional digit left: theta is not determined) or ``L``
         overflowing; ``tol`` not a real number in (0, 1).
     OverflowError
         A value exceeds the double range and ``log_scale`` is False.
+    MemoryError
+        The batch's outputs do not fit in memory (checked before any work).
+    KeyboardInterrupt
+        Ctrl-C: a batch checks for signals about every millisecond of work and
+        stops within a few milliseconds (a single point costs at most
+        :data:`MAX_SECONDS_PER_POINT` by the cost estimate).
 
     Notes
     -----
@@ -372,6 +433,28 @@ def theta_all(
     return vals
 
 
+@overload
+def theta(
+    z: npt.ArrayLike,
+    tau: npt.ArrayLike,
+    char: CharLike = ...,
+    *,
+    derivs: Sequence[int] = ...,
+    tol: float = ...,
+    log_scale: Literal[False] = ...,
+    parallel: bool = ...,
+) -> ComplexOut: ...
+@overload
+def theta(
+    z: npt.ArrayLike,
+    tau: npt.ArrayLike,
+    char: CharLike = ...,
+    *,
+    derivs: Sequence[int] = ...,
+    tol: float = ...,
+    log_scale: Literal[True],
+    parallel: bool = ...,
+) -> tuple[ComplexOut, LogScale]: ...
 def theta(
     z: npt.ArrayLike,
     tau: npt.ArrayLike,
@@ -381,7 +464,7 @@ def theta(
     tol: float = DEFAULT_TOL,
     log_scale: bool = False,
     parallel: bool = True,
-) -> Any:
+) -> ComplexOut | tuple[ComplexOut, LogScale]:
     r"""One theta function ``theta[a;b](z, tau)`` or one of its z-derivatives.
 
     .. math:: \theta[a;b](z,\tau)=\sum_{n\in\mathbb Z^g}
@@ -429,6 +512,12 @@ def theta(
         ``derivs`` is not a sequence of integers.
     OverflowError
         A value exceeds the double range and ``log_scale`` is False.
+    MemoryError
+        The batch's outputs do not fit in memory (checked before any work).
+    KeyboardInterrupt
+        Ctrl-C: a batch checks for signals about every millisecond of work and
+        stops within a few milliseconds (a single point costs at most
+        :data:`MAX_SECONDS_PER_POINT` by the cost estimate).
     """
     z2, tau_a, lead, g = _prepare(z, tau)
     idx = _resolve_char(char, g)
@@ -450,6 +539,28 @@ def theta(
     return _out(np.asarray(out), lead)
 
 
+@overload
+def theta_jet(
+    z: npt.ArrayLike,
+    tau: npt.ArrayLike,
+    char: CharLike = ...,
+    *,
+    all_chars: bool = ...,
+    tol: float = ...,
+    log_scale: Literal[False] = ...,
+    parallel: bool = ...,
+) -> tuple[ComplexOut, ComplexArray, ComplexArray]: ...
+@overload
+def theta_jet(
+    z: npt.ArrayLike,
+    tau: npt.ArrayLike,
+    char: CharLike = ...,
+    *,
+    all_chars: bool = ...,
+    tol: float = ...,
+    log_scale: Literal[True],
+    parallel: bool = ...,
+) -> tuple[ComplexOut, ComplexArray, ComplexArray, LogScale]: ...
 def theta_jet(
     z: npt.ArrayLike,
     tau: npt.ArrayLike,
@@ -459,7 +570,10 @@ def theta_jet(
     tol: float = DEFAULT_TOL,
     log_scale: bool = False,
     parallel: bool = True,
-) -> Any:
+) -> (
+    tuple[ComplexOut, ComplexArray, ComplexArray]
+    | tuple[ComplexOut, ComplexArray, ComplexArray, LogScale]
+):
     r"""Value, gradient and Hessian in z of theta functions, from one lattice sum.
 
     With the terms of the paper's (36) with characteristics (35),
@@ -495,6 +609,12 @@ def theta_jet(
         (checked only when ``all_chars`` is False).
     OverflowError
         A value exceeds the double range and ``log_scale`` is False.
+    MemoryError
+        The batch's outputs do not fit in memory (checked before any work).
+    KeyboardInterrupt
+        Ctrl-C: a batch checks for signals about every millisecond of work and
+        stops within a few milliseconds (a single point costs at most
+        :data:`MAX_SECONDS_PER_POINT` by the cost estimate).
     """
     z2, tau_a, lead, g = _prepare(z, tau)
     vals, grad, hess, log = _jet(z2, tau_a, lead, g, tol, 2, not log_scale, parallel)

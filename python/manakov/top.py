@@ -30,6 +30,7 @@ import numpy as np
 
 from . import _core
 from ._checks import _finite_result, _float_array, _n_from_dim, _out, _states, state_dim
+from .reduction import Kotter
 from .reduction import LevelSet as _LevelSet
 from .reduction import from_kotter as _from_kotter
 from .reduction import kotter as _kotter
@@ -813,7 +814,7 @@ class ManakovTop(FrahmTop):
         vals = _finite_result(_core.manakov_integrals(self._a, flat))
         return vals.reshape(lead + (vals.shape[1],))
 
-    def kotter(self, l: Any, *, errors: str = "raise") -> Any:
+    def kotter(self, l: Any, *, errors: str = "raise") -> Kotter:
         """Schottky–Kötter coordinates of the state(s) ``l`` (n = 4 only).
 
         Shorthand for :func:`manakov.kotter` ``(self.a, self.b, l)``: the roots of
@@ -844,7 +845,7 @@ class ManakovTop(FrahmTop):
         self._require_so4("kotter")
         return _kotter(self._a, self._b, l, errors=errors)
 
-    def level_set(self, l0: Any) -> Any:
+    def level_set(self, l0: Any) -> _LevelSet:
         """The level set of ``l0`` with Kötter's constants fixed once (n = 4 only).
 
         Shorthand for :class:`manakov.LevelSet` ``(self.a, self.b, l0)``; its
@@ -859,7 +860,7 @@ class ManakovTop(FrahmTop):
         self._require_so4("level_set")
         return _LevelSet(self._a, self._b, l0)
 
-    def from_kotter(self, k: Any) -> np.ndarray:
+    def from_kotter(self, k: Kotter) -> np.ndarray:
         """Map Schottky–Kötter coordinates back to the state l (n = 4 only).
 
         Shorthand for :func:`manakov.from_kotter` ``(self.a, self.b, k)``: rebuilds

@@ -5,7 +5,10 @@ use numpy::ndarray::{Array3, Array4};
 use numpy::{
     IntoPyArray, PyArray1, PyArray2, PyArray3, PyArray4, PyArrayMethods, PyReadonlyArray2,
 };
+use pyo3::exceptions::PyMemoryError;
 use pyo3::prelude::*;
+
+use super::errors::py_cancel;
 
 use crate::error::Error;
 use crate::theta::{apply_scale, ThetaPlan, MAX_GENUS};
@@ -39,6 +42,17 @@ fn read_tau(tau: &PyReadonlyArray2<'_, Complex64>) -> Result<(Vec<Complex64>, us
     Ok((t.iter().copied().collect(), r))
 }
 
+/// `len` complex zeros, or MemoryError if they cannot be allocated (a plain
+/// `vec!` would abort the process).
+fn try_zeros(len: usize) -> PyResult<Vec<Complex64>> {
+    let mut v = Vec::new();
+    v.try_reserve_exact(len).map_err(|e| {
+        PyMemoryError::new_err(format!("cannot allocate {len} complex numbers: {e}"))
+    })?;
+    v.resize(len, Complex64::new(0.0, 0.0));
+    Ok(v)
+}
+
 /// All 4^g theta values θ[a;b](z, τ) = Σ_n exp(iπ mᵀτm + 2πi mᵀ(z + b/2)),
 /// m = n + a/2 (the paper's (36) with the characteristics of (35)), FLINT order,
 /// and their z-derivatives up to `order` at
@@ -69,38 +83,65 @@ fn theta_jet_py<'py>(
         }
         .into());
     }
-    let z_flat: Vec<Complex64> = match zv.as_slice() {
-        Some(contiguous) => contiguous.to_vec(),
-        None => zv.iter().copied().collect(),
-    };
+    // Invalid tau or tol is reported before a large batch is allocated.
+    let plan = ThetaPlan::new(&tau_v, g, tol, order)?.with_parallel(parallel);
     let n = 1usize << (2 * g);
     let (gd, hd) = match order {
         0 => (0, 0),
         1 => (g, 0),
         _ => (g, g),
     };
+    // Sizes are checked before anything is allocated or copied: a batch too large
+    // for memory is a MemoryError (numpy's own, from the allocation below), one
+    // too large to address a ValueError; never an abort or a panic.
+    let per_point = n * (1 + gd + gd * hd); // values, gradient, Hessian entries
+    let entries = npts.checked_mul(per_point).filter(|&e| {
+        e.checked_mul(std::mem::size_of::<Complex64>())
+            .is_some_and(|b| b <= isize::MAX as usize)
+    });
+    if entries.is_none() {
+        return Err(Error::InvalidArgument {
+            what: "z",
+            reason: format!(
+                "{npts} points of genus {g} need {npts} x {per_point} complex outputs: \
+                 more than the address space"
+            ),
+        }
+        .into());
+    }
     // The values and L are written straight into numpy-allocated arrays: numpy
     // asks for huge pages for large arrays, which saves most of the page faults
     // of first touching a fresh 256-bytes-per-point output (measured: a one-core
-    // 10^5-point call went from 0.160 to 0.147 µs/point).
-    let values_arr = PyArray2::<Complex64>::zeros(py, [npts, n], false);
-    let logs_arr = PyArray1::<f64>::zeros(py, npts, false);
+    // 10^5-point call went from 0.160 to 0.147 µs/point). They are made by
+    // numpy.zeros through Python, so that a failed allocation raises MemoryError
+    // (PyArray::zeros panics on it).
+    let np = py.import("numpy")?;
+    let values_arr = np
+        .call_method1("zeros", ((npts, n), "complex128"))?
+        .cast_into::<PyArray2<Complex64>>()?;
+    let logs_arr = np
+        .call_method1("zeros", (npts, "float64"))?
+        .cast_into::<PyArray1<f64>>()?;
+    let mut gradient = try_zeros(npts * n * gd)?;
+    let mut hessian = try_zeros(npts * n * gd * hd)?;
+    let mut z_flat = try_zeros(npts * g)?;
+    for (dst, src) in z_flat.iter_mut().zip(zv.iter()) {
+        *dst = *src;
+    }
     // SAFETY: both arrays were created just above, are contiguous and not yet
     // shared with Python or anything else, so these are the only references.
     let (values, logs) = unsafe { (values_arr.as_slice_mut()?, logs_arr.as_slice_mut()?) };
-    let (gradient, hessian, finite) = py.detach(move || -> Result<_, Error> {
-        let plan = ThetaPlan::new(&tau_v, g, tol, order)?.with_parallel(parallel);
-        let zero = Complex64::new(0.0, 0.0);
-        let mut gradient = vec![zero; npts * n * gd];
-        let mut hessian = vec![zero; npts * n * g * hd];
+    let cancel = py_cancel();
+    let out = py.detach(move || -> Result<_, Error> {
         let finite = if scaled && order == 0 {
-            plan.eval_batch_scaled(&z_flat, values, logs)?
+            plan.eval_batch_scaled_cancel(&z_flat, values, logs, &cancel)?
         } else {
-            plan.eval_batch(&z_flat, values, &mut gradient, &mut hessian, logs)?;
+            plan.eval_batch_cancel(&z_flat, values, &mut gradient, &mut hessian, logs, &cancel)?;
             !scaled || apply_scale(values, &mut gradient, &mut hessian, logs)
         };
         Ok((gradient, hessian, finite))
     })?;
+    let (gradient, hessian, finite) = out;
     let shape_err = |e: numpy::ndarray::ShapeError| Error::Shape {
         what: "theta output",
         expected: "consistent sizes".into(),
@@ -117,7 +158,7 @@ fn theta_jet_py<'py>(
     ))
 }
 
-/// (radius, rho, error_bound, expected_terms) of the summation plan for `tau`
+/// (radius, rho, error_bound, expected_terms, seconds_per_point) of the summation plan for `tau`
 /// (the truncated lattice sum of (36), docs/theta.md).
 #[pyfunction(name = "theta_plan_info")]
 #[pyo3(signature = (tau, tol, order))]
@@ -125,10 +166,16 @@ fn theta_plan_info_py(
     tau: PyReadonlyArray2<'_, Complex64>,
     tol: f64,
     order: usize,
-) -> PyResult<(f64, f64, f64, f64)> {
+) -> PyResult<(f64, f64, f64, f64, f64)> {
     let (tau_v, g) = read_tau(&tau)?;
     let info = ThetaPlan::new(&tau_v, g, tol, order)?.info();
-    Ok((info.radius, info.rho, info.error_bound, info.expected_terms))
+    Ok((
+        info.radius,
+        info.rho,
+        info.error_bound,
+        info.expected_terms,
+        info.seconds_per_point,
+    ))
 }
 
 /// Adds this module's functions to `manakov._core`.

@@ -41,6 +41,7 @@ mod sum;
 pub use bound::tail_bound;
 pub use chars::{char_from_index, char_index, paper_char_index, parity, MAX_GENUS, PAPER_TABLE_35};
 
+use crate::cancel::Cancel;
 use crate::error::{check_finite, Error, Result};
 use num_complex::Complex64;
 use rayon::prelude::*;
@@ -58,6 +59,29 @@ pub const SYMMETRY_RTOL: f64 = 1e-12;
 /// Largest number of lattice terms a plan may need (about 1 s of work): beyond
 /// it `Im τ` is so ill-conditioned that the user should reduce τ first.
 pub const MAX_TERMS: f64 = 2e8;
+
+/// Largest estimated cost of one point ([`PlanInfo::seconds_per_point`]): a
+/// single point is summed without a cancellation check, so this bounds how long
+/// Ctrl-C can wait, and it refuses large-genus sums that would run for seconds
+/// (genus 6 near [`MAX_TERMS`] took 5–10 s per point).
+pub const MAX_SECONDS_PER_POINT: f64 = 1.0;
+
+/// Cost model of one point, in nanoseconds: `terms · TERM + rows · ROW`, times
+/// `1 + order` on the generic path. Fitted on this crate's own timings
+/// (genus 2–6, random and anisotropic `Im τ`, 1e4–2e8 terms, release build,
+/// one core): the genus-2 walk costs 3–6 ns a term whatever the order; the
+/// generic path 8–60 ns a term (up to 240 ns when rows are short) and
+/// 250–1300 ns per inner row (two exponentials and the class bookkeeping).
+/// The generic constants are upper quartiles, so the estimate errs high (by up
+/// to ~2×) rather than low.
+const COST_G2_TERM_NS: f64 = 5.0;
+const COST_G2_ROW_NS: f64 = 40.0;
+const COST_TERM_NS: f64 = 15.0;
+const COST_ROW_NS: f64 = 500.0;
+
+/// Work between two cancellation checks in a batch: ~1 ms (`Cancel::check`
+/// costs ~50 ns, so this is free, and Ctrl-C is seen long before 0.5 s).
+const CANCEL_CHECK_NS: f64 = 1e6;
 
 /// Largest `|Re z_k|` and `|(Im τ)^{-1} Im z|_k` accepted: beyond 2^52 a double
 /// has no fractional part, so θ is not determined to any digit.
@@ -171,6 +195,11 @@ pub struct PlanInfo {
     pub error_bound: f64,
     /// Expected number of terms (volume of the ellipsoid in the half-lattice).
     pub expected_terms: f64,
+    /// Expected number of inner rows (the same for the first `g - 1` coordinates).
+    pub expected_rows: f64,
+    /// Estimated cost of one point in seconds on one core (the cost model of
+    /// [`MAX_SECONDS_PER_POINT`]; errs high).
+    pub seconds_per_point: f64,
 }
 
 /// Reusable scratch space for the class sums.
@@ -353,13 +382,19 @@ impl ThetaPlan {
             batch2: std::sync::OnceLock::new(),
             parallel: true,
         };
-        let expected = plan.info().expected_terms;
-        if expected > MAX_TERMS {
+        let info = plan.info();
+        let expected = info.expected_terms;
+        let cost = info.seconds_per_point;
+        if expected > MAX_TERMS || cost.is_nan() || cost > MAX_SECONDS_PER_POINT {
             return Err(Error::InvalidArgument {
                 what: "tau",
                 reason: format!(
-                    "Im tau is too ill-conditioned: about {expected:.2e} terms needed \
-                     (det Im tau = {:.3e}); reduce tau first",
+                    "Im tau is too ill-conditioned for genus {g}: about {expected:.2e} terms \
+                     and {:.2e} rows needed per point, estimated {:.2} s each (budget \
+                     {MAX_TERMS:.0e} terms, {MAX_SECONDS_PER_POINT} s; det Im tau = {:.3e}); \
+                     reduce tau first",
+                    info.expected_rows,
+                    info.seconds_per_point,
                     plan.ldl_d.iter().product::<f64>()
                 ),
             });
@@ -394,11 +429,30 @@ impl ThetaPlan {
         let sk = (0..g)
             .map(|k| (self.yinv[k * g + k] / pi()).sqrt())
             .fold(0.0, f64::max);
+        let expected_terms = vg * self.rq.powf(g as f64 / 2.0) / det.sqrt() * f64::from(1u32 << g);
+        // The outer coordinates j_1..j_{g-1} range over the projection of the
+        // ellipsoid, whose form is Σ_{i<g-1} d_i (…)² (the factorisation eliminates
+        // the last coordinate first).
+        let expected_rows = if g == 1 {
+            1.0
+        } else {
+            let outer_det: f64 = self.ldl_d[..g - 1].iter().product();
+            let v = pi().powf((g - 1) as f64 / 2.0) / gamma_half_int(g + 1);
+            (v * self.rq.powf((g - 1) as f64 / 2.0) / outer_det.sqrt() * f64::from(1u32 << (g - 1)))
+                .max(1.0)
+        };
+        let ns = if self.fast_g2 {
+            expected_terms * COST_G2_TERM_NS + expected_rows * COST_G2_ROW_NS
+        } else {
+            (expected_terms * COST_TERM_NS + expected_rows * COST_ROW_NS) * (1 + self.order) as f64
+        };
         PlanInfo {
             radius: self.radius,
             rho: self.rho,
             error_bound: output_error_bound(g, self.rho_used, self.radius, sk, self.order),
-            expected_terms: vg * self.rq.powf(g as f64 / 2.0) / det.sqrt() * f64::from(1u32 << g),
+            expected_terms,
+            expected_rows,
+            seconds_per_point: ns * 1e-9,
         }
     }
 
@@ -782,6 +836,20 @@ impl ThetaPlan {
         hessian: &mut [Complex64],
         log_scale: &mut [f64],
     ) -> Result<()> {
+        self.eval_batch_cancel(z, values, gradient, hessian, log_scale, &Cancel::never())
+    }
+
+    /// [`ThetaPlan::eval_batch`] that checks `cancel` about every millisecond of
+    /// work and stops with [`Error::Interrupted`] (outputs then partly written).
+    pub fn eval_batch_cancel(
+        &self,
+        z: &[Complex64],
+        values: &mut [Complex64],
+        gradient: &mut [Complex64],
+        hessian: &mut [Complex64],
+        log_scale: &mut [f64],
+        cancel: &Cancel,
+    ) -> Result<()> {
         let g = self.g;
         let n = 1usize << (2 * g);
         let npts = log_scale.len();
@@ -791,7 +859,7 @@ impl ThetaPlan {
             && (gradient.is_empty() || gradient.len() == npts * gs)
             && (hessian.is_empty() || hessian.len() == npts * hs);
         let Some(chunk) = self.parallel_chunk(npts).filter(|_| shapes_ok) else {
-            return self.eval_batch_serial(z, values, gradient, hessian, log_scale);
+            return self.eval_batch_serial(z, values, gradient, hessian, log_scale, cancel);
         };
         let gs = if gradient.is_empty() { 0 } else { gs };
         let hs = if hessian.is_empty() { 0 } else { hs };
@@ -805,12 +873,23 @@ impl ThetaPlan {
         } else {
             hessian.chunks_mut(chunk * hs).collect()
         };
-        z.par_chunks(chunk * g)
-            .zip(values.par_chunks_mut(chunk * n))
-            .zip(gchunks.par_iter_mut())
-            .zip(hchunks.par_iter_mut())
-            .zip(log_scale.par_chunks_mut(chunk))
-            .try_for_each(|((((zc, vc), gc), hc), lc)| self.eval_batch_serial(zc, vc, gc, hc, lc))
+        run_polled(cancel, || {
+            z.par_chunks(chunk * g)
+                .zip(values.par_chunks_mut(chunk * n))
+                .zip(gchunks.par_iter_mut())
+                .zip(hchunks.par_iter_mut())
+                .zip(log_scale.par_chunks_mut(chunk))
+                .try_for_each(|((((zc, vc), gc), hc), lc)| {
+                    self.eval_batch_serial(zc, vc, gc, hc, lc, cancel)
+                })
+        })
+    }
+
+    /// Points between two cancellation checks (about [`CANCEL_CHECK_NS`] of work
+    /// by the cost model, whole kernel chunks).
+    fn points_per_check(&self) -> usize {
+        let per = CANCEL_CHECK_NS / (self.info().seconds_per_point * 1e9).max(1.0);
+        ((per as usize).max(1)).div_ceil(batch::LANES) * batch::LANES
     }
 
     /// Chunk size for splitting a batch of `npts` points over the thread pool,
@@ -834,6 +913,7 @@ impl ThetaPlan {
         gradient: &mut [Complex64],
         hessian: &mut [Complex64],
         log_scale: &mut [f64],
+        cancel: &Cancel,
     ) -> Result<()> {
         let g = self.g;
         let n = 1usize << (2 * g);
@@ -849,7 +929,7 @@ impl ThetaPlan {
         if gradient.is_empty() && hessian.is_empty() && npts >= BATCH_KERNEL_MIN_POINTS {
             if let Some(b2) = self.batch2.get_or_init(|| batch::Batch2::build(self)) {
                 return self
-                    .eval_batch_g2(b2, z, values, log_scale, false)
+                    .eval_batch_g2(b2, z, values, log_scale, false, cancel)
                     .map(|_| ());
             }
         }
@@ -866,7 +946,11 @@ impl ThetaPlan {
                 got: format!("{}, {}", gradient.len(), hessian.len()),
             });
         }
+        let every = self.points_per_check();
         for i in 0..npts {
+            if i % every == 0 {
+                cancel.check()?;
+            }
             log_scale[i] = self.eval_into(
                 &z[i * g..(i + 1) * g],
                 &mut ws,
@@ -889,14 +973,19 @@ impl ThetaPlan {
         values: &mut [Complex64],
         log_scale: &mut [f64],
         scaled: bool,
+        cancel: &Cancel,
     ) -> Result<bool> {
         const L: usize = batch::LANES;
         let mut finite = true;
         let npts = log_scale.len();
+        let every = self.points_per_check();
         let mut sc = b2.scratch();
         let mut inp = batch::ChunkIn::default();
         let mut i0 = 0;
         while i0 < npts {
+            if i0 % every == 0 {
+                cancel.check()?;
+            }
             let m = (npts - i0).min(L);
             if m < L {
                 inp = batch::ChunkIn::default();
@@ -935,17 +1024,31 @@ impl ThetaPlan {
         values: &mut [Complex64],
         log_scale: &mut [f64],
     ) -> Result<bool> {
+        self.eval_batch_scaled_cancel(z, values, log_scale, &Cancel::never())
+    }
+
+    /// [`ThetaPlan::eval_batch_scaled`] that checks `cancel` about every
+    /// millisecond of work and stops with [`Error::Interrupted`].
+    pub fn eval_batch_scaled_cancel(
+        &self,
+        z: &[Complex64],
+        values: &mut [Complex64],
+        log_scale: &mut [f64],
+        cancel: &Cancel,
+    ) -> Result<bool> {
         let (g, npts) = (self.g, log_scale.len());
         let n = 1usize << (2 * g);
         let shapes_ok = z.len() == npts * g && values.len() == npts * n;
         let Some(chunk) = self.parallel_chunk(npts).filter(|_| shapes_ok) else {
-            return self.eval_batch_scaled_serial(z, values, log_scale);
+            return self.eval_batch_scaled_serial(z, values, log_scale, cancel);
         };
-        z.par_chunks(chunk * g)
-            .zip(values.par_chunks_mut(chunk * n))
-            .zip(log_scale.par_chunks_mut(chunk))
-            .map(|((zc, vc), lc)| self.eval_batch_scaled_serial(zc, vc, lc))
-            .try_reduce(|| true, |a, b| Ok(a && b))
+        run_polled(cancel, || {
+            z.par_chunks(chunk * g)
+                .zip(values.par_chunks_mut(chunk * n))
+                .zip(log_scale.par_chunks_mut(chunk))
+                .map(|((zc, vc), lc)| self.eval_batch_scaled_serial(zc, vc, lc, cancel))
+                .try_reduce(|| true, |a, b| Ok(a && b))
+        })
     }
 
     fn eval_batch_scaled_serial(
@@ -953,16 +1056,44 @@ impl ThetaPlan {
         z: &[Complex64],
         values: &mut [Complex64],
         log_scale: &mut [f64],
+        cancel: &Cancel,
     ) -> Result<bool> {
         let npts = log_scale.len();
         if z.len() == 2 * npts && values.len() == 16 * npts && npts >= BATCH_KERNEL_MIN_POINTS {
             if let Some(b2) = self.batch2.get_or_init(|| batch::Batch2::build(self)) {
-                return self.eval_batch_g2(b2, z, values, log_scale, true);
+                return self.eval_batch_g2(b2, z, values, log_scale, true, cancel);
             }
         }
-        self.eval_batch_serial(z, values, &mut [], &mut [], log_scale)?;
+        self.eval_batch_serial(z, values, &mut [], &mut [], log_scale, cancel)?;
         Ok(apply_scale(values, &mut [], &mut [], log_scale))
     }
+}
+
+/// Runs `work` (which splits itself over rayon's pool) while the calling thread
+/// polls `cancel`: the caller is not a pool thread, so without this it would
+/// only wait, and a poll that must run on the calling thread (Python's signal
+/// handlers) would never run. On cancellation the flag stops the workers at
+/// their next check.
+fn run_polled<T: Send>(cancel: &Cancel, work: impl FnOnce() -> Result<T> + Send) -> Result<T> {
+    let (tx, rx) = std::sync::mpsc::sync_channel::<()>(1);
+    let mut out = None;
+    rayon::in_place_scope(|s| {
+        let slot = &mut out;
+        s.spawn(move |_| {
+            *slot = Some(work());
+            // The receiver lives until the scope ends; a failed send cannot happen.
+            let _ = tx.send(());
+        });
+        // recv_timeout wakes as soon as the work is done: no added latency.
+        while let Err(std::sync::mpsc::RecvTimeoutError::Timeout) =
+            rx.recv_timeout(std::time::Duration::from_millis(5))
+        {
+            if cancel.check().is_err() {
+                break;
+            }
+        }
+    });
+    out.unwrap_or(Err(Error::Interrupted))
 }
 
 /// Multiplies batch outputs of [`ThetaPlan::eval_batch`] by `exp(L)` in place, giving

@@ -484,3 +484,61 @@ fn foreign_workspace_and_extreme_imaginary_parts() {
         );
     }
 }
+
+#[test]
+fn a_cancelled_batch_stops_with_interrupted_serial_and_parallel() {
+    let plan = ThetaPlan::new(&bench_tau(), 2, 1e-15, 0).unwrap();
+    let npts = 20_000;
+    let z: Vec<C> = (0..2 * npts)
+        .map(|i| C::new(0.001 * i as f64, 0.1))
+        .collect();
+    for parallel in [false, true] {
+        let plan = plan.clone().with_parallel(parallel);
+        let cancel = crate::cancel::Cancel::never();
+        cancel.cancel();
+        let mut v = vec![C::new(0.0, 0.0); 16 * npts];
+        let mut l = vec![0.0; npts];
+        assert_eq!(
+            plan.eval_batch_cancel(&z, &mut v, &mut [], &mut [], &mut l, &cancel),
+            Err(Error::Interrupted)
+        );
+        assert_eq!(
+            plan.eval_batch_scaled_cancel(&z, &mut v, &mut l, &cancel),
+            Err(Error::Interrupted)
+        );
+        // an uncancelled token changes nothing
+        let mut v2 = vec![C::new(0.0, 0.0); 16 * npts];
+        let mut l2 = vec![0.0; npts];
+        plan.eval_batch(&z, &mut v, &mut [], &mut [], &mut l)
+            .unwrap();
+        plan.eval_batch_cancel(
+            &z,
+            &mut v2,
+            &mut [],
+            &mut [],
+            &mut l2,
+            &crate::cancel::Cancel::never(),
+        )
+        .unwrap();
+        assert_eq!(v, v2);
+    }
+}
+
+#[test]
+fn large_genus_sums_over_the_cost_budget_are_refused() {
+    let g = 6;
+    let tau: Vec<C> = (0..g * g)
+        .map(|ik| C::new(0.3, if ik / g == ik % g { 0.2 } else { 0.0 }))
+        .collect();
+    match ThetaPlan::new(&tau, g, 1e-15, 0) {
+        Err(Error::InvalidArgument { reason, .. }) => {
+            assert!(reason.contains("estimated"), "{reason}")
+        }
+        other => panic!("{other:?}"),
+    }
+    let ok: Vec<C> = (0..g * g)
+        .map(|ik| C::new(0.3, if ik / g == ik % g { 1.0 } else { 0.0 }))
+        .collect();
+    let info = ThetaPlan::new(&ok, g, 1e-15, 0).unwrap().info();
+    assert!(info.seconds_per_point > 0.0 && info.seconds_per_point <= MAX_SECONDS_PER_POINT);
+}
