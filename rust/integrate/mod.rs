@@ -1202,10 +1202,19 @@ fn run_gauss<S: Stepper, F: VectorField>(
 /// it; a thread blocked in rayon would never poll). Joined before returning, so
 /// no thread outlives the call.
 fn poll_during<T: Send>(cancel: &Cancel, work: impl FnOnce() -> T + Send) -> T {
+    use std::sync::mpsc::{channel, RecvTimeoutError};
     std::thread::scope(|s| {
-        let handle = s.spawn(work);
-        while !handle.is_finished() {
-            std::thread::sleep(std::time::Duration::from_millis(2));
+        let (done, finished) = channel::<()>();
+        let handle = s.spawn(move || {
+            let out = work();
+            // The receiver lives until the join below; a failed send cannot happen.
+            let _ = done.send(());
+            out
+        });
+        // Wakes as soon as the work is done (no polling delay on short calls).
+        while let Err(RecvTimeoutError::Timeout) =
+            finished.recv_timeout(std::time::Duration::from_millis(5))
+        {
             // An Err here has set the shared flag; the workers see it and stop.
             let _ = cancel.check();
         }
@@ -1270,6 +1279,13 @@ pub fn integrate_many_with<F: VectorField>(
     let lanes = f
         .so4_coefficients()
         .filter(|_| matches!(opts.method, Method::Gauss16 | Method::Dop853));
+    // One task's worth of work runs on the calling thread: no pool, no poller thread.
+    let task = match (lanes, opts.method) {
+        (Some(_), Method::Gauss16) => LANES,
+        (Some(_), _) => DOP853_TASK,
+        (None, _) => 1,
+    };
+    let parallel = parallel && rows > task;
     let mut run = || -> Result<u64> {
         let steps: Vec<u64> = match lanes {
             Some(c) if opts.method == Method::Gauss16 => {
