@@ -21,6 +21,7 @@ pub mod curve;
 pub mod error;
 pub mod integrate;
 pub mod kotter;
+pub mod riemann;
 pub mod so4;
 pub mod theta;
 
