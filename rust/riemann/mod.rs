@@ -859,14 +859,22 @@ impl HyperellipticCurve {
         }
     }
 
-    /// `η(e_k)`: `u(e_k) ≡ (b + τ a)/2`, 0-based `k`; `k = n` is `∞` (odd `n`).
-    pub fn branch_char(&self, k: usize) -> Result<(Vec<u8>, Vec<u8>)> {
+    /// `η(e_k)`: `u(e_k) ≡ (b + τ a)/2` modulo the lattice, for the 0-based
+    /// index `k` (`e_{k+1}`); `k = n` is `∞` for odd `n` (`η(∞) = 0`, the base
+    /// point). Empty vectors for an index out of range
+    /// ([`Self::try_branch_char`] gives the error).
+    pub fn branch_char(&self, k: usize) -> (Vec<u8>, Vec<u8>) {
+        self.try_branch_char(k).unwrap_or_default()
+    }
+
+    /// [`Self::branch_char`] with an error for an index out of range.
+    pub fn try_branch_char(&self, k: usize) -> Result<(Vec<u8>, Vec<u8>)> {
         self.half_period_char(&self.abel_branch_point(k)?)
     }
 
     /// The half period `(b + τa)/2` of `η(e_k)` (reduced representative).
     pub fn branch_half_period(&self, k: usize) -> Result<Vec<C>> {
-        let (a, b) = self.branch_char(k)?;
+        let (a, b) = self.try_branch_char(k)?;
         Ok(self.half_period(&a, &b))
     }
 
@@ -929,7 +937,7 @@ impl HyperellipticCurve {
             let v: Vec<C> = (0..2).map(|i| u1[i] + u2[i] + k[i]).collect();
             let (vals, _) = plan.theta_all(&v)?;
             for j in 0..5 {
-                let (a, b) = self.branch_char(j)?;
+                let (a, b) = self.try_branch_char(j)?;
                 let idx = crate::theta::char_index(&a, &b)?;
                 let ratio = vals[0] / vals[idx];
                 calib.push(((x1 - self.e[j]) * (x2 - self.e[j]) * ratio * ratio, idx));
@@ -945,14 +953,27 @@ impl HyperellipticCurve {
 
     /// The vector of Riemann constants `K` for the base point `P0`: the half
     /// period `(b + τa)/2` with `θ(u(P_1) + … + u(P_{g−1}) + K) = 0` for all
-    /// points (g = 2: `θ(u(P) + K) = 0`), found among the `4^g` half periods
-    /// by evaluating theta at three fixed divisors.
-    pub fn riemann_constant(&self) -> Result<&[C]> {
+    /// points (g = 2: `θ(u(P) + K) = 0` for every `P`), found among the `4^g`
+    /// half periods by evaluating theta at three fixed divisors (built on
+    /// first use). Empty if that search failed; [`Self::try_riemann_constant`]
+    /// gives the error.
+    pub fn riemann_constant(&self) -> &[C] {
+        self.try_riemann_constant().unwrap_or(&[])
+    }
+
+    /// [`Self::riemann_constant`] with the error of the search.
+    pub fn try_riemann_constant(&self) -> Result<&[C]> {
         Ok(&self.derived()?.k)
     }
 
-    /// The characteristic `[a; b]` of [`Self::riemann_constant`].
-    pub fn riemann_constant_char(&self) -> Result<(Vec<u8>, Vec<u8>)> {
+    /// The characteristic `[a; b]` of [`Self::riemann_constant`]
+    /// (`K = (b + τa)/2`); empty vectors if the search failed.
+    pub fn riemann_constant_char(&self) -> (Vec<u8>, Vec<u8>) {
+        self.try_riemann_constant_char().unwrap_or_default()
+    }
+
+    /// [`Self::riemann_constant_char`] with the error of the search.
+    pub fn try_riemann_constant_char(&self) -> Result<(Vec<u8>, Vec<u8>)> {
         Ok(self.derived()?.k_char.clone())
     }
 
