@@ -11,6 +11,7 @@ mod arrays;
 mod curve;
 mod errors;
 mod kotter;
+mod riemann;
 mod so4;
 mod theta;
 
@@ -28,6 +29,7 @@ mod _core {
         theta::register(m)?;
         kotter::register(m)?;
         curve::register(m)?;
+        riemann::register(m)?;
         Ok(())
     }
 }
