@@ -23,6 +23,7 @@ pub mod integrate;
 pub mod kotter;
 pub mod riemann;
 pub mod so4;
+pub mod solution;
 pub mod theta;
 
 pub use error::{Error, Result};
