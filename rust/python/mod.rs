@@ -13,6 +13,7 @@ mod errors;
 mod kotter;
 mod riemann;
 mod so4;
+mod solution;
 mod theta;
 
 #[pymodule]
@@ -30,6 +31,7 @@ mod _core {
         kotter::register(m)?;
         curve::register(m)?;
         riemann::register(m)?;
+        solution::register(m)?;
         Ok(())
     }
 }

@@ -177,8 +177,14 @@ impl Solution {
         }
         let sum = |p: usize, q: usize| {
             (
-                [(eta[p].0[0] + eta[q].0[0]) % 2, (eta[p].0[1] + eta[q].0[1]) % 2],
-                [(eta[p].1[0] + eta[q].1[0]) % 2, (eta[p].1[1] + eta[q].1[1]) % 2],
+                [
+                    (eta[p].0[0] + eta[q].0[0]) % 2,
+                    (eta[p].0[1] + eta[q].0[1]) % 2,
+                ],
+                [
+                    (eta[p].1[0] + eta[q].1[0]) % 2,
+                    (eta[p].1[1] + eta[q].1[1]) % 2,
+                ],
             )
         };
         let mut chars = [([0u8; 2], [0u8; 2]); 7];
@@ -302,7 +308,10 @@ impl Solution {
         })?;
         let rate = [sol[0], sol[1]];
         if !(rate.iter().all(|v| v.re.is_finite() && v.im.is_finite())) {
-            return Err(Error::NonFinite { what: "U", index: 0 });
+            return Err(Error::NonFinite {
+                what: "U",
+                index: 0,
+            });
         }
         let (x0, y0) = curve.lattice_coordinates(&v0);
         let (xr, yr) = curve.lattice_coordinates(&rate);
@@ -433,11 +442,7 @@ impl Solution {
         let d: C = (0..8).map(|m| self.den[m] * th[m]).sum();
         let dinv = d.inv();
         for q in 0..6 {
-            let n: C = self.num[q]
-                .iter()
-                .zip(th.iter())
-                .map(|(w, t)| w * t)
-                .sum();
+            let n: C = self.num[q].iter().zip(th.iter()).map(|(w, t)| w * t).sum();
             out[q] = (n * dinv).re;
         }
     }
