@@ -15,6 +15,7 @@ __all__ = [
     "curve_wurzel",
     "curve_xi_eta",
     "HyperellipticCore",
+    "SolutionCore",
     "gauss_tableau",
     "hamiltonian",
     "integrate",
@@ -212,7 +213,7 @@ class SolutionCore:
         b: npt.NDArray[np.float64],
         l0: npt.NDArray[np.float64],
     ) -> SolutionCore: ...
-    def l(self, t: npt.NDArray[np.float64]) -> npt.NDArray[np.float64]: ...
+    def l(self, t: npt.NDArray[np.float64]) -> npt.NDArray[np.float64]: ...  # noqa: E743
     def abel(self, l: npt.NDArray[np.float64]) -> npt.NDArray[np.complex128]: ...
     @property
     def u0(self) -> npt.NDArray[np.complex128]: ...
