@@ -21,7 +21,9 @@ pub mod curve;
 pub mod error;
 pub mod integrate;
 pub mod kotter;
+pub mod riemann;
 pub mod so4;
+pub mod solution;
 pub mod theta;
 
 pub use error::{Error, Result};

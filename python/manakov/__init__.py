@@ -9,6 +9,8 @@ from ._core import ConvergenceError, __version__
 from .curve import CurvePoints, KotterCurve, Wurzel
 from .problems import Problem, benchmark_setup, problem, problem_names
 from .reduction import Kotter, LevelSet, from_kotter, kotter
+from .riemann import HyperellipticCurve
+from .solution import Solution
 from .theta import (
     CHARACTERISTICS,
     PAPER_CHARACTERISTICS,
@@ -38,6 +40,7 @@ __all__ = [
     "ConvergenceError",
     "CurvePoints",
     "FrahmTop",
+    "HyperellipticCurve",
     "from_kotter",
     "from_matrix",
     "kotter",
@@ -53,6 +56,7 @@ __all__ = [
     "problem",
     "Problem",
     "problem_names",
+    "Solution",
     "theta",
     "theta_all",
     "theta_jet",

@@ -34,6 +34,7 @@ from .reduction import Kotter
 from .reduction import LevelSet as _LevelSet
 from .reduction import from_kotter as _from_kotter
 from .reduction import kotter as _kotter
+from .solution import Solution
 
 __all__ = [
     "FrahmTop",
@@ -894,6 +895,27 @@ class ManakovTop(FrahmTop):
             f" (c{i + 1}{j + 1} = {self._c[i, j]:.3g} = (b{i + 1} - b{j + 1}) / "
             f"(a{i + 1} - a{j + 1}) with a{i + 1} - a{j + 1} = {gap:.3g}: nearly equal a_i)"
         )
+
+    def solve(self, l0: Any) -> Solution:
+        """The explicit solution (9)–(10) through ``l0``: ``l(t)`` as theta quotients.
+
+        Parameters
+        ----------
+        l0 : array_like, shape (6,)
+
+        Returns
+        -------
+        manakov.solution.Solution
+            ``.l(t)``, ``.u0``, ``.U``, ``.tau``, ``.curve``, ``.characteristics``,
+            ``.constants``, ``.abel(l)``.
+
+        Raises
+        ------
+        ValueError
+            Not an so(4) top, or a singular state (the message names the reason).
+        """
+        self._require_so4("solve")
+        return Solution(self.a, self.b, l0)
 
     def _require_so4(self, what: str) -> None:
         if self.n != 4:

@@ -11,7 +11,9 @@ mod arrays;
 mod curve;
 mod errors;
 mod kotter;
+mod riemann;
 mod so4;
+mod solution;
 mod theta;
 
 #[pymodule]
@@ -28,6 +30,8 @@ mod _core {
         theta::register(m)?;
         kotter::register(m)?;
         curve::register(m)?;
+        riemann::register(m)?;
+        solution::register(m)?;
         Ok(())
     }
 }
