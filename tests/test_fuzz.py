@@ -152,8 +152,11 @@ def check_call(
         assert _same(v, before[1][k]), f"{f.__qualname__} modified {k}"
     if finite and out is not None:
         bad = _non_finite(out)
+        owner = getattr(f, "__self__", None)
+        on = f"\n  on {owner!r}" if owner is not None else ""
         assert bad is None, (
-            f"{f.__qualname__} returned NaN/inf at {bad}\n  args = {args!r}\n  kwargs = {kwargs!r}"
+            f"{f.__qualname__} returned NaN/inf at {bad}{on}\n  args = {args!r}\n"
+            f"  kwargs = {kwargs!r}"
         )
     return out
 
