@@ -488,13 +488,7 @@ def _small_run(data: st.DataObject) -> tuple[Any, np.ndarray, dict[str, Any]]:
 def prop_integrate(data: st.DataObject) -> None:
     top, l0, kw = _small_run(data)
     t_end = kw.pop("t_end")
-    tr = check_call(top.integrate, l0, t_end, **kw)
-    if tr is not None:
-        if "t_eval" in kw:
-            # fuzz item 6 of issue 11 (branch 'batch'): Trajectory.t was the caller's array
-            assert tr.t is not kw["t_eval"] or not tr.t.flags.writeable, (
-                "integrate returned the caller's t_eval array itself as Trajectory.t"
-            )
+    check_call(top.integrate, l0, t_end, **kw)
 
 
 def prop_integrate_many(data: st.DataObject) -> None:
@@ -568,6 +562,18 @@ def test_fuzz(prop):
 @pytest.mark.parametrize("prop", PROPERTIES, ids=[p.__name__[5:] for p in PROPERTIES])
 def test_fuzz_slow(prop):
     _run(prop, SLOW_EXAMPLES, derandomize=False)
+
+
+@pytest.mark.xfail(
+    strict=True,
+    reason="issue 11 fuzz item 6, fixed on branch 'batch': remove this marker after the merge",
+)
+def test_integrate_does_not_return_the_callers_t_eval():
+    p = PROBLEMS[0]
+    top = manakov.ManakovTop(p.a, p.b)
+    t_eval = np.array([0.0, 0.5, 1.0])
+    tr = top.integrate(p.l0, 1.0, t_eval=t_eval)
+    assert tr.t is not t_eval and not np.shares_memory(tr.t, t_eval)
 
 
 def test_the_checker_catches_panics_nan_and_mutation():
