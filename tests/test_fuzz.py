@@ -152,8 +152,11 @@ def check_call(
         assert _same(v, before[1][k]), f"{f.__qualname__} modified {k}"
     if finite and out is not None:
         bad = _non_finite(out)
+        owner = getattr(f, "__self__", None)
+        on = f"\n  on {owner!r}" if owner is not None else ""
         assert bad is None, (
-            f"{f.__qualname__} returned NaN/inf at {bad}\n  args = {args!r}\n  kwargs = {kwargs!r}"
+            f"{f.__qualname__} returned NaN/inf at {bad}{on}\n  args = {args!r}\n"
+            f"  kwargs = {kwargs!r}"
         )
     return out
 
@@ -485,11 +488,7 @@ def _small_run(data: st.DataObject) -> tuple[Any, np.ndarray, dict[str, Any]]:
 def prop_integrate(data: st.DataObject) -> None:
     top, l0, kw = _small_run(data)
     t_end = kw.pop("t_end")
-    tr = check_call(top.integrate, l0, t_end, **kw)
-    if tr is not None:
-        assert _non_finite(tr.l) is None and _non_finite(tr.t) is None
-        if "t_eval" in kw:
-            assert tr.t is not kw["t_eval"] or not tr.t.flags.writeable
+    check_call(top.integrate, l0, t_end, **kw)
 
 
 def prop_integrate_many(data: st.DataObject) -> None:
@@ -563,6 +562,18 @@ def test_fuzz(prop):
 @pytest.mark.parametrize("prop", PROPERTIES, ids=[p.__name__[5:] for p in PROPERTIES])
 def test_fuzz_slow(prop):
     _run(prop, SLOW_EXAMPLES, derandomize=False)
+
+
+@pytest.mark.xfail(
+    strict=True,
+    reason="issue 11 fuzz item 6, fixed on branch 'batch': remove this marker after the merge",
+)
+def test_integrate_does_not_return_the_callers_t_eval():
+    p = PROBLEMS[0]
+    top = manakov.ManakovTop(p.a, p.b)
+    t_eval = np.array([0.0, 0.5, 1.0])
+    tr = top.integrate(p.l0, 1.0, t_eval=t_eval)
+    assert tr.t is not t_eval and not np.shares_memory(tr.t, t_eval)
 
 
 def test_the_checker_catches_panics_nan_and_mutation():
