@@ -305,7 +305,8 @@ class HyperellipticCurve:
         ``v = u + K``, then Newton on the Abel map.
         """
         ua = _c(u, "u")
-        if ua.ndim == 0 or ua.shape[-1] != 2:
-            raise ValueError(f"u must have shape (..., 2), got {ua.shape}")
-        x, y = self._core.invert(np.ascontiguousarray(ua.reshape(-1, 2)))
+        g = self.genus
+        if ua.ndim == 0 or ua.shape[-1] != g:
+            raise ValueError(f"u must have shape (..., {g}), got {ua.shape}")
+        x, y = self._core.invert(np.ascontiguousarray(ua.reshape(-1, g)))
         return x.reshape(ua.shape), y.reshape(ua.shape)
