@@ -213,3 +213,71 @@ fn debug_timing2() {
     }
     println!("17 nodes {:?} {acc}", t.elapsed() / 1000);
 }
+
+#[test]
+#[ignore]
+fn debug_invert_timing() {
+    let mut rng = Rng(0x9e37_79b9_7f4a_7c15);
+    let e: Vec<C> = (0..5).map(|_| rng.c(2.0)).collect();
+    let h = HyperellipticCurve::new(&e).unwrap();
+    let d = h.derived().unwrap();
+    let z = vec![c(0.1, 0.2), c(0.3, -0.1)];
+    let t = std::time::Instant::now();
+    for _ in 0..1000 {
+        std::hint::black_box(d.plan.theta_all(&z).unwrap());
+    }
+    println!("theta_all {:?}", t.elapsed() / 1000);
+    let t = std::time::Instant::now();
+    for _ in 0..100 {
+        std::hint::black_box(HyperellipticCurve::new(&e).unwrap().derived().unwrap());
+    }
+    println!("new+derived {:?}", t.elapsed() / 100);
+    let t = std::time::Instant::now();
+    for _ in 0..100 {
+        std::hint::black_box(ThetaPlan::new(&h.tau_flat, 2, THETA_TOL, 0).unwrap());
+    }
+    println!("plan {:?}", t.elapsed() / 100);
+}
+
+#[test]
+#[ignore]
+fn debug_invert_iters() {
+    let mut rng = Rng(0x9e37_79b9_7f4a_7c15);
+    let e: Vec<C> = (0..5).map(|_| rng.c(2.0)).collect();
+    let h = HyperellipticCurve::new(&e).unwrap();
+    for _ in 0..5 {
+        let (x1, x2) = (rng.c(3.0), rng.c(3.0));
+        let u1 = h.abel(x1, h.y(x1, 1)).unwrap();
+        let u2 = h.abel(x2, h.y(x2, -1)).unwrap();
+        let u: Vec<C> = (0..2).map(|i| u1[i] + u2[i]).collect();
+        let t = std::time::Instant::now();
+        for _ in 0..100 {
+            std::hint::black_box(h.invert(&u).unwrap());
+        }
+        let t1 = t.elapsed() / 100;
+        let t = std::time::Instant::now();
+        for _ in 0..100 {
+            std::hint::black_box(h.abel(x1, h.y(x1, 1)).unwrap());
+        }
+        println!("invert {t1:?} abel {:?}", t.elapsed() / 100);
+    }
+}
+
+#[test]
+#[ignore]
+fn debug_invert_outlier() {
+    let mut rng = Rng(0x9e37_79b9_7f4a_7c15);
+    let e: Vec<C> = (0..5).map(|_| rng.c(2.0)).collect();
+    let h = HyperellipticCurve::new(&e).unwrap();
+    println!("e = {e:?}");
+    for _ in 0..2 {
+        let (x1, x2) = (rng.c(3.0), rng.c(3.0));
+        let t = std::time::Instant::now();
+        for _ in 0..100 {
+            std::hint::black_box(h.abel(x2, h.y(x2, -1)).unwrap());
+        }
+        println!("x1 {x1} x2 {x2} abel(x2) {:?}", t.elapsed() / 100);
+        let k = (0..5).max_by(|&a, &b| h.route_quality(Route::Branch(a), x2).total_cmp(&h.route_quality(Route::Branch(b), x2))).unwrap();
+        println!("best branch {k} q {} inf q {}", h.route_quality(Route::Branch(k), x2), h.route_quality(Route::Infinity, x2));
+    }
+}
