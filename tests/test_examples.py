@@ -16,6 +16,7 @@ CLAIMS = {
     "long_run.py": (["1e4"], r"drift of\s+H0: ([0-9.e+-]+)", 1e-13),
     "kotter_along_trajectory.py": (["generic"], r"round trip .*: ([0-9.e+-]+)", 1e-12),
     "theta_identities.py": ([], r"relative error: ([0-9.e+-]+)", 1e-13),
+    "riemann_basis.py": (["--no-plot"], r"tau asymmetry \(relative\): ([0-9.e+-]+)", 1e-14),
 }
 
 
