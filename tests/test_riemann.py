@@ -546,6 +546,17 @@ def test_bad_points_and_u():
         h.invert(np.array([np.nan, 0.0]))
     with pytest.raises(ValueError, match="sheet"):
         h.y(0.5, sheet=2)
+    # Large |x|: fine while y ~ x^(5/2) is a finite double, then a ValueError.
+    big = 1e100 * (0.6 + 0.8j)
+    th = manakov.theta_all(h.abel(big, h.y(big)) + h.riemann_constant, h.tau)
+    assert abs(th[0]) <= THETA_DIVISOR_RTOL * np.max(np.abs(th))
+    with pytest.raises(ValueError, match="finite"):
+        h.abel(1e200, h.y(1e200))
+    with pytest.raises(ValueError, match="branch point"):
+        h.abel(h.branch_points[1], 1.0)
+    # At a branch point, y = 0 is the point; its image is the stated half period.
+    u = h.abel(h.branch_points[1], 0.0)
+    assert np.max(np.abs(h.reduce(u - h.branch_half_periods[1]))) <= HALF_PERIOD_ATOL
     h3 = HyperellipticCurve(np.arange(7.0) + 0.5j * np.arange(7.0) ** 2)
     with pytest.raises(ValueError, match="genus 2"):
         h3.invert(np.zeros(3))

@@ -662,7 +662,11 @@ impl HyperellipticCurve {
         DMatrix::from_fn(g, 2 * g, |i, j| self.edge_periods[self.cycle_edges[j]][i])
     }
 
-    /// Checks that `(x, y)` lies on the curve to [`ON_CURVE_RTOL`].
+    /// Checks that `(x, y)` lies on the curve to [`ON_CURVE_RTOL`]:
+    /// `|y² − R(x)| ≤ ON_CURVE_RTOL · Π_k (|x| + |e_k|)`, evaluated divided by
+    /// `|R(x)|` as `|q² − 1| ≤ ON_CURVE_RTOL · Π_k (|x| + |e_k|)/|x − e_k|` with
+    /// `q = y / Π_k √(x − e_k)` (factor by factor, so nothing overflows before
+    /// `y` itself does).
     pub fn check_point(&self, x: C, y: C) -> Result<()> {
         if !is_finite_c(x) || !is_finite_c(y) {
             return Err(Error::InvalidArgument {
@@ -670,15 +674,35 @@ impl HyperellipticCurve {
                 reason: format!("x = {x}, y = {y} must be finite"),
             });
         }
-        let scale: f64 = self.e.iter().map(|ek| x.norm() + ek.norm()).product();
-        let dev = (y * y - self.r(x)).norm();
-        if dev.is_nan() || dev > ON_CURVE_RTOL * scale {
+        if let Some(k) = self.e.iter().position(|&ek| x == ek) {
+            let scale: f64 = self.e.iter().map(|ek| x.norm() + ek.norm()).product();
+            if y.norm() > (ON_CURVE_RTOL * scale).sqrt() {
+                return Err(Error::InvalidArgument {
+                    what: "point",
+                    reason: format!("x = e[{k}] is a branch point: y must be 0, got {y}"),
+                });
+            }
+            return Ok(());
+        }
+        let mut q = y;
+        let mut bound = ON_CURVE_RTOL;
+        for &ek in &self.e {
+            q /= sqrt_principal(x - ek);
+            bound *= (x.norm() + ek.norm()) / (x - ek).norm();
+        }
+        let dev = (q * q - 1.0).norm();
+        if !is_finite_c(q) {
+            return Err(Error::InvalidArgument {
+                what: "point",
+                reason: format!("x = {x}: |x| is too large for y = R(x)^(1/2) in double precision"),
+            });
+        }
+        if dev > bound {
             return Err(Error::InvalidArgument {
                 what: "point",
                 reason: format!(
-                    "(x, y) = ({x}, {y}) is not on the curve: |y² − R(x)| = {dev:e} > \
-                     {ON_CURVE_RTOL:e} · Π(|x| + |e_k|) = {:e}",
-                    ON_CURVE_RTOL * scale
+                    "(x, y) = ({x}, {y}) is not on the curve: |y² − R(x)| / |R(x)| = {dev:e} > \
+                     {ON_CURVE_RTOL:e} · Π(|x| + |e_k|)/|R(x)| = {bound:e}"
                 ),
             });
         }

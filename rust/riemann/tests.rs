@@ -277,7 +277,16 @@ fn debug_invert_outlier() {
             std::hint::black_box(h.abel(x2, h.y(x2, -1)).unwrap());
         }
         println!("x1 {x1} x2 {x2} abel(x2) {:?}", t.elapsed() / 100);
-        let k = (0..5).max_by(|&a, &b| h.route_quality(Route::Branch(a), x2).total_cmp(&h.route_quality(Route::Branch(b), x2))).unwrap();
-        println!("best branch {k} q {} inf q {}", h.route_quality(Route::Branch(k), x2), h.route_quality(Route::Infinity, x2));
+        let k = (0..5)
+            .max_by(|&a, &b| {
+                h.route_quality(Route::Branch(a), x2)
+                    .total_cmp(&h.route_quality(Route::Branch(b), x2))
+            })
+            .unwrap();
+        println!(
+            "best branch {k} q {} inf q {}",
+            h.route_quality(Route::Branch(k), x2),
+            h.route_quality(Route::Infinity, x2)
+        );
     }
 }
