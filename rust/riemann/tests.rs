@@ -290,3 +290,52 @@ fn debug_invert_outlier() {
         );
     }
 }
+
+#[test]
+#[ignore]
+fn debug_bench_points() {
+    struct R2(u64);
+    impl R2 {
+        fn uniform(&mut self, lo: f64, hi: f64) -> f64 {
+            self.0 ^= self.0 >> 12;
+            self.0 ^= self.0 << 25;
+            self.0 ^= self.0 >> 27;
+            let u = (self.0.wrapping_mul(0x2545_f491_4f6c_dd1d) >> 11) as f64 / (1u64 << 53) as f64;
+            lo + (hi - lo) * u
+        }
+        fn c(&mut self, lo: f64, hi: f64) -> C {
+            C::new(self.uniform(lo, hi), self.uniform(lo, hi))
+        }
+    }
+    let mut rng = R2(0x9e37_79b9_7f4a_7c15);
+    let curves5: Vec<Vec<C>> = (0..20).map(|_| (0..5).map(|_| rng.c(-2.0, 2.0)).collect()).collect();
+    let _c6: Vec<Vec<C>> = (0..20).map(|_| (0..6).map(|_| rng.c(-2.0, 2.0)).collect()).collect();
+    let h = HyperellipticCurve::new(&curves5[0]).unwrap();
+    println!("e = {:?}", curves5[0]);
+    let mut hist = std::collections::BTreeMap::new();
+    let mut slow = vec![];
+    for _ in 0..1000 {
+        let x = rng.c(-3.0, 3.0);
+        let y = h.y(x, 1);
+        let t = std::time::Instant::now();
+        for _ in 0..20 {
+            std::hint::black_box(h.abel(x, y).unwrap());
+        }
+        let dt = t.elapsed().as_nanos() / 20;
+        *hist.entry(dt / 1000).or_insert(0) += 1;
+        if dt > 5000 {
+            let mut best = (Route::Infinity, h.route_quality(Route::Infinity, x));
+            for k in 0..5 {
+                let q = h.route_quality(Route::Branch(k), x);
+                if q > best.1 {
+                    best = (Route::Branch(k), q);
+                }
+            }
+            slow.push((x, dt, best.0, best.1.acosh()));
+        }
+    }
+    println!("{hist:?}");
+    for s in slow.iter().take(10) {
+        println!("{s:?}");
+    }
+}
