@@ -474,18 +474,24 @@ impl HyperellipticCurve {
             return Ok(out);
         }
         let q = sqrt_principal(dx);
-        let mut sing: Vec<C> = Vec::with_capacity(2 * self.e.len());
-        let mut segs: Vec<(C, SegmentSqrt)> = Vec::with_capacity(self.e.len());
+        // Stack buffers (n ≤ 2 MAX_GENUS + 2): this is the per-point hot path.
+        let one = C::new(1.0, 0.0);
+        let mut sing_buf = [one; 4 * MAX_GENUS + 4];
+        let mut seg_buf = [(one, SegmentSqrt::new(one, one)); 2 * MAX_GENUS + 2];
+        let mut ns = 0;
         for (m, &em) in self.e.iter().enumerate() {
             if m == k {
                 continue;
             }
             let a = ek - em;
-            segs.push((a, SegmentSqrt::new(a, dx)));
+            seg_buf[ns] = (a, SegmentSqrt::new(a, dx));
             let s = sqrt_principal(-a / dx);
-            sing.push(s);
-            sing.push(-s);
+            sing_buf[2 * ns] = s;
+            sing_buf[2 * ns + 1] = -s;
+            ns += 1;
         }
+        let segs = &seg_buf[..ns];
+        let sing = &sing_buf[..2 * ns];
         let unrot: C = segs.iter().map(|(_, s)| s.unrot()).product();
         let y1 = q * unrot * segs.iter().map(|(a, s)| s.rotated(a + dx)).product::<C>();
         let sign = if (y * y1.conj()).re < 0.0 { -1.0 } else { 1.0 };
@@ -511,7 +517,7 @@ impl HyperellipticCurve {
             quad::integrate_even(nn as usize, &mut out, integrand);
         } else {
             let mut pieces: Vec<Piece> = Vec::new();
-            quad::plan_pieces(&sing, &mut pieces)?;
+            quad::plan_pieces(sing, &mut pieces)?;
             quad::integrate(&pieces, &mut out, integrand);
         }
         let fac = 2.0 * sign * q / unrot;
@@ -585,6 +591,9 @@ impl HyperellipticCurve {
         Ok((out, lam))
     }
 }
+
+/// Branch points tried as the start of an Abel path (the nearest ones).
+const ROUTE_CANDIDATES: usize = 3;
 
 /// Rows at least this long are split over rayon's pool in [`HyperellipticCurve::abel_batch`]
 /// (~1 ms of work, well above the pool's wake-up cost).
@@ -748,14 +757,32 @@ impl HyperellipticCurve {
 
     /// `∫_{P0}^{(x, y)} ω`, unnormalised, along the best route (no point check).
     fn abel_unnormalised(&self, x: C, y: C) -> Result<Vec<C>> {
-        let mut best = (Route::Infinity, self.route_quality(Route::Infinity, x));
-        for k in 0..self.e.len() {
-            if x == self.e[k] {
-                return Ok(self.u_branch[k].clone());
+        if let Some(k) = self.e.iter().position(|&ek| ek == x) {
+            return Ok(self.u_branch[k].clone());
+        }
+        // Candidates: the ray from ∞ and the segments from the ROUTE_CANDIDATES
+        // nearest branch points (a far start is never better: its segment
+        // passes the nearer ones). Any route is exact to the target; the
+        // choice only sets the node count.
+        let mut near = [(f64::INFINITY, 0usize); ROUTE_CANDIDATES];
+        for (k, &ek) in self.e.iter().enumerate() {
+            let d = (x - ek).norm_sqr();
+            if d < near[ROUTE_CANDIDATES - 1].0 {
+                let mut i = ROUTE_CANDIDATES - 1;
+                while i > 0 && near[i - 1].0 > d {
+                    near[i] = near[i - 1];
+                    i -= 1;
+                }
+                near[i] = (d, k);
             }
-            let q = self.route_quality(Route::Branch(k), x);
-            if q > best.1 {
-                best = (Route::Branch(k), q);
+        }
+        let mut best = (Route::Infinity, self.route_quality(Route::Infinity, x));
+        for &(d, k) in &near {
+            if d.is_finite() {
+                let q = self.route_quality(Route::Branch(k), x);
+                if q > best.1 {
+                    best = (Route::Branch(k), q);
+                }
             }
         }
         match best.0 {
