@@ -106,7 +106,7 @@ const INVERT_MAX_ITER: usize = 40;
 
 /// A hyperelliptic curve `y² = Π (x − e_k)` with its canonical homology basis,
 /// periods and Abel map (module docs for the conventions).
-#[derive(Debug)]
+#[derive(Debug, Clone)]
 pub struct HyperellipticCurve {
     e: Vec<C>,
     g: usize,
@@ -131,7 +131,7 @@ pub struct HyperellipticCurve {
 }
 
 /// Theta plan, Riemann constant and inversion calibration (built on first use).
-#[derive(Debug)]
+#[derive(Debug, Clone)]
 struct Derived {
     plan: ThetaPlan,
     k_char: (Vec<u8>, Vec<u8>),
