@@ -22,6 +22,7 @@ CLAIMS = {
         r"\[0, 100\]: ([0-9.e+-]+)",
         1e-11,
     ),
+    "riemann_basis.py": (["--no-plot"], r"tau asymmetry \(relative\): ([0-9.e+-]+)", 1e-14),
 }
 
 

@@ -276,7 +276,7 @@ class HyperellipticCurve:
 
     # -- Jacobi inversion ------------------------------------------------------------
     def invert(self, u: Any) -> tuple[np.ndarray, np.ndarray]:
-        """Jacobi inversion (``g = 2``, ``n = 5``): the divisor ``P1 + P2`` with
+        """Jacobi inversion (``g = 2``, ``n = 5`` or ``6``): the divisor ``P1 + P2`` with
         ``u(P1) + u(P2) = u`` modulo the lattice.
 
         Parameters
@@ -291,10 +291,9 @@ class HyperellipticCurve:
         Raises
         ------
         ValueError
-            ``u`` on the theta divisor (``theta(u + K) = 0``: the divisor is
-            special, containing ``infinity`` or a pair ``P + iota P``, and is not
-            unique), a curve other than genus 2 with five finite branch points,
-            wrong shape, NaN.
+            ``u`` on the theta divisor (``theta(u + K) = 0``: the divisor
+            contains a pair ``P + iota P``, and is not unique, or the base point),
+            a curve of genus other than 2, wrong shape, NaN.
         manakov.ConvergenceError
             Newton on the Abel map did not converge.
 
@@ -302,10 +301,13 @@ class HyperellipticCurve:
         -----
         Start from the theta quotients (34):
         ``(x1 - e_j)(x2 - e_j) = c_j theta[eta(e_j)](v)**2 / theta(v)**2``,
-        ``v = u + K``, then Newton on the Abel map.
+        ``v = u + K`` (``n = 5``; for ``n = 6`` the quotients
+        ``(x1 - e_j)(x2 - e_j)/((x1 - e_1)(x2 - e_1))`` with characteristics found
+        numerically), then Newton on the Abel map.
         """
         ua = _c(u, "u")
-        if ua.ndim == 0 or ua.shape[-1] != 2:
-            raise ValueError(f"u must have shape (..., 2), got {ua.shape}")
-        x, y = self._core.invert(np.ascontiguousarray(ua.reshape(-1, 2)))
+        g = self.genus
+        if ua.ndim == 0 or ua.shape[-1] != g:
+            raise ValueError(f"u must have shape (..., {g}), got {ua.shape}")
+        x, y = self._core.invert(np.ascontiguousarray(ua.reshape(-1, g)))
         return x.reshape(ua.shape), y.reshape(ua.shape)

@@ -215,8 +215,9 @@ impl HyperellipticCore {
         u: PyReadonlyArray2<'py, C>,
     ) -> PyResult<(Bound<'py, PyArray2<C>>, Bound<'py, PyArray2<C>>)> {
         let v = u.as_array();
-        if v.ncols() != 2 {
-            return Err(shape_err("u", "(N, 2)", v.shape()));
+        let g = self.curve.genus();
+        if v.ncols() != g {
+            return Err(shape_err("u", format!("(N, {g})"), v.shape()));
         }
         let flat: Vec<C> = v.iter().copied().collect();
         let n = v.nrows();
@@ -224,7 +225,7 @@ impl HyperellipticCore {
         let (xs, ys) = py.detach(|| -> Result<(Vec<C>, Vec<C>), Error> {
             let mut xs = Vec::with_capacity(2 * n);
             let mut ys = Vec::with_capacity(2 * n);
-            for (i, row) in flat.chunks(2).enumerate() {
+            for (i, row) in flat.chunks(g).enumerate() {
                 if i % 256 == 0 {
                     cancel.check()?;
                 }

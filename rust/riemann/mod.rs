@@ -106,7 +106,7 @@ const INVERT_MAX_ITER: usize = 40;
 
 /// A hyperelliptic curve `y² = Π (x − e_k)` with its canonical homology basis,
 /// periods and Abel map (module docs for the conventions).
-#[derive(Debug)]
+#[derive(Debug, Clone)]
 pub struct HyperellipticCurve {
     e: Vec<C>,
     g: usize,
@@ -131,14 +131,17 @@ pub struct HyperellipticCurve {
 }
 
 /// Theta plan, Riemann constant and inversion calibration (built on first use).
-#[derive(Debug)]
+#[derive(Debug, Clone)]
 struct Derived {
     plan: ThetaPlan,
     k_char: (Vec<u8>, Vec<u8>),
     k: Vec<C>,
-    /// For the inversion start (g = 2, odd n): `c_j² = (x1−e_j)(x2−e_j) θ(v)²/θ[η_j](v)²`
-    /// and the index of `η_j`, for every branch point `j`.
-    calib: Vec<(C, usize)>,
+    /// For the inversion start (g = 2): `(c_j, num, den)` with
+    /// `f_j(D) = c_j (θ[num](v)/θ[den](v))²`, `v = u(D) + K`, where
+    /// `f_j = (x1−e_j)(x2−e_j)` for odd `n` (then `num = η(e_j)`, `den = 0`, (34))
+    /// and `f_j = (x1−e_j)(x2−e_j)/((x1−e_1)(x2−e_1))`, `j ≥ 1`, for even `n`
+    /// (characteristics found numerically). `None` where none was found.
+    calib: Vec<Option<(C, usize, usize)>>,
 }
 
 fn is_finite_c(v: C) -> bool {
@@ -471,18 +474,24 @@ impl HyperellipticCurve {
             return Ok(out);
         }
         let q = sqrt_principal(dx);
-        let mut sing: Vec<C> = Vec::with_capacity(2 * self.e.len());
-        let mut segs: Vec<(C, SegmentSqrt)> = Vec::with_capacity(self.e.len());
+        // Stack buffers (n ≤ 2 MAX_GENUS + 2): this is the per-point hot path.
+        let one = C::new(1.0, 0.0);
+        let mut sing_buf = [one; 4 * MAX_GENUS + 4];
+        let mut seg_buf = [(one, SegmentSqrt::new(one, one)); 2 * MAX_GENUS + 2];
+        let mut ns = 0;
         for (m, &em) in self.e.iter().enumerate() {
             if m == k {
                 continue;
             }
             let a = ek - em;
-            segs.push((a, SegmentSqrt::new(a, dx)));
+            seg_buf[ns] = (a, SegmentSqrt::new(a, dx));
             let s = sqrt_principal(-a / dx);
-            sing.push(s);
-            sing.push(-s);
+            sing_buf[2 * ns] = s;
+            sing_buf[2 * ns + 1] = -s;
+            ns += 1;
         }
+        let segs = &seg_buf[..ns];
+        let sing = &sing_buf[..2 * ns];
         let unrot: C = segs.iter().map(|(_, s)| s.unrot()).product();
         let y1 = q * unrot * segs.iter().map(|(a, s)| s.rotated(a + dx)).product::<C>();
         let sign = if (y * y1.conj()).re < 0.0 { -1.0 } else { 1.0 };
@@ -508,7 +517,7 @@ impl HyperellipticCurve {
             quad::integrate_even(nn as usize, &mut out, integrand);
         } else {
             let mut pieces: Vec<Piece> = Vec::new();
-            quad::plan_pieces(&sing, &mut pieces)?;
+            quad::plan_pieces(sing, &mut pieces)?;
             quad::integrate(&pieces, &mut out, integrand);
         }
         let fac = 2.0 * sign * q / unrot;
@@ -582,6 +591,9 @@ impl HyperellipticCurve {
         Ok((out, lam))
     }
 }
+
+/// Branch points tried as the start of an Abel path (the nearest ones).
+const ROUTE_CANDIDATES: usize = 3;
 
 /// Rows at least this long are split over rayon's pool in [`HyperellipticCurve::abel_batch`]
 /// (~1 ms of work, well above the pool's wake-up cost).
@@ -662,7 +674,11 @@ impl HyperellipticCurve {
         DMatrix::from_fn(g, 2 * g, |i, j| self.edge_periods[self.cycle_edges[j]][i])
     }
 
-    /// Checks that `(x, y)` lies on the curve to [`ON_CURVE_RTOL`].
+    /// Checks that `(x, y)` lies on the curve to [`ON_CURVE_RTOL`]:
+    /// `|y² − R(x)| ≤ ON_CURVE_RTOL · Π_k (|x| + |e_k|)`, evaluated divided by
+    /// `|R(x)|` as `|q² − 1| ≤ ON_CURVE_RTOL · Π_k (|x| + |e_k|)/|x − e_k|` with
+    /// `q = y / Π_k √(x − e_k)` (factor by factor, so nothing overflows before
+    /// `y` itself does).
     pub fn check_point(&self, x: C, y: C) -> Result<()> {
         if !is_finite_c(x) || !is_finite_c(y) {
             return Err(Error::InvalidArgument {
@@ -670,15 +686,35 @@ impl HyperellipticCurve {
                 reason: format!("x = {x}, y = {y} must be finite"),
             });
         }
-        let scale: f64 = self.e.iter().map(|ek| x.norm() + ek.norm()).product();
-        let dev = (y * y - self.r(x)).norm();
-        if dev.is_nan() || dev > ON_CURVE_RTOL * scale {
+        if let Some(k) = self.e.iter().position(|&ek| x == ek) {
+            let scale: f64 = self.e.iter().map(|ek| x.norm() + ek.norm()).product();
+            if y.norm() > (ON_CURVE_RTOL * scale).sqrt() {
+                return Err(Error::InvalidArgument {
+                    what: "point",
+                    reason: format!("x = e[{k}] is a branch point: y must be 0, got {y}"),
+                });
+            }
+            return Ok(());
+        }
+        let mut q = y;
+        let mut bound = ON_CURVE_RTOL;
+        for &ek in &self.e {
+            q /= sqrt_principal(x - ek);
+            bound *= (x.norm() + ek.norm()) / (x - ek).norm();
+        }
+        let dev = (q * q - 1.0).norm();
+        if !is_finite_c(q) {
+            return Err(Error::InvalidArgument {
+                what: "point",
+                reason: format!("x = {x}: |x| is too large for y = R(x)^(1/2) in double precision"),
+            });
+        }
+        if dev > bound {
             return Err(Error::InvalidArgument {
                 what: "point",
                 reason: format!(
-                    "(x, y) = ({x}, {y}) is not on the curve: |y² − R(x)| = {dev:e} > \
-                     {ON_CURVE_RTOL:e} · Π(|x| + |e_k|) = {:e}",
-                    ON_CURVE_RTOL * scale
+                    "(x, y) = ({x}, {y}) is not on the curve: |y² − R(x)| / |R(x)| = {dev:e} > \
+                     {ON_CURVE_RTOL:e} · Π(|x| + |e_k|)/|R(x)| = {bound:e}"
                 ),
             });
         }
@@ -721,14 +757,32 @@ impl HyperellipticCurve {
 
     /// `∫_{P0}^{(x, y)} ω`, unnormalised, along the best route (no point check).
     fn abel_unnormalised(&self, x: C, y: C) -> Result<Vec<C>> {
-        let mut best = (Route::Infinity, self.route_quality(Route::Infinity, x));
-        for k in 0..self.e.len() {
-            if x == self.e[k] {
-                return Ok(self.u_branch[k].clone());
+        if let Some(k) = self.e.iter().position(|&ek| ek == x) {
+            return Ok(self.u_branch[k].clone());
+        }
+        // Candidates: the ray from ∞ and the segments from the ROUTE_CANDIDATES
+        // nearest branch points (a far start is never better: its segment
+        // passes the nearer ones). Any route is exact to the target; the
+        // choice only sets the node count.
+        let mut near = [(f64::INFINITY, 0usize); ROUTE_CANDIDATES];
+        for (k, &ek) in self.e.iter().enumerate() {
+            let d = (x - ek).norm_sqr();
+            if d < near[ROUTE_CANDIDATES - 1].0 {
+                let mut i = ROUTE_CANDIDATES - 1;
+                while i > 0 && near[i - 1].0 > d {
+                    near[i] = near[i - 1];
+                    i -= 1;
+                }
+                near[i] = (d, k);
             }
-            let q = self.route_quality(Route::Branch(k), x);
-            if q > best.1 {
-                best = (Route::Branch(k), q);
+        }
+        let mut best = (Route::Infinity, self.route_quality(Route::Infinity, x));
+        for &(d, k) in &near {
+            if d.is_finite() {
+                let q = self.route_quality(Route::Branch(k), x);
+                if q > best.1 {
+                    best = (Route::Branch(k), q);
+                }
             }
         }
         match best.0 {
@@ -978,8 +1032,14 @@ impl HyperellipticCurve {
                 let (a, b) = self.try_branch_char(j)?;
                 let idx = crate::theta::char_index(&a, &b)?;
                 let ratio = vals[0] / vals[idx];
-                calib.push(((x1 - self.e[j]) * (x2 - self.e[j]) * ratio * ratio, idx));
+                calib.push(Some((
+                    (x1 - self.e[j]) * (x2 - self.e[j]) * ratio * ratio,
+                    idx,
+                    0,
+                )));
             }
+        } else if g == 2 && self.e.len() == 6 {
+            calib = self.calibrate_even(&plan, &k)?;
         }
         Ok(Derived {
             plan,
@@ -987,6 +1047,59 @@ impl HyperellipticCurve {
             k,
             calib,
         })
+    }
+
+    /// Degree 6: for each `j = 1..5` the pair of characteristics `(num, den)`
+    /// with `(x1−e_j)(x2−e_j)/((x1−e_0)(x2−e_0)) · θ[den](v)²/θ[num](v)²`
+    /// constant (relative [`K_SEARCH_RTOL`]) over four fixed divisors.
+    fn calibrate_even(&self, plan: &ThetaPlan, k: &[C]) -> Result<Vec<Option<(C, usize, usize)>>> {
+        let mut divs = Vec::new();
+        for t in 0..4 {
+            let (x1, y1) = self.test_point(t, 0);
+            let (x2, y2) = self.test_point(t + 1, 1);
+            let u1 = self.normalise(&self.abel_unnormalised(x1, y1)?);
+            let u2 = self.normalise(&self.abel_unnormalised(x2, y2)?);
+            let v: Vec<C> = (0..2).map(|i| u1[i] + u2[i] + k[i]).collect();
+            let (vals, _) = plan.theta_all(&v)?;
+            divs.push((x1, x2, vals));
+        }
+        let e0 = self.e[0];
+        let mut out = vec![None];
+        for j in 1..6 {
+            let ej = self.e[j];
+            let f: Vec<C> = divs
+                .iter()
+                .map(|(x1, x2, _)| (x1 - ej) * (x2 - ej) / ((x1 - e0) * (x2 - e0)))
+                .collect();
+            let mut found = None;
+            'search: for num in 0..16 {
+                for den in 0..16 {
+                    if num == den {
+                        continue;
+                    }
+                    let r: Vec<C> = divs
+                        .iter()
+                        .zip(&f)
+                        .map(|((_, _, vals), fj)| {
+                            let q = vals[den] / vals[num];
+                            fj * q * q
+                        })
+                        .collect();
+                    let r0 = r[0];
+                    if !is_finite_c(r0) || r0.norm() == 0.0 {
+                        continue;
+                    }
+                    if r.iter()
+                        .all(|ri| (ri - r0).norm() <= K_SEARCH_RTOL * r0.norm())
+                    {
+                        found = Some((r0, num, den));
+                        break 'search;
+                    }
+                }
+            }
+            out.push(found);
+        }
+        Ok(out)
     }
 
     /// The vector of Riemann constants `K` for the base point `P0`: the half
@@ -1031,11 +1144,11 @@ impl HyperellipticCurve {
     /// the divisor is special and not unique ([`Error::InvalidArgument`]);
     /// Newton not reaching [`INVERT_MAX_RESIDUAL`] ([`Error::NoConvergence`]).
     pub fn invert(&self, u: &[C]) -> Result<[(C, C); 2]> {
-        if self.g != 2 || self.e.len() != 5 {
+        if self.g != 2 {
             return Err(Error::InvalidArgument {
                 what: "invert",
                 reason: format!(
-                    "implemented for genus 2 with 5 finite branch points, got g = {}, n = {}",
+                    "implemented for genus 2 (5 or 6 finite branch points), got g = {}, n = {}",
                     self.g,
                     self.e.len()
                 ),
@@ -1061,29 +1174,55 @@ impl HyperellipticCurve {
                 what: "u",
                 reason: format!(
                     "u lies on the theta divisor (|θ(u + K)| = {:e} of the largest theta value): \
-                     the divisor is special (contains ∞ or a pair P + ιP), not unique",
+                     the divisor contains a pair P + ιP (not unique) or the base point \
+                     (∞ for odd n, e_1 for even n)",
                     vals[0].norm() / big
                 ),
             });
         }
-        // The two branch points farthest apart give the best-conditioned
-        // linear solve for x1 + x2 and x1 x2.
-        let (mut jb, mut kb, mut dist) = (0, 1, 0.0);
-        for j in 0..5 {
-            for k in (j + 1)..5 {
-                if (self.e[j] - self.e[k]).norm() > dist {
-                    (jb, kb, dist) = (j, k, (self.e[j] - self.e[k]).norm());
+        // Linear equations for s = x1 + x2, p = x1 x2 from the quotients:
+        // odd n:  p − e_j s + e_j² = q_j;
+        // even n: p − e_j s + e_j² = q_j (p − e_0 s + e_0²).
+        // The pair of equations with the largest determinant is used.
+        let e0 = self.e[0];
+        let rows: Vec<(C, C, C)> = d
+            .calib
+            .iter()
+            .enumerate()
+            .filter_map(|(j, cal)| {
+                let (c, num, den) = (*cal)?;
+                let r = vals[num] / vals[den];
+                let q = c * r * r;
+                let ej = self.e[j];
+                let row = if self.e.len() % 2 == 1 {
+                    (C::new(1.0, 0.0), -ej, q - ej * ej)
+                } else {
+                    (1.0 - q, q * e0 - ej, q * e0 * e0 - ej * ej)
+                };
+                (is_finite_c(row.0) && is_finite_c(row.1) && is_finite_c(row.2)).then_some(row)
+            })
+            .collect();
+        let mut best_pair = None;
+        let mut best_det = 0.0;
+        for i in 0..rows.len() {
+            for j in (i + 1)..rows.len() {
+                let (a1, b1, c1) = rows[i];
+                let (a2, b2, c2) = rows[j];
+                let det = a1 * b2 - a2 * b1;
+                let scale = (a1.norm() + b1.norm()) * (a2.norm() + b2.norm());
+                let rel = det.norm() / scale;
+                if rel > best_det {
+                    best_det = rel;
+                    best_pair = Some(((c1 * b2 - c2 * b1) / det, (a1 * c2 - a2 * c1) / det));
                 }
             }
         }
-        let q = |j: usize| {
-            let (c, idx) = d.calib[j];
-            let r = vals[idx] / vals[0];
-            c * r * r
-        };
-        let (ej, ek) = (self.e[jb], self.e[kb]);
-        let s = ej + ek - (q(jb) - q(kb)) / (ej - ek);
-        let p = q(jb) + ej * s - ej * ej;
+        let (p, s) = best_pair.ok_or(Error::NoConvergence {
+            what: "Jacobi inversion start (no usable theta quotients)",
+            tol: INVERT_MAX_RESIDUAL,
+            reached: f64::INFINITY,
+            iterations: 0,
+        })?;
         let disc = sqrt_principal(s * s - 4.0 * p);
         let mut x1 = 0.5 * (s + disc);
         let mut x2 = 0.5 * (s - disc);

@@ -82,8 +82,9 @@ fn abel_path_independence_and_theta_divisor() {
 #[test]
 fn inversion_round_trip() {
     let mut rng = Rng(99);
-    for _ in 0..20 {
-        let e: Vec<C> = (0..5).map(|_| rng.c(2.0)).collect();
+    for it in 0..40 {
+        let n = if it % 2 == 0 { 5 } else { 6 };
+        let e: Vec<C> = (0..n).map(|_| rng.c(2.0)).collect();
         let h = HyperellipticCurve::new(&e).unwrap();
         for _ in 0..5 {
             let (x1, x2) = (rng.c(2.5), rng.c(2.5));
@@ -102,114 +103,90 @@ fn inversion_round_trip() {
 }
 
 #[test]
-#[ignore]
-fn debug_node_counts() {
-    let mut rng = Rng(0x9e37_79b9_7f4a_7c15);
-    let e: Vec<C> = (0..5).map(|_| rng.c(2.0)).collect();
-    let h = HyperellipticCurve::new(&e).unwrap();
-    let mut tot = 0;
-    for _ in 0..100 {
-        let x = rng.c(3.0);
-        let mut best = (Route::Infinity, h.route_quality(Route::Infinity, x));
-        for k in 0..5 {
-            let q = h.route_quality(Route::Branch(k), x);
-            if q > best.1 {
-                best = (Route::Branch(k), q);
-            }
+fn genus1_tau_is_the_lattice_ratio_of_a_real_cubic() {
+    // y² = x(x − 1)(x − λ) with real 0 < 1 < λ: the a-period is real and the
+    // b-period imaginary for the chain basis, so τ is purely imaginary up to
+    // SL(2, Z); check the j-invariant relation through |j| symmetric cases:
+    // λ = 2 is harmonic (j = 1728), so τ is SL(2,Z)-equivalent to i.
+    let h = HyperellipticCurve::new(&[c(0.0, 0.0), c(1.0, 0.0), c(2.0, 0.0)]).unwrap();
+    let mut t = h.tau()[(0, 0)];
+    // Reduce to the fundamental domain.
+    for _ in 0..50 {
+        t -= t.re.round();
+        if t.norm_sqr() < 1.0 - 1e-15 {
+            t = -1.0 / t;
+        } else {
+            break;
         }
-        let mut sing = vec![];
-        match best.0 {
-            Route::Branch(k) => {
-                for m in 0..5 {
-                    if m != k {
-                        let s = sqrt_principal((e[m] - e[k]) / (x - e[k]));
-                        sing.push(s);
-                        sing.push(-s);
-                    }
-                }
-            }
-            Route::Infinity => {
-                for m in 0..5 {
-                    let s = sqrt_principal((x - h.center) / (e[m] - h.center));
-                    sing.push(s);
-                    sing.push(-s);
-                }
-            }
-        }
-        let mut p = vec![];
-        quad::plan_pieces(&sing, &mut p).unwrap();
-        let nn: usize = p.iter().map(|q| quad::gl_rule(q.n).nodes.len()).sum();
-        println!(
-            "{:?} q={:.3} pieces={} nodes={}",
-            best.0,
-            best.1,
-            p.len(),
-            nn
-        );
-        tot += nn;
     }
-    println!("avg {}", tot as f64 / 100.0);
+    assert!((t - c(0.0, 1.0)).norm() < 1e-13, "{t}");
 }
 
 #[test]
-#[ignore]
-fn debug_timing() {
-    let mut rng = Rng(0x9e37_79b9_7f4a_7c15);
-    let e: Vec<C> = (0..5).map(|_| rng.c(2.0)).collect();
-    let h = HyperellipticCurve::new(&e).unwrap();
-    let xs: Vec<C> = (0..1000).map(|_| rng.c(3.0)).collect();
-    let ys: Vec<C> = xs.iter().map(|&x| h.y(x, 1)).collect();
-    let t = std::time::Instant::now();
-    let mut s = 0.0;
-    for &x in &xs {
-        for k in 0..5 {
-            s += h.route_quality(Route::Branch(k), x);
-        }
-    }
-    println!("quality {:?} {s}", t.elapsed() / 1000);
-    let t = std::time::Instant::now();
-    for (&x, &y) in xs.iter().zip(&ys) {
-        s += h.path_from_branch(0, x, y).unwrap()[0].re;
-    }
-    println!("path {:?} {s}", t.elapsed() / 1000);
-    let t = std::time::Instant::now();
-    for (&x, &y) in xs.iter().zip(&ys) {
-        s += h.abel(x, y).unwrap()[0].re;
-    }
-    println!("abel {:?} {s}", t.elapsed() / 1000);
+fn bad_input_is_an_error_not_a_panic() {
+    assert!(matches!(
+        HyperellipticCurve::new(&[c(0.0, 0.0), c(1.0, 0.0)]),
+        Err(Error::Shape { .. })
+    ));
+    assert!(matches!(
+        HyperellipticCurve::new(&[c(0.0, 0.0), c(1.0, 0.0), c(1.0, 0.0)]),
+        Err(Error::RepeatedBranchPoints { .. })
+    ));
+    assert!(matches!(
+        HyperellipticCurve::new(&[c(0.0, 0.0), c(f64::NAN, 0.0), c(1.0, 0.0)]),
+        Err(Error::NonFinite { .. })
+    ));
+    let h = HyperellipticCurve::new(&[
+        c(0.0, 0.0),
+        c(1.0, 0.2),
+        c(-1.0, 0.5),
+        c(0.3, -1.0),
+        c(2.0, 1.0),
+    ])
+    .unwrap();
+    assert!(h.abel(c(0.5, 0.5), c(1.0, 0.0)).is_err());
+    assert!(h.invert(&[c(0.0, 0.0), c(0.0, 0.0)]).is_err());
+    assert!(h.invert(&[c(f64::NAN, 0.0), c(0.0, 0.0)]).is_err());
+    assert!(h.try_branch_char(7).is_err());
+    assert!(h.branch_char(7).0.is_empty());
+    let mut out = vec![c(0.0, 0.0); 3];
+    assert!(h
+        .abel_batch(&[c(0.5, 0.5)], &[h.y(c(0.5, 0.5), 1)], &mut out)
+        .is_err());
 }
 
-#[test]
-#[ignore]
-fn debug_timing2() {
-    let mut rng = Rng(0x9e37_79b9_7f4a_7c15);
-    let e: Vec<C> = (0..5).map(|_| rng.c(2.0)).collect();
-    let xs: Vec<C> = (0..1000).map(|_| rng.c(3.0)).collect();
-    let t = std::time::Instant::now();
-    let mut p = vec![];
-    let mut s = 0.0;
-    for &x in &xs {
-        let sing: Vec<C> = e[1..]
-            .iter()
-            .map(|&em| sqrt_principal((em - e[0]) / (x - e[0])))
-            .collect();
-        quad::plan_pieces(&sing, &mut p).unwrap();
-        s += p.len() as f64;
+mod prop {
+    use super::*;
+    use proptest::prelude::*;
+
+    fn pts(n: usize) -> impl Strategy<Value = Vec<(f64, f64)>> {
+        proptest::collection::vec((-3.0f64..3.0, -3.0f64..3.0), n)
     }
-    println!("plan {:?} {s}", t.elapsed() / 1000);
-    let segs: Vec<SegmentSqrt> = e
-        .iter()
-        .map(|&em| SegmentSqrt::new(em, C::new(1.0, 0.5)))
-        .collect();
-    let t = std::time::Instant::now();
-    let mut acc = C::new(0.0, 0.0);
-    for i in 0..17000 {
-        let v = i as f64 / 17000.0;
-        let prod: C = segs
-            .iter()
-            .map(|sg| sg.rotated(e[1] + C::new(1.0, 0.5) * v))
-            .product();
-        acc += C::new(1.0, 0.0) / prod;
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(48))]
+
+        /// Any distinct complex branch points (genus 2 and 3): τ symmetric
+        /// (raw A⁻¹B) to 1e-13 and θ(u(P) + K) = 0 at a point.
+        #[test]
+        fn siegel_and_theta_divisor(e in prop_oneof![pts(5), pts(6), pts(7)], px in -3.0f64..3.0, py in -3.0f64..3.0) {
+            let e: Vec<C> = e.iter().map(|&(a, b)| c(a, b)).collect();
+            let mind = (0..e.len()).flat_map(|i| (0..i).map(move |j| (i, j)))
+                .map(|(i, j)| (e[i] - e[j]).norm()).fold(f64::INFINITY, f64::min);
+            prop_assume!(mind > 1e-3);
+            let h = HyperellipticCurve::new(&e).unwrap();
+            let (a, b) = h.periods();
+            let raw = a.clone().try_inverse().unwrap() * b;
+            prop_assert!(max_asym(&raw) < 1e-13);
+            if h.genus() == 2 {
+                let x = c(px, py);
+                let u = h.abel(x, h.y(x, -1)).unwrap();
+                let k = h.riemann_constant();
+                let z: Vec<C> = (0..2).map(|i| u[i] + k[i]).collect();
+                let (vals, _) = h.theta_plan().unwrap().theta_all(&z).unwrap();
+                let big = vals.iter().map(|v| v.norm()).fold(0.0, f64::max);
+                prop_assert!(vals[0].norm() <= 1e-13 * big);
+            }
+        }
     }
-    println!("17 nodes {:?} {acc}", t.elapsed() / 1000);
 }
