@@ -251,9 +251,11 @@ def plot_theorem(
     sol = Solution(p.a, p.b, p.l0)
     t = np.linspace(0.0, float(t_end), int(samples))
     c = _core.manakov_c(np.asarray(p.a, float), np.asarray(p.b, float))
-    l_int, _, _ = _core.integrate(
+    l_int, _, _, err = _core.integrate(
         c, np.asarray(p.l0, float), 0.0, t, "gauss16", float(dt), 0.0, 0.0, 10**9
     )
+    if err is not None:
+        raise err
     l_int = np.asarray(l_int).reshape(len(t), 6)
     l_th = sol.l(t)
     diff = np.max(np.abs(l_th - l_int), axis=1) / np.linalg.norm(p.l0)
