@@ -407,6 +407,31 @@ def test_sigint_writes_partial_output_and_exits_130(tmp_path, suffix):
 
 def test_commands_registry_builds_the_parser():
     names = [c.name for c in cli.COMMANDS]
-    assert names == ["simulate", "kotter", "theta"]
+    assert names[:4] == ["simulate", "kotter", "theta", "theorem"]
     for c in cli.COMMANDS:
         assert callable(c.run) and callable(c.add_arguments) and c.example.startswith("manakov ")
+
+
+#: The Theorem's claim on [0, 100] for the shared 'physical' top (issue 10).
+THEOREM_CLI_RTOL = 1e-11
+
+
+def test_theorem_subcommand_writes_png_and_reports_the_error(tmp_path, capsys):
+    png = tmp_path / "th.png"
+    argv = ["theorem", "physical", "-o", str(png), "--t-end", "10", "--samples", "21"]
+    assert cli.main(argv) == 0
+    text = capsys.readouterr().out
+    assert png.exists() and png.stat().st_size > 0
+    err = float(re.search(r"= ([0-9.e+-]+)", text).group(1))
+    # Independent of the CLI's own number: theta solution against a gauss16 run here.
+    p = manakov.problem("physical")
+    top = manakov.ManakovTop(p.a, p.b)
+    t = np.linspace(0.0, 10.0, 21)
+    ref = top.integrate(p.l0, 10.0, t_eval=t, dt=1e-3).l
+    mine = np.max(np.abs(top.solve(p.l0).l(t) - ref)) / np.linalg.norm(p.l0)
+    assert err <= THEOREM_CLI_RTOL and mine <= THEOREM_CLI_RTOL
+
+
+def test_theorem_subcommand_rejects_unknown_problem():
+    r = _run("theorem", "nope")
+    assert r.returncode == 2 and "invalid choice" in r.stderr
