@@ -29,6 +29,7 @@ from .top import (
     poisson_tensor,
     to_matrix,
 )
+from .tori import FrequencyMap, Torus, frequency_map, real_torus
 
 __all__ = [
     "benchmark_setup",
@@ -38,6 +39,8 @@ __all__ = [
     "ConvergenceError",
     "CurvePoints",
     "FrahmTop",
+    "frequency_map",
+    "FrequencyMap",
     "from_kotter",
     "from_matrix",
     "kotter",
@@ -52,10 +55,12 @@ __all__ = [
     "problem",
     "Problem",
     "problem_names",
+    "real_torus",
     "theta",
     "theta_all",
     "theta_jet",
     "to_matrix",
+    "Torus",
     "Trajectory",
     "Wurzel",
     "__version__",

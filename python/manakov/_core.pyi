@@ -26,9 +26,11 @@ __all__ = [
     "manakov_integral_labels",
     "manakov_integrals",
     "poisson_tensor",
+    "real_torus",
     "so4_integrals",
     "theta_jet",
     "theta_plan_info",
+    "tori_status_names",
     "vector_field",
     "__version__",
 ]
@@ -170,3 +172,10 @@ def kotter_from_points(
     branch: npt.NDArray[np.int8],
     zd: npt.NDArray[np.complex128] | None = None,
 ) -> npt.NDArray[np.float64]: ...
+def real_torus(
+    tau: npt.NDArray[np.complex128],
+    u: npt.NDArray[np.complex128],
+    u2: npt.NDArray[np.complex128],
+    chars: npt.NDArray[np.uint8],
+) -> tuple[npt.NDArray[np.complex128], npt.NDArray[np.int64], npt.NDArray[np.float64]]: ...
+def tori_status_names() -> list[str]: ...

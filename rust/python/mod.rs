@@ -13,6 +13,7 @@ mod errors;
 mod kotter;
 mod so4;
 mod theta;
+mod tori;
 
 #[pymodule]
 mod _core {
@@ -28,6 +29,7 @@ mod _core {
         theta::register(m)?;
         kotter::register(m)?;
         curve::register(m)?;
+        tori::register(m)?;
         Ok(())
     }
 }

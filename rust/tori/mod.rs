@@ -233,7 +233,7 @@ pub fn real_torus(
     let e1 = p1.map(|v| v / n1);
     let r2 = reject(&g, &[e1], &p2);
     let sin_angle = g.norm2(&r2).sqrt() / n2;
-    if !(sin_angle > PLANE_TOL) {
+    if sin_angle.is_nan() || sin_angle <= PLANE_TOL {
         return Err(TorusFailure::DegeneratePlane { sin_angle });
     }
     let e2 = r2.map(|v| v / (sin_angle * n2));
@@ -357,7 +357,7 @@ pub fn real_torus(
     let mut nu = [(g22 * r1 - g12 * r2) / gd, (g11 * r2 - g12 * r1) / gd];
     let fit = axpy(-nu[1], &b.1, &axpy(-nu[0], &a.1, &p1));
     let residual = g.norm2(&fit).sqrt() / n1;
-    if !(residual <= RESIDUAL_TOL) {
+    if residual.is_nan() || residual > RESIDUAL_TOL {
         return Err(TorusFailure::NoRealLattice { residual });
     }
     for (k, v) in [&mut a, &mut b].into_iter().enumerate() {

@@ -1,0 +1,98 @@
+"""The real torus of a motion on C²/Λ' (a leaf of the import graph: only ``_core``).
+
+``solution`` (``sol.torus``) and ``tori`` (frequency maps) both build on it; see
+``manakov.tori`` and ``docs/tori.md`` for the mathematics and the basis convention.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any, NamedTuple
+
+import numpy as np
+
+from . import _core
+
+__all__ = ["Torus", "real_torus"]
+
+
+class Torus(NamedTuple):
+    """The real torus of a motion.
+
+    Attributes
+    ----------
+    lambdas : ndarray, complex, shape (2, 2)
+        Rows ``λ1``, ``λ2`` in ``C²``: a reduced basis of ``Λ' ∩ span_R(U, U')``.
+    coords : ndarray, int64, shape (2, 4)
+        Their lattice coordinates ``(m1, m2, n1, n2)``, ``λ = m + τ n``.
+    frequencies : ndarray, shape (2,)
+        ``(ν1, ν2) ≥ 0`` with ``U = ν1 λ1 + ν2 λ2`` (cycles per unit time).
+    """
+
+    lambdas: np.ndarray
+    coords: np.ndarray
+    frequencies: np.ndarray
+
+    @property
+    def rotation_number(self) -> float:
+        """``ν1/ν2`` (``inf`` on the resonance ``ν2 = 0``)."""
+        n1, n2 = (float(v) for v in self.frequencies)
+        return n1 / n2 if n2 != 0.0 else math.inf
+
+    def angles(self, t: Any) -> np.ndarray:
+        """Torus angles ``(ν1 t, ν2 t) mod 1`` measured from the initial point.
+
+        Parameters
+        ----------
+        t : array_like, real
+            Times.
+
+        Returns
+        -------
+        ndarray, shape (..., 2)
+            Angles in ``[0, 1)`` (cycles).
+        """
+        tt = np.asarray(t, dtype=float)[..., None]
+        return np.mod(tt * self.frequencies, 1.0)
+
+
+def real_torus(tau: Any, U: Any, U2: Any, characteristics: Any) -> Torus:
+    """The real torus carrying the motion ``u0 + U t`` modulo the periods of l.
+
+    Parameters
+    ----------
+    tau : array_like, complex, shape (2, 2)
+        The period matrix (``Im τ`` positive definite).
+    U : array_like, complex, shape (2,)
+        The velocity of the motion in ``C²``.
+    U2 : array_like, complex, shape (2,)
+        The velocity of a second commuting flow on the same level set
+        (the same curve and divisor), R-linearly independent of ``U``.
+    characteristics : array_like of {0, 1}, shape (k, 4)
+        The characteristics ``[a1 a2; b1 b2]`` of the quotients ``θ[χ]/θ``
+        that enter l; they define the lattice ``Λ'`` of periods of l.
+
+    Returns
+    -------
+    Torus
+
+    Raises
+    ------
+    ValueError
+        If the inputs have the wrong shape, are not finite, ``Im τ`` is not
+        positive definite, ``U`` and ``U2`` do not span a real plane, or the
+        plane meets ``Λ'`` in no rank-2 lattice.
+    """
+    t = np.ascontiguousarray(np.asarray(tau, dtype=complex))
+    u = np.ascontiguousarray(np.asarray(U, dtype=complex))
+    u2 = np.ascontiguousarray(np.asarray(U2, dtype=complex))
+    ch = np.asarray(characteristics)
+    if ch.ndim != 2 or ch.shape[1] != 4 or not np.all((ch == 0) | (ch == 1)):
+        raise ValueError(f"characteristics must be (k, 4) of 0/1, got {ch!r}")
+    lam, coords, nu = _core.real_torus(t, u, u2, np.ascontiguousarray(ch, dtype=np.uint8))
+    return Torus(_readonly(lam), _readonly(coords), _readonly(nu))
+
+
+def _readonly(x: np.ndarray) -> np.ndarray:
+    x.setflags(write=False)
+    return x
