@@ -13,7 +13,7 @@ import numpy as np
 
 from . import _core
 
-__all__ = ["Torus", "real_torus"]
+__all__ = ["Torus", "real_torus", "second_flow_b"]
 
 
 class Torus(NamedTuple):
@@ -96,3 +96,28 @@ def real_torus(tau: Any, U: Any, U2: Any, characteristics: Any) -> Torus:
 def _readonly(x: np.ndarray) -> np.ndarray:
     x.setflags(write=False)
     return x
+
+
+def second_flow_b(a: Any, b: Any) -> np.ndarray:
+    """``b'`` of the second commuting flow that spans the real torus with the top's.
+
+    ``c_ij = (b_i − b_j)/(a_i − a_j)`` (2) is linear in ``b``; with the cubic
+    interpolant ``b_i = p0 + p1 a_i + p2 a_i² + p3 a_i³`` the top's flow is
+    ``p2 X_{a²} + p3 X_{a³}`` (``b = 1`` and ``b = a`` give no flow on the level
+    set). The second flow is ``b' = a²`` unless the ``a²`` part dominates,
+    ``|p2| > |p3| max|a|``, in which case ``b' = a³``: either way the two
+    velocities are far from parallel.
+
+    Parameters
+    ----------
+    a, b : array_like, shape (4,)
+
+    Returns
+    -------
+    ndarray, shape (4,)
+    """
+    aa = np.asarray(a, dtype=float)
+    bb = np.asarray(b, dtype=float)
+    p = np.linalg.solve(np.vander(aa, 4, increasing=True), bb)
+    s = float(np.max(np.abs(aa)))
+    return aa**3 if abs(p[2]) > abs(p[3]) * s else aa**2

@@ -31,7 +31,7 @@ import numpy as np
 
 from . import _core
 from ._progress import ProgressBar
-from ._torus import Torus, real_torus
+from ._torus import Torus, real_torus, second_flow_b
 from .problems import problem
 from .top import ManakovTop
 
@@ -41,6 +41,7 @@ __all__ = [
     "FrequencyMap",
     "Torus",
     "real_torus",
+    "second_flow_b",
     "frequency_map",
     "casimir_slice",
     "plot_frequency_map",
