@@ -552,3 +552,80 @@ where
     cancel.check()?;
     Ok(out)
 }
+
+/// What [`frequencies_of_state`] needs of the Theorem's solution of one top
+/// at one state: the period matrix, the velocity `U` and the characteristics
+/// of the quotients that enter `l`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FlowData {
+    pub tau: Tau,
+    pub u: C2,
+    pub chars: Vec<Char>,
+}
+
+/// `b'` of the second commuting flow (see `docs/tori.md` §2): with the cubic
+/// interpolant `b_i = p0 + p1 a_i + p2 a_i² + p3 a_i³`, `a³` if
+/// `|p2| > |p3| max|a|` (the top's flow is mostly the `a²` flow), else `a²`.
+pub fn second_flow_b(a: &[f64; 4], b: &[f64; 4]) -> [f64; 4] {
+    let v = nalgebra::Matrix4::from_fn(|i, j| a[i].powi(j as i32));
+    let p = v
+        .lu()
+        .solve(&nalgebra::Vector4::from_column_slice(b))
+        .unwrap_or_else(nalgebra::Vector4::zeros);
+    let s = a.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+    if p[2].abs() > p[3].abs() * s {
+        a.map(|x| x * x * x)
+    } else {
+        a.map(|x| x * x)
+    }
+}
+
+/// Relative size of `h1² − 4h0²` below which a state counts as on the
+/// singular level set `h1² = 4h0²` (status 1): `F(s)` of (19) divides by it,
+/// and the reduction's roots lose all digits well before it is zero.
+pub const CASIMIR_SINGULAR_RTOL: f64 = 1e-12;
+
+/// The status and frequencies of one state.
+///
+/// `solve(b, l0)` runs the Theorem for the top `(a, b)` (the caller closes
+/// over `a`); it is called for the top's `b` and for [`second_flow_b`].
+/// Errors become status codes by `classify`; nothing here panics or raises.
+pub fn frequencies_of_state<S, K>(
+    b: &[f64; 4],
+    b2: &[f64; 4],
+    l0: &[f64; 6],
+    solve: S,
+    classify: K,
+) -> MapEntry
+where
+    S: Fn(&[f64; 4], &[f64; 6]) -> Result<FlowData>,
+    K: Fn(&Error) -> Status,
+{
+    if l0.iter().any(|v| !v.is_finite()) {
+        return MapEntry::failed(Status::NonFinite);
+    }
+    if l0.iter().all(|&v| v == 0.0) {
+        return MapEntry::failed(Status::ZeroState);
+    }
+    let [l12, l13, l14, l23, l24, l34] = *l0;
+    let h0 = l12 * l34 - l13 * l24 + l14 * l23;
+    let h1: f64 = l0.iter().map(|v| v * v).sum();
+    if (h1 * h1 - 4.0 * h0 * h0).abs() <= CASIMIR_SINGULAR_RTOL * h1 * h1 {
+        return MapEntry::failed(Status::SingularCasimirs);
+    }
+    let first = match solve(b, l0) {
+        Ok(d) => d,
+        Err(e) => return MapEntry::failed(classify(&e)),
+    };
+    let second = match solve(b2, l0) {
+        Ok(d) => d,
+        Err(e) => return MapEntry::failed(classify(&e)),
+    };
+    match real_torus(&first.tau, &first.u, &second.u, &first.chars) {
+        Ok(t) => MapEntry {
+            status: Status::Ok,
+            nu: t.nu,
+        },
+        Err(f) => MapEntry::failed(f.into()),
+    }
+}

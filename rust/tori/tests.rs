@@ -299,3 +299,67 @@ fn map_states_keeps_order_and_stops_when_cancelled() {
         .unwrap()
         .is_empty());
 }
+
+#[test]
+fn second_flow_is_the_other_power() {
+    let a = [0.3, 1.1, 2.0, 3.7];
+    let sq = a.map(|x| x * x);
+    let cu = a.map(|x| x * x * x);
+    // b = a²: the top's flow is the a² flow, so the second is a³; and back.
+    assert_eq!(second_flow_b(&a, &sq), cu);
+    assert_eq!(second_flow_b(&a, &cu), sq);
+    let mixed: [f64; 4] = std::array::from_fn(|i| 0.5 + sq[i] - 0.1 * cu[i]);
+    assert_eq!(second_flow_b(&a, &mixed), cu);
+}
+
+#[test]
+fn state_statuses_and_nan_policy() {
+    // A stand-in for the Theorem: the plane of `real_plane_of_a_diagonal_tau`
+    // for every b, or an error chosen by the state.
+    let tau = [[c(0.0, 1.3), c(0.0, 0.0)], [c(0.0, 0.0), c(0.0, 0.8)]];
+    let solve = |b: &[f64; 4], l0: &[f64; 6]| -> Result<FlowData> {
+        if l0[0] > 10.0 {
+            return Err(Error::RepeatedBranchPoints {
+                i: 1,
+                j: 2,
+                value: c(1.0, 0.0),
+            });
+        }
+        let u = if b[0] == 1.0 {
+            [c(0.37, 0.0), c(0.52, 0.0)]
+        } else {
+            [c(-0.2, 0.0), c(0.9, 0.0)]
+        };
+        Ok(FlowData {
+            tau,
+            u,
+            chars: SIMPLE.to_vec(),
+        })
+    };
+    let classify = |e: &Error| match e {
+        Error::RepeatedBranchPoints { .. } => Status::CoincidingBranchPoints,
+        _ => Status::Singular,
+    };
+    let (b, b2) = ([1.0; 4], [2.0; 4]);
+    let run = |l0: [f64; 6]| frequencies_of_state(&b, &b2, &l0, solve, classify);
+    let ok = run([0.8, -0.3, 0.5, 1.1, -0.7, 0.2]);
+    assert_eq!(ok.status, Status::Ok);
+    assert!((ok.nu[0] - 0.185).abs() < 1e-15 && (ok.nu[1] - 0.26).abs() < 1e-15);
+    assert_eq!(run([0.0; 6]).status, Status::ZeroState);
+    assert_eq!(
+        run([f64::NAN, 0.0, 0.0, 0.0, 0.0, 0.0]).status,
+        Status::NonFinite
+    );
+    // m = n (m = (l23, l31, l12), n = (l14, l24, l34)): h1 = 2 h0.
+    assert_eq!(
+        run([0.3, -0.2, 0.5, 0.5, 0.2, 0.3]).status,
+        Status::SingularCasimirs
+    );
+    assert_eq!(
+        run([11.0, 0.0, 0.0, 0.0, 1.0, 0.0]).status,
+        Status::CoincidingBranchPoints
+    );
+    for l0 in [[0.0; 6], [11.0, 0.0, 0.0, 0.0, 1.0, 0.0]] {
+        assert!(run(l0).nu.iter().all(|v| v.is_nan()));
+    }
+}
