@@ -22,6 +22,7 @@ pub mod curve;
 pub mod error;
 pub mod integrate;
 pub mod kotter;
+pub mod riemann;
 pub mod so4;
 pub mod theta;
 pub mod tori;

@@ -1,0 +1,292 @@
+//! Quadrature on straight paths of a hyperelliptic curve.
+//!
+//! Every integral of the layer is `∫_0^1 f(v) dv` (or a Gauss–Chebyshev
+//! integral on `[-1, 1]`) of a function analytic on `[0, 1]` whose only
+//! singularities are known points `z_j` of the complex `v`-plane (the branch
+//! points, mapped into the path's parameter). The endpoint square roots are
+//! removed beforehand by the substitutions of `mod.rs`. The node count comes
+//! from the Bernstein ellipse through the nearest singularity: Gauss–Legendre
+//! with `N` nodes errs by `O(ρ^{-2N})` for a function analytic inside the
+//! ellipse with foci at the ends and parameter `ρ` (Trefethen, *Approximation
+//! Theory and Approximation Practice*, Thm 19.3); the same holds for
+//! Gauss–Chebyshev with the weight `1/√(1 − t²)`. A piece whose ellipse is
+//! too thin (a singularity close to the path) is bisected, so the cost grows
+//! only logarithmically with the closeness.
+
+use num_complex::Complex64;
+use std::sync::OnceLock;
+
+use crate::error::{Error, Result};
+
+type C = Complex64;
+
+/// `ln(1/ε)` of the quadrature target: `ρ^{-2N} ≤ e^{-TARGET_LN}` ≈ 1e-18,
+/// two digits below double rounding, which absorbs the `M/(ρ − 1)` prefactor
+/// of the error bound for all but the thinnest ellipses (those are bisected).
+pub const TARGET_LN: f64 = 41.0;
+
+/// Gauss–Legendre rules available, by node count.
+const GL_LADDER: [usize; 14] = [4, 6, 8, 10, 12, 14, 16, 20, 24, 28, 32, 40, 48, 64];
+
+/// Largest Gauss–Legendre rule used on one piece; a thinner ellipse is bisected.
+pub const GL_MAX: usize = 64;
+
+/// Gauss–Chebyshev rules available (node counts); beyond the last one an edge
+/// period is computed as two composite Gauss–Legendre halves instead.
+const CHEB_LADDER: [usize; 16] = [
+    6, 8, 10, 12, 16, 20, 24, 32, 40, 48, 64, 80, 96, 128, 160, 192,
+];
+
+/// Largest Gauss–Chebyshev rule.
+pub const CHEB_MAX: usize = 192;
+
+/// Most pieces one composite integral may use: a singularity at relative
+/// distance `δ` from the path needs about `log2(1/δ)` bisections, so 400
+/// pieces cover `δ` far below double precision; beyond, the path is refused.
+const MAX_PIECES: usize = 400;
+
+/// A quadrature rule on `[0, 1]` (Gauss–Legendre) or `[-1, 1]` (Chebyshev).
+#[derive(Debug)]
+pub struct Rule {
+    pub nodes: Vec<f64>,
+    pub weights: Vec<f64>,
+}
+
+fn gauss_legendre(n: usize) -> Rule {
+    // Newton on the three-term recurrence for P_n; Tricomi's initial guesses.
+    let mut nodes = vec![0.0; n];
+    let mut weights = vec![0.0; n];
+    let nf = n as f64;
+    for k in 0..n.div_ceil(2) {
+        let mut x = (std::f64::consts::PI * (k as f64 + 0.75) / (nf + 0.5)).cos();
+        let mut dp = 1.0;
+        for _ in 0..100 {
+            let (mut p0, mut p1) = (1.0, x);
+            for j in 2..=n {
+                let jf = j as f64;
+                let p2 = ((2.0 * jf - 1.0) * x * p1 - (jf - 1.0) * p0) / jf;
+                p0 = p1;
+                p1 = p2;
+            }
+            dp = nf * (x * p1 - p0) / (x * x - 1.0);
+            let dx = p1 / dp;
+            x -= dx;
+            if dx.abs() < 1e-16 {
+                break;
+            }
+        }
+        let w = 2.0 / ((1.0 - x * x) * dp * dp);
+        // Map [-1, 1] → [0, 1].
+        nodes[k] = (1.0 - x) / 2.0;
+        nodes[n - 1 - k] = (1.0 + x) / 2.0;
+        weights[k] = w / 2.0;
+        weights[n - 1 - k] = w / 2.0;
+    }
+    Rule { nodes, weights }
+}
+
+fn gauss_chebyshev(n: usize) -> Rule {
+    let w = std::f64::consts::PI / n as f64;
+    let nodes = (0..n)
+        .map(|k| ((2 * k + 1) as f64 * std::f64::consts::PI / (2 * n) as f64).cos())
+        .collect();
+    Rule {
+        nodes,
+        weights: vec![w; n],
+    }
+}
+
+static GL_RULES: [OnceLock<Rule>; GL_LADDER.len()] = [const { OnceLock::new() }; GL_LADDER.len()];
+static CHEB_RULES: [OnceLock<Rule>; CHEB_LADDER.len()] =
+    [const { OnceLock::new() }; CHEB_LADDER.len()];
+
+/// The smallest Gauss–Legendre rule (on `[0, 1]`) with at least `n` nodes.
+pub fn gl_rule(n: usize) -> &'static Rule {
+    let i = GL_LADDER
+        .iter()
+        .position(|&m| m >= n)
+        .unwrap_or(GL_LADDER.len() - 1);
+    GL_RULES[i].get_or_init(|| gauss_legendre(GL_LADDER[i]))
+}
+
+/// The smallest Gauss–Chebyshev rule with at least `n` nodes (`n ≤ CHEB_MAX`).
+pub fn cheb_rule(n: usize) -> &'static Rule {
+    let i = CHEB_LADDER
+        .iter()
+        .position(|&m| m >= n)
+        .unwrap_or(CHEB_LADDER.len() - 1);
+    CHEB_RULES[i].get_or_init(|| gauss_chebyshev(CHEB_LADDER[i]))
+}
+
+/// `ln ρ` of the Bernstein ellipse with foci `±1` through `z`: `acosh` of the
+/// half sum of the focal distances (0 on the segment itself).
+#[inline]
+pub fn log_rho(z: C) -> f64 {
+    let s = 0.5 * ((z - 1.0).norm() + (z + 1.0).norm());
+    s.max(1.0).acosh()
+}
+
+/// Node count for an ellipse parameter `ln ρ` (infinite for `ln ρ = 0`).
+#[inline]
+pub fn nodes_for(log_rho: f64) -> f64 {
+    (TARGET_LN / (2.0 * log_rho)).ceil()
+}
+
+/// Square root of `w` with `Re w > 0` (the rotated values of [`SegmentSqrt`]):
+/// `√w = (t, Im w / 2t)`, `t = √((|w| + Re w)/2)`, accurate to a few ulps
+/// because no cancellation occurs on the right half plane.
+#[inline(always)]
+pub fn sqrt_right(w: C) -> C {
+    let t = (0.5 * (w.re.hypot(w.im) + w.re)).sqrt();
+    if t == 0.0 {
+        return C::new(0.0, 0.0);
+    }
+    C::new(t, w.im / (2.0 * t))
+}
+
+/// A continuous branch of `√(a + v b)` for `v ∈ [0, 1]`, for a segment
+/// `a + [0, 1] b` that does not pass through 0.
+///
+/// With `p` the point of the segment nearest to 0 and `c = p̄/|p|`, the
+/// segment lies in the half plane `Re(c w) ≥ |p| > 0` (nearest-point property
+/// of a convex set), so `√(c w)` (principal) is continuous along it and
+/// `√(c w)·c^{-1/2}` squares to `w`.
+#[derive(Debug, Clone, Copy)]
+pub struct SegmentSqrt {
+    rot: C,
+    unrot: C,
+}
+
+impl SegmentSqrt {
+    pub fn new(a: C, b: C) -> Self {
+        let bb = b.norm_sqr();
+        let v = if bb > 0.0 {
+            (-(b.conj() * a).re / bb).clamp(0.0, 1.0)
+        } else {
+            0.0
+        };
+        let p = a + b * v;
+        let r = p.norm();
+        let rot = if r > 0.0 {
+            p.conj() / r
+        } else {
+            C::new(1.0, 0.0)
+        };
+        // c^{-1/2} = conj(√c) for |c| = 1; √c with Re c arbitrary: principal.
+        let unrot = crate::curve::sqrt_principal(rot).conj();
+        SegmentSqrt { rot, unrot }
+    }
+
+    /// `√w` on the branch of the segment (`w` a point of it).
+    #[inline(always)]
+    pub fn eval(&self, w: C) -> C {
+        sqrt_right(self.rot * w) * self.unrot
+    }
+
+    /// `Π c^{-1/2}` is folded into one constant by callers that multiply many.
+    #[inline(always)]
+    pub fn rotated(&self, w: C) -> C {
+        sqrt_right(self.rot * w)
+    }
+
+    /// The constant `c^{-1/2}`.
+    pub fn unrot(&self) -> C {
+        self.unrot
+    }
+}
+
+/// One piece `[a, b] ⊂ [0, 1]` of a composite rule, with its node count.
+#[derive(Debug, Clone, Copy)]
+pub struct Piece {
+    pub a: f64,
+    pub b: f64,
+    pub n: usize,
+}
+
+/// Splits `[0, 1]` into pieces on each of which Gauss–Legendre with at most
+/// [`GL_MAX`] nodes reaches [`TARGET_LN`], given the singular points `sing`
+/// of the integrand in the `v`-plane.
+pub fn plan_pieces(sing: &[C], out: &mut Vec<Piece>) -> Result<()> {
+    out.clear();
+    let mut stack: Vec<(f64, f64)> = vec![(0.0, 1.0)];
+    while let Some((a, b)) = stack.pop() {
+        let (mid, half) = (0.5 * (a + b), 0.5 * (b - a));
+        let lr = sing
+            .iter()
+            .map(|&z| log_rho((z - mid) / half))
+            .fold(f64::INFINITY, f64::min);
+        let n = nodes_for(lr);
+        if n <= GL_MAX as f64 {
+            out.push(Piece {
+                a,
+                b,
+                n: (n as usize).max(4),
+            });
+        } else if out.len() + stack.len() >= MAX_PIECES || half < 1e-17 {
+            return Err(Error::InvalidArgument {
+                what: "path",
+                reason: "an integration path passes within rounding distance of a branch point"
+                    .into(),
+            });
+        } else {
+            stack.push((mid, b));
+            stack.push((a, mid));
+        }
+    }
+    Ok(())
+}
+
+/// `∫_0^1 f(v) dv` on `pieces`, `f` adding `w·f(v)` into its accumulator.
+#[inline]
+pub fn integrate(pieces: &[Piece], acc: &mut [C], mut f: impl FnMut(f64, f64, &mut [C])) {
+    for p in pieces {
+        let rule = gl_rule(p.n);
+        let h = p.b - p.a;
+        for (&x, &w) in rule.nodes.iter().zip(&rule.weights) {
+            f(p.a + h * x, w * h, acc);
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn gauss_legendre_integrates_polynomials_exactly() {
+        for &n in &GL_LADDER {
+            let r = gl_rule(n);
+            for k in 0..(2 * n) {
+                let s: f64 = r
+                    .nodes
+                    .iter()
+                    .zip(&r.weights)
+                    .map(|(x, w)| w * x.powi(k as i32))
+                    .sum();
+                assert!((s - 1.0 / (k as f64 + 1.0)).abs() < 1e-14, "n={n} k={k}");
+            }
+        }
+    }
+
+    #[test]
+    fn segment_sqrt_is_continuous_and_squares_back() {
+        let (a, b) = (C::new(-3.0, 0.5), C::new(6.0, -1.2));
+        let s = SegmentSqrt::new(a, b);
+        let mut prev = s.eval(a);
+        for k in 1..=1000 {
+            let w = a + b * (k as f64 / 1000.0);
+            let r = s.eval(w);
+            assert!((r * r - w).norm() < 1e-14 * w.norm().max(1.0));
+            assert!((r - prev).norm() < 0.1);
+            prev = r;
+        }
+    }
+
+    #[test]
+    fn log_rho_of_known_points() {
+        // On the real axis beyond the end: ρ = x + √(x² − 1).
+        let x: f64 = 2.0;
+        assert!((log_rho(C::new(x, 0.0)) - (x + (x * x - 1.0).sqrt()).ln()).abs() < 1e-15);
+        assert_eq!(log_rho(C::new(0.3, 0.0)), 0.0);
+    }
+}
