@@ -24,6 +24,7 @@ pub mod integrate;
 pub mod kotter;
 pub mod riemann;
 pub mod so4;
+pub mod solution;
 pub mod theta;
 pub mod tori;
 

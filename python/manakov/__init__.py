@@ -9,6 +9,7 @@ from ._core import ConvergenceError, __version__
 from .curve import CurvePoints, KotterCurve, Wurzel
 from .problems import Problem, benchmark_setup, problem, problem_names
 from .reduction import Kotter, from_kotter, kotter
+from .riemann import HyperellipticCurve
 from .theta import (
     CHARACTERISTICS,
     PAPER_CHARACTERISTICS,
@@ -41,6 +42,7 @@ __all__ = [
     "FrahmTop",
     "frequency_map",
     "FrequencyMap",
+    "HyperellipticCurve",
     "from_kotter",
     "from_matrix",
     "kotter",

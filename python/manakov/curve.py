@@ -194,7 +194,7 @@ class KotterCurve:
     :attr:`kappa` ``= prod_{m=1}^3 (d_m - d_4)`` (see ``docs/errata.md``).
     """
 
-    __slots__ = ("_d", "_c", "_ct", "_kappa")
+    __slots__ = ("_d", "_c", "_ct", "_kappa", "_surface")
 
     def __init__(self, d1: complex, d2: complex, d3: complex) -> None:
         d = _c([d1, d2, d3])
@@ -205,6 +205,7 @@ class KotterCurve:
         self._c = _frozen(c)
         self._ct = _frozen(ct)
         self._kappa = complex(kappa[0])
+        self._surface: Any = None
 
     def _d123(self) -> np.ndarray:
         return np.ascontiguousarray(self._d[1:4])
@@ -236,6 +237,21 @@ class KotterCurve:
     def kappa(self) -> complex:
         """``kappa = prod_{m=1}^3 (d_m - d_4) = -R'(d_4)/d_4``, the factor of (29) corrected."""
         return self._kappa
+
+    @property
+    def surface(self) -> Any:
+        """The curve (8) as a :class:`manakov.HyperellipticCurve` (built once).
+
+        Its branch points are ``(d_0, .., d_4)`` in this order, so
+        ``surface.branch_char(j)`` is ``eta(d_j)``; the base point of its Abel
+        map is ``infinity``.
+        """
+        if self._surface is None:
+            # Imported here: riemann sits above curve in the import graph.
+            from .riemann import HyperellipticCurve
+
+            self._surface = HyperellipticCurve(self._d)
+        return self._surface
 
     def __repr__(self) -> str:
         d1, d2, d3 = self.d

@@ -11,6 +11,7 @@ mod arrays;
 mod curve;
 mod errors;
 mod kotter;
+mod riemann;
 mod so4;
 mod theta;
 mod tori;
@@ -30,6 +31,7 @@ mod _core {
         kotter::register(m)?;
         curve::register(m)?;
         tori::register(m)?;
+        riemann::register(m)?;
         Ok(())
     }
 }

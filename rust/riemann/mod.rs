@@ -51,7 +51,7 @@ use num_complex::Complex64;
 use crate::curve::sqrt_principal;
 use crate::error::{Error, Result};
 use crate::theta::ThetaPlan;
-use quad::{log_rho, nodes_for, Piece, SegmentSqrt};
+use quad::{nodes_for, Piece, SegmentSqrt};
 
 type C = Complex64;
 
@@ -486,9 +486,7 @@ impl HyperellipticCurve {
         let unrot: C = segs.iter().map(|(_, s)| s.unrot()).product();
         let y1 = q * unrot * segs.iter().map(|(a, s)| s.rotated(a + dx)).product::<C>();
         let sign = if (y * y1.conj()).re < 0.0 { -1.0 } else { 1.0 };
-        let mut pieces: Vec<Piece> = Vec::new();
-        quad::plan_pieces(&sing, &mut pieces)?;
-        quad::integrate(&pieces, &mut out, |s, w, acc| {
+        let integrand = |s: f64, w: f64, acc: &mut [C]| {
             let s2 = s * s;
             let prod: C = segs.iter().map(|(a, sg)| sg.rotated(a + dx * s2)).product();
             let xs = ek + dx * s2;
@@ -497,7 +495,22 @@ impl HyperellipticCurve {
                 *v += f;
                 f *= xs;
             }
-        });
+        };
+        // Singularities ±√t_m come in pairs: the ellipse of [−1, 1] decides.
+        let lr = sing
+            .iter()
+            .step_by(2)
+            .map(|&z| quad::focal_half_sum(z))
+            .fold(f64::INFINITY, f64::min)
+            .acosh();
+        let nn = nodes_for(lr);
+        if nn <= quad::GL_MAX as f64 {
+            quad::integrate_even(nn as usize, &mut out, integrand);
+        } else {
+            let mut pieces: Vec<Piece> = Vec::new();
+            quad::plan_pieces(&sing, &mut pieces)?;
+            quad::integrate(&pieces, &mut out, integrand);
+        }
         let fac = 2.0 * sign * q / unrot;
         out.iter_mut().for_each(|v| *v *= fac);
         Ok(out)
@@ -529,9 +542,7 @@ impl HyperellipticCurve {
         let y0 = unrot * segs.iter().map(|(_, s)| s.rotated(xx)).product::<C>();
         let lam = sign * y0 / xx.powi(g as i32 + 1);
         let mut out = vec![C::new(0.0, 0.0); g];
-        let mut pieces: Vec<Piece> = Vec::new();
-        quad::plan_pieces(&sing, &mut pieces)?;
-        quad::integrate(&pieces, &mut out, |t, w, acc| {
+        let integrand = |t: f64, w: f64, acc: &mut [C]| {
             let t2 = t * t;
             let prod: C = segs.iter().map(|(b, sg)| sg.rotated(xx + b * t2)).product();
             let xs = c * t2 + xx;
@@ -548,7 +559,24 @@ impl HyperellipticCurve {
                 *v += xp * tps[i];
                 xp *= xs;
             }
-        });
+        };
+        let lr = if n % 2 == 1 {
+            sing.iter()
+                .step_by(2)
+                .map(|&z| quad::focal_half_sum(z))
+                .fold(f64::INFINITY, f64::min)
+                .acosh()
+        } else {
+            0.0
+        };
+        let nn = nodes_for(lr);
+        if n % 2 == 1 && nn <= quad::GL_MAX as f64 {
+            quad::integrate_even(nn as usize, &mut out, integrand);
+        } else {
+            let mut pieces: Vec<Piece> = Vec::new();
+            quad::plan_pieces(&sing, &mut pieces)?;
+            quad::integrate(&pieces, &mut out, integrand);
+        }
         let fac = 2.0 * sign * xx / unrot;
         out.iter_mut().for_each(|v| *v *= fac);
         Ok((out, lam))
@@ -657,10 +685,11 @@ impl HyperellipticCurve {
         Ok(())
     }
 
+    /// `(|z−1| + |z+1|)/2` of the route's worst singularity (larger is
+    /// better): branch routes and, for odd `n`, the ray from `∞` have even
+    /// integrands with paired singularities `±z` (ellipse of `[−1, 1]`); the
+    /// ray for even `n` has singularities `z` on `[0, 1]`, mapped.
     fn route_quality(&self, route: Route, x: C) -> f64 {
-        // ln ρ of the worst singularity of the route's σ or τ integrand,
-        // seen from [0, 1] mapped to [−1, 1].
-        let map = |s: C| log_rho(2.0 * s - 1.0).min(log_rho(-2.0 * s - 1.0));
         match route {
             Route::Branch(k) => {
                 let dx = x - self.e[k];
@@ -668,14 +697,23 @@ impl HyperellipticCurve {
                     .iter()
                     .enumerate()
                     .filter(|&(m, _)| m != k)
-                    .map(|(_, &em)| map(sqrt_principal((em - self.e[k]) / dx)))
+                    .map(|(_, &em)| quad::focal_half_sum(sqrt_principal((em - self.e[k]) / dx)))
                     .fold(f64::INFINITY, f64::min)
             }
             Route::Infinity => {
                 let xx = x - self.center;
+                let odd = self.e.len() % 2 == 1;
                 self.e
                     .iter()
-                    .map(|&em| map(sqrt_principal(xx / (em - self.center))))
+                    .map(|&em| {
+                        let z = sqrt_principal(xx / (em - self.center));
+                        if odd {
+                            quad::focal_half_sum(z)
+                        } else {
+                            quad::focal_half_sum(2.0 * z - 1.0)
+                                .min(quad::focal_half_sum(-2.0 * z - 1.0))
+                        }
+                    })
                     .fold(f64::INFINITY, f64::min)
             }
         }
@@ -859,14 +897,22 @@ impl HyperellipticCurve {
         }
     }
 
-    /// `η(e_k)`: `u(e_k) ≡ (b + τ a)/2`, 0-based `k`; `k = n` is `∞` (odd `n`).
-    pub fn branch_char(&self, k: usize) -> Result<(Vec<u8>, Vec<u8>)> {
+    /// `η(e_k)`: `u(e_k) ≡ (b + τ a)/2` modulo the lattice, for the 0-based
+    /// index `k` (`e_{k+1}`); `k = n` is `∞` for odd `n` (`η(∞) = 0`, the base
+    /// point). Empty vectors for an index out of range
+    /// ([`Self::try_branch_char`] gives the error).
+    pub fn branch_char(&self, k: usize) -> (Vec<u8>, Vec<u8>) {
+        self.try_branch_char(k).unwrap_or_default()
+    }
+
+    /// [`Self::branch_char`] with an error for an index out of range.
+    pub fn try_branch_char(&self, k: usize) -> Result<(Vec<u8>, Vec<u8>)> {
         self.half_period_char(&self.abel_branch_point(k)?)
     }
 
     /// The half period `(b + τa)/2` of `η(e_k)` (reduced representative).
     pub fn branch_half_period(&self, k: usize) -> Result<Vec<C>> {
-        let (a, b) = self.branch_char(k)?;
+        let (a, b) = self.try_branch_char(k)?;
         Ok(self.half_period(&a, &b))
     }
 
@@ -929,7 +975,7 @@ impl HyperellipticCurve {
             let v: Vec<C> = (0..2).map(|i| u1[i] + u2[i] + k[i]).collect();
             let (vals, _) = plan.theta_all(&v)?;
             for j in 0..5 {
-                let (a, b) = self.branch_char(j)?;
+                let (a, b) = self.try_branch_char(j)?;
                 let idx = crate::theta::char_index(&a, &b)?;
                 let ratio = vals[0] / vals[idx];
                 calib.push(((x1 - self.e[j]) * (x2 - self.e[j]) * ratio * ratio, idx));
@@ -945,14 +991,27 @@ impl HyperellipticCurve {
 
     /// The vector of Riemann constants `K` for the base point `P0`: the half
     /// period `(b + τa)/2` with `θ(u(P_1) + … + u(P_{g−1}) + K) = 0` for all
-    /// points (g = 2: `θ(u(P) + K) = 0`), found among the `4^g` half periods
-    /// by evaluating theta at three fixed divisors.
-    pub fn riemann_constant(&self) -> Result<&[C]> {
+    /// points (g = 2: `θ(u(P) + K) = 0` for every `P`), found among the `4^g`
+    /// half periods by evaluating theta at three fixed divisors (built on
+    /// first use). Empty if that search failed; [`Self::try_riemann_constant`]
+    /// gives the error.
+    pub fn riemann_constant(&self) -> &[C] {
+        self.try_riemann_constant().unwrap_or(&[])
+    }
+
+    /// [`Self::riemann_constant`] with the error of the search.
+    pub fn try_riemann_constant(&self) -> Result<&[C]> {
         Ok(&self.derived()?.k)
     }
 
-    /// The characteristic `[a; b]` of [`Self::riemann_constant`].
-    pub fn riemann_constant_char(&self) -> Result<(Vec<u8>, Vec<u8>)> {
+    /// The characteristic `[a; b]` of [`Self::riemann_constant`]
+    /// (`K = (b + τa)/2`); empty vectors if the search failed.
+    pub fn riemann_constant_char(&self) -> (Vec<u8>, Vec<u8>) {
+        self.try_riemann_constant_char().unwrap_or_default()
+    }
+
+    /// [`Self::riemann_constant_char`] with the error of the search.
+    pub fn try_riemann_constant_char(&self) -> Result<(Vec<u8>, Vec<u8>)> {
         Ok(self.derived()?.k_char.clone())
     }
 

@@ -122,8 +122,14 @@ pub fn cheb_rule(n: usize) -> &'static Rule {
 /// half sum of the focal distances (0 on the segment itself).
 #[inline]
 pub fn log_rho(z: C) -> f64 {
-    let s = 0.5 * ((z - 1.0).norm() + (z + 1.0).norm());
-    s.max(1.0).acosh()
+    focal_half_sum(z).acosh()
+}
+
+/// `(|z − 1| + |z + 1|)/2 ≥ 1`, monotone in `ρ` (cheap comparisons; no hypot).
+#[inline]
+pub fn focal_half_sum(z: C) -> f64 {
+    let s = 0.5 * ((z - 1.0).norm_sqr().sqrt() + (z + 1.0).norm_sqr().sqrt());
+    s.max(1.0)
 }
 
 /// Node count for an ellipse parameter `ln ρ` (infinite for `ln ρ = 0`).
@@ -137,7 +143,7 @@ pub fn nodes_for(log_rho: f64) -> f64 {
 /// because no cancellation occurs on the right half plane.
 #[inline(always)]
 pub fn sqrt_right(w: C) -> C {
-    let t = (0.5 * (w.re.hypot(w.im) + w.re)).sqrt();
+    let t = (0.5 * (w.norm_sqr().sqrt() + w.re)).sqrt();
     if t == 0.0 {
         return C::new(0.0, 0.0);
     }
@@ -234,6 +240,20 @@ pub fn plan_pieces(sing: &[C], out: &mut Vec<Piece>) -> Result<()> {
         }
     }
     Ok(())
+}
+
+/// `∫_0^1 f(v²) dv = ½ ∫_{−1}^{1} f(v²) dv` by one Gauss–Legendre rule on
+/// `[−1, 1]` with `n` (even) nodes, evaluating only the positive half: the
+/// integrand of an endpoint-substituted path is even in `v`, and its
+/// singularities `±z_j` come in pairs, so the ellipse is that of `[−1, 1]`.
+#[inline]
+pub fn integrate_even(n: usize, acc: &mut [C], mut f: impl FnMut(f64, f64, &mut [C])) {
+    let rule = gl_rule(n);
+    for (&x, &w) in rule.nodes.iter().zip(&rule.weights) {
+        if x > 0.5 {
+            f(2.0 * x - 1.0, 2.0 * w, acc);
+        }
+    }
 }
 
 /// `∫_0^1 f(v) dv` on `pieces`, `f` adding `w·f(v)` into its accumulator.

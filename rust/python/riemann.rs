@@ -1,0 +1,252 @@
+//! Bindings for `crate::riemann`: one frozen class holding a built
+//! `HyperellipticCurve` (its construction is the expensive step), with
+//! methods on flattened arrays that the Python layer has broadcast.
+
+use numpy::ndarray::{Array1, Array2};
+use numpy::{Complex64, IntoPyArray, PyArray1, PyArray2, PyReadonlyArray1, PyReadonlyArray2};
+use pyo3::prelude::*;
+
+use super::arrays::{out_shape_err, shape_err, vec1};
+use super::errors::py_cancel;
+use crate::error::Error;
+use crate::riemann::HyperellipticCurve;
+
+type C = Complex64;
+
+/// Points per chunk between cancellation checks (~2 ms of Abel integrals).
+const CHUNK: usize = 1024;
+
+fn matrix_to_array(m: &nalgebra::DMatrix<C>) -> Array2<C> {
+    Array2::from_shape_fn((m.nrows(), m.ncols()), |(i, j)| m[(i, j)])
+}
+
+fn finite(what: &'static str, v: &[C]) -> Result<(), Error> {
+    match v
+        .iter()
+        .position(|z| !(z.re.is_finite() && z.im.is_finite()))
+    {
+        Some(index) => Err(Error::NonFinite { what, index }),
+        None => Ok(()),
+    }
+}
+
+/// A hyperelliptic curve with its homology basis, periods and Abel map.
+#[pyclass(name = "HyperellipticCore", module = "manakov._core", frozen)]
+pub struct HyperellipticCore {
+    curve: HyperellipticCurve,
+}
+
+#[pymethods]
+impl HyperellipticCore {
+    #[new]
+    fn new(py: Python<'_>, branch_points: PyReadonlyArray1<'_, C>) -> PyResult<Self> {
+        let e = vec1(&branch_points, "branch_points", None)?;
+        let curve = py.detach(|| HyperellipticCurve::new(&e))?;
+        Ok(HyperellipticCore { curve })
+    }
+
+    #[getter]
+    fn genus(&self) -> usize {
+        self.curve.genus()
+    }
+
+    #[getter]
+    fn branch_points<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<C>> {
+        Array1::from(self.curve.branch_points().to_vec()).into_pyarray(py)
+    }
+
+    /// `(A, B)`, `g × g` each.
+    fn periods<'py>(&self, py: Python<'py>) -> (Bound<'py, PyArray2<C>>, Bound<'py, PyArray2<C>>) {
+        let (a, b) = self.curve.periods();
+        (
+            matrix_to_array(a).into_pyarray(py),
+            matrix_to_array(b).into_pyarray(py),
+        )
+    }
+
+    fn tau<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<C>> {
+        matrix_to_array(self.curve.tau()).into_pyarray(py)
+    }
+
+    /// `∮_{c_j} ω_i` of the tree loops, `g × 2g`.
+    fn cycle_periods<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<C>> {
+        matrix_to_array(&self.curve.cycle_periods()).into_pyarray(py)
+    }
+
+    /// Tree edges of the cycles `c_j` as `(2g, 2)` indices.
+    fn cycle_edges<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<i64>>> {
+        let e = self.curve.cycle_edges();
+        let flat: Vec<i64> = e.iter().flat_map(|&(p, q)| [p as i64, q as i64]).collect();
+        Ok(Array2::from_shape_vec((e.len(), 2), flat)
+            .map_err(out_shape_err)?
+            .into_pyarray(py))
+    }
+
+    fn intersection_matrix<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<i64>>> {
+        let m = self.curve.intersection_matrix();
+        let flat: Vec<i64> = m.iter().flatten().copied().collect();
+        Ok(Array2::from_shape_vec((m.len(), m.len()), flat)
+            .map_err(out_shape_err)?
+            .into_pyarray(py))
+    }
+
+    fn symplectic_basis<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<i64>>> {
+        let m = self.curve.symplectic_basis();
+        let flat: Vec<i64> = m.iter().flatten().copied().collect();
+        Ok(Array2::from_shape_vec((m.len(), m.len()), flat)
+            .map_err(out_shape_err)?
+            .into_pyarray(py))
+    }
+
+    /// `y(x, sheet)` at each `x`.
+    fn y<'py>(
+        &self,
+        py: Python<'py>,
+        x: PyReadonlyArray1<'py, C>,
+        sheet: i8,
+    ) -> PyResult<Bound<'py, PyArray1<C>>> {
+        let xs = vec1(&x, "x", None)?;
+        finite("x", &xs)?;
+        let out: Vec<C> = py.detach(|| xs.iter().map(|&v| self.curve.y(v, sheet)).collect());
+        Ok(Array1::from(out).into_pyarray(py))
+    }
+
+    /// Abel map of `N` points, `(N, g)`; `route` (tests): `None` the best route,
+    /// `-1` the ray from infinity, `k ≥ 0` the segment from branch point `k`.
+    #[pyo3(signature = (x, y, route=None))]
+    fn abel<'py>(
+        &self,
+        py: Python<'py>,
+        x: PyReadonlyArray1<'py, C>,
+        y: PyReadonlyArray1<'py, C>,
+        route: Option<i64>,
+    ) -> PyResult<Bound<'py, PyArray2<C>>> {
+        let xs = vec1(&x, "x", None)?;
+        let ys = vec1(&y, "y", Some(xs.len()))?;
+        let g = self.curve.genus();
+        let n = xs.len();
+        let cancel = py_cancel();
+        let out = py.detach(|| -> Result<Vec<C>, Error> {
+            let mut out = vec![C::new(0.0, 0.0); n * g];
+            for (k, chunk) in out.chunks_mut(CHUNK * g).enumerate() {
+                cancel.check()?;
+                let lo = k * CHUNK;
+                let hi = (lo + CHUNK).min(n);
+                match route {
+                    None => self.curve.abel_batch(&xs[lo..hi], &ys[lo..hi], chunk)?,
+                    Some(r) => {
+                        let rr = if r < 0 { None } else { Some(r as usize) };
+                        for i in lo..hi {
+                            let u = self.curve.abel_via(xs[i], ys[i], rr)?;
+                            chunk[(i - lo) * g..(i - lo + 1) * g].copy_from_slice(&u);
+                        }
+                    }
+                }
+            }
+            Ok(out)
+        })?;
+        Ok(Array2::from_shape_vec((n, g), out)
+            .map_err(out_shape_err)?
+            .into_pyarray(py))
+    }
+
+    /// `u(e_k)` for every finite branch point (unreduced, tree paths), `(n, g)`.
+    fn abel_branch_points<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<C>>> {
+        let (n, g) = (self.curve.branch_points().len(), self.curve.genus());
+        let mut flat = Vec::with_capacity(n * g);
+        for k in 0..n {
+            flat.extend(self.curve.abel_branch_point(k)?);
+        }
+        Ok(Array2::from_shape_vec((n, g), flat)
+            .map_err(out_shape_err)?
+            .into_pyarray(py))
+    }
+
+    /// Characteristics `[a | b]` of `η(e_k)`, `k = 0..n` (row `n` is `∞` for odd `n`).
+    fn branch_chars<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<u8>>> {
+        let n = self.curve.branch_points().len();
+        let g = self.curve.genus();
+        let rows = if n % 2 == 1 { n + 1 } else { n };
+        let mut flat = Vec::with_capacity(rows * 2 * g);
+        for k in 0..rows {
+            let (a, b) = self.curve.try_branch_char(k)?;
+            flat.extend(a);
+            flat.extend(b);
+        }
+        Ok(Array2::from_shape_vec((rows, 2 * g), flat)
+            .map_err(out_shape_err)?
+            .into_pyarray(py))
+    }
+
+    fn riemann_constant<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray1<C>>> {
+        let k = py.detach(|| self.curve.try_riemann_constant().map(|k| k.to_vec()))?;
+        Ok(Array1::from(k).into_pyarray(py))
+    }
+
+    fn riemann_constant_char<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray1<u8>>> {
+        let (a, b) = py.detach(|| self.curve.try_riemann_constant_char())?;
+        Ok(Array1::from([a, b].concat()).into_pyarray(py))
+    }
+
+    /// `z (N, g)` reduced modulo the lattice.
+    fn reduce<'py>(
+        &self,
+        py: Python<'py>,
+        z: PyReadonlyArray2<'py, C>,
+    ) -> PyResult<Bound<'py, PyArray2<C>>> {
+        let g = self.curve.genus();
+        let v = z.as_array();
+        if v.ncols() != g {
+            return Err(shape_err("z", format!("(N, {g})"), v.shape()));
+        }
+        let flat: Vec<C> = v.iter().copied().collect();
+        finite("z", &flat)?;
+        let out: Vec<C> = flat.chunks(g).flat_map(|r| self.curve.reduce(r)).collect();
+        Ok(Array2::from_shape_vec((v.nrows(), g), out)
+            .map_err(out_shape_err)?
+            .into_pyarray(py))
+    }
+
+    /// Jacobi inversion of `u (N, 2)`: `(x (N, 2), y (N, 2))`.
+    #[allow(clippy::type_complexity)]
+    fn invert<'py>(
+        &self,
+        py: Python<'py>,
+        u: PyReadonlyArray2<'py, C>,
+    ) -> PyResult<(Bound<'py, PyArray2<C>>, Bound<'py, PyArray2<C>>)> {
+        let v = u.as_array();
+        if v.ncols() != 2 {
+            return Err(shape_err("u", "(N, 2)", v.shape()));
+        }
+        let flat: Vec<C> = v.iter().copied().collect();
+        let n = v.nrows();
+        let cancel = py_cancel();
+        let (xs, ys) = py.detach(|| -> Result<(Vec<C>, Vec<C>), Error> {
+            let mut xs = Vec::with_capacity(2 * n);
+            let mut ys = Vec::with_capacity(2 * n);
+            for (i, row) in flat.chunks(2).enumerate() {
+                if i % 256 == 0 {
+                    cancel.check()?;
+                }
+                let [(x1, y1), (x2, y2)] = self.curve.invert(row)?;
+                xs.extend([x1, x2]);
+                ys.extend([y1, y2]);
+            }
+            Ok((xs, ys))
+        })?;
+        Ok((
+            Array2::from_shape_vec((n, 2), xs)
+                .map_err(out_shape_err)?
+                .into_pyarray(py),
+            Array2::from_shape_vec((n, 2), ys)
+                .map_err(out_shape_err)?
+                .into_pyarray(py),
+        ))
+    }
+}
+
+/// Adds this module's class to `manakov._core`.
+pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_class::<HyperellipticCore>()?;
+    Ok(())
+}

@@ -1,0 +1,591 @@
+//! The Theorem (9)–(10): the state `l(t)` as a quotient of genus-2 theta
+//! functions whose argument moves on a straight line, `v(t) = v0 + U t`.
+//!
+//! The chain (docs/theorem.md, equation numbers Perelomov's, corrections in
+//! docs/errata.md):
+//!
+//! * the reduction of `l0` ([`crate::kotter`]): the level-set constants
+//!   (`d_j`, `α_j … δ_j` of the corrected (24), `K`, `ε` of the corrected
+//!   (40)), the points `(z_i, y_i)`, `g` and the branch of the `P_j`, all fixed
+//!   once per solution;
+//! * the curve (8) as a [`HyperellipticCurve`] with branch points
+//!   `(d_0, …, d_4)`: `τ`, the Abel map `u` (base point ∞) and the Riemann
+//!   constant `K_R`; `v = u(P1) + u(P2) + K_R`;
+//! * (34): `P_L = C_L θ[χ_L](v)/θ(v)`, `χ_j = η(d_j)`, `χ_jk = χ_j + χ_k`, with
+//!   `C_L²` from a well-conditioned auxiliary divisor and the sign of `C_L`
+//!   from the initial state;
+//! * (37) and the corrected (42): `ξ_j = √c_j g P_kl`, `η_j = √c_j g P_j4`,
+//!   `g = G/(1 − ε P_0)`, `G = √(h0/K)`, so `ξ_j = √c_j G C_kl θ_kl/D`,
+//!   `η_j = √c_j G C_j4 θ_j4/D` with the common denominator
+//!   `D(v) = θ(v) − ε C_0 θ_0(v)`;
+//! * (23): `l` is linear in `ξ, η`, hence `l_q(v) = N_q(v)/D(v)` with
+//!   `N_q` a fixed combination of six theta functions — (9)–(10) as they truly read;
+//! * `U` from the equations of motion: `d l/dt = (1)` at `v0` and
+//!   `d l/dt = (∇N_q − l_q ∇D)·U / D`, a 6 × 2 complex linear system solved
+//!   by least squares (theta gradients at `v0`).
+//!
+//! Evaluation at large `t`: `v = x + τ y` with real lattice coordinates
+//! `x(t) = x0 + X t`, `y(t) = y0 + Y t`, reduced modulo 2 (an even lattice
+//! vector multiplies every `θ[χ]` by one common factor, so the quotients are
+//! exact); the products `X t`, `Y t` are split error-free (fma), so the phase
+//! keeps its digits at `t = 10^6`.
+
+use nalgebra::{DMatrix, DVector};
+use num_complex::Complex64;
+use rayon::prelude::*;
+
+use crate::cancel::Cancel;
+use crate::curve::{sqrt_principal, KotterCurve, CYCLIC};
+use crate::error::{Error, Result};
+use crate::kotter::{kotter_constants, kotter_with, KotterConstants, KotterState};
+use crate::riemann::HyperellipticCurve;
+use crate::so4;
+use crate::theta::{char_index, ThetaPlan};
+
+type C = Complex64;
+
+/// Truncation tolerance of the theta sums (absolute, on normalised values):
+/// below the rounding of the quotients.
+pub const THETA_TOL: f64 = 1e-16;
+
+/// `h0 = 0` or `h1² = 4h0²` are detected relative to `|l|²` (resp. `|l|⁴`):
+/// the integrals are rounded sums of products of size `|l|²`.
+pub const DEGENERATE_RTOL: f64 = 1e-13;
+
+/// The divisor of `l0` contains ∞ (the `P_L` have poles) when `θ(v0)` is
+/// this small relative to the largest `|θ[χ](v0)|`.
+pub const DIVISOR_AT_INFINITY_RTOL: f64 = 1e-10;
+
+/// Times per work unit between two cancellation checks (~2 ms on one core).
+const CHUNK: usize = 8192;
+
+/// Smallest piece handed to one thread.
+const PAR_PIECE: usize = 512;
+
+/// Labels of the Wurzelfunktionen that enter (37) and (42), in the order of
+/// [`Solution::constants`]: `P_0`, `P_kl` for `j = 1, 2, 3` (`kl = 23, 31, 12`),
+/// `P_j4` for `j = 1, 2, 3`.
+pub const LABELS: [&str; 7] = ["P0", "P23", "P31", "P12", "P14", "P24", "P34"];
+
+/// An explicit solution of the Manakov top on the level set of `l0`.
+#[derive(Debug)]
+pub struct Solution {
+    a: [f64; 4],
+    c4: [f64; 6],
+    l0: [f64; 6],
+    kotter: KotterConstants,
+    state0: KotterState,
+    curve: HyperellipticCurve,
+    plan: ThetaPlan,
+    tau: [C; 4],
+    rc: [C; 2],
+    u0: [C; 2],
+    rate: [C; 2],
+    /// `x0, y0` of `v0 = x0 + τ y0`.
+    lat0: [f64; 4],
+    /// `X, Y` of `U = X + τ Y`.
+    lat_rate: [f64; 4],
+    /// Theta indices (FLINT order): `θ`, then the seven labels.
+    idx: [usize; 8],
+    /// Characteristics `(a, b)` of the seven labels.
+    chars: [([u8; 2], [u8; 2]); 7],
+    cl: [C; 7],
+    /// `l_q = Re(Σ_m num[q][m] θ_idx[m] / Σ_m den[m] θ_idx[m])`.
+    num: [[C; 8]; 6],
+    den: [C; 8],
+    calibration: [f64; 7],
+}
+
+fn singular(reason: String) -> Error {
+    Error::InvalidArgument {
+        what: "state l0",
+        reason,
+    }
+}
+
+/// `x + X t` reduced to `[−1, 1]` modulo 2 with `X t` split error-free.
+#[inline(always)]
+fn phase_mod2(x0: f64, rate: f64, t: f64) -> f64 {
+    let p = rate * t;
+    let e = rate.mul_add(t, -p);
+    // p − 2 round(p/2) is exact (|result| ≤ 1 and both are multiples of ulp(p)).
+    let r = p - 2.0 * (0.5 * p).round();
+    let s = x0 + r + e;
+    s - 2.0 * (0.5 * s).round()
+}
+
+impl Solution {
+    /// Sets up the solution through `l0` for the top with parameters `a, b`.
+    ///
+    /// Errors ([`Error::InvalidArgument`] naming the reason): `l0 = 0`;
+    /// `h0 = 0`; `h1² = 4h0²`; coinciding branch points `d_j`; the divisor of
+    /// `l0` at infinity (`θ(v0) = 0`); and those of the reduction.
+    pub fn new(a: &[f64; 4], b: &[f64; 4], l0: &[f64; 6]) -> Result<Self> {
+        crate::error::check_finite("l0", l0)?;
+        let c = so4::manakov_c(a, b)?;
+        // State order (12, 13, 14, 23, 24, 34) from the row-major 4 × 4 matrix.
+        let c4 = [c[1], c[2], c[3], c[6], c[7], c[11]];
+        let size = l0.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        if size == 0.0 {
+            return Err(singular(
+                "l0 = 0: the rest state; the solution is l(t) = 0, there is no curve (8)".into(),
+            ));
+        }
+        let h = so4::integrals4(a, l0);
+        let s2 = size * size;
+        if h[0].abs() <= DEGENERATE_RTOL * s2 {
+            return Err(singular(format!(
+                "h0 = {:e} vanishes: the branch points d_0 = 0 and d_j coincide (F (19) has double \
+                 roots), the curve (8) degenerates; the solution exists in a limiting sense \
+                 (genus < 2, elementary functions), not as a genus-2 theta quotient",
+                h[0]
+            )));
+        }
+        let disc = h[1] * h[1] - 4.0 * h[0] * h[0];
+        if disc.abs() <= DEGENERATE_RTOL * (h[1] * h[1] + 4.0 * h[0] * h[0]) {
+            return Err(singular(format!(
+                "h1^2 - 4 h0^2 = {disc:e} vanishes (m = ±n, a self-dual state): F (19) is not \
+                 defined; the motion reduces to an so(3) top (elliptic functions), the \
+                 genus-2 solution exists only as a limit"
+            )));
+        }
+        let kotter = kotter_constants(a, l0).map_err(|e| match e {
+            Error::RepeatedBranchPoints { i, j, value } => coinciding(i, j, value),
+            other => other,
+        })?;
+        let state0 = kotter_with(kotter.clone(), l0).map_err(|e| match e {
+            Error::RepeatedBranchPoints { i, j, value } => coinciding(i, j, value),
+            other => other,
+        })?;
+        let bp = state0.curve.branch_points();
+        let curve = HyperellipticCurve::new(&bp).map_err(|e| match e {
+            Error::RepeatedBranchPoints { i, j, value } => coinciding(i, j, value),
+            other => other,
+        })?;
+        let tau_rm = curve.tau_row_major();
+        let tau: [C; 4] = [tau_rm[0], tau_rm[1], tau_rm[2], tau_rm[3]];
+        let plan = ThetaPlan::new(&tau, 2, THETA_TOL, 1)?.with_parallel(false);
+        let rcv = curve.try_riemann_constant()?;
+        let rc = [rcv[0], rcv[1]];
+
+        // Characteristics: χ_j = η(d_j) (index j of the branch points passed),
+        // χ_jk = χ_j + χ_k mod 2.
+        let mut eta = [([0u8; 2], [0u8; 2]); 5];
+        for (j, e) in eta.iter_mut().enumerate() {
+            let (ca, cb) = curve.try_branch_char(j)?;
+            *e = ([ca[0], ca[1]], [cb[0], cb[1]]);
+        }
+        let sum = |p: usize, q: usize| {
+            (
+                [(eta[p].0[0] + eta[q].0[0]) % 2, (eta[p].0[1] + eta[q].0[1]) % 2],
+                [(eta[p].1[0] + eta[q].1[0]) % 2, (eta[p].1[1] + eta[q].1[1]) % 2],
+            )
+        };
+        let mut chars = [([0u8; 2], [0u8; 2]); 7];
+        chars[0] = eta[0];
+        for (j, &(_, k, l)) in CYCLIC.iter().enumerate() {
+            chars[1 + j] = sum(k, l);
+            chars[4 + j] = sum(j + 1, 4);
+        }
+        let mut idx = [0usize; 8];
+        idx[0] = char_index(&[0, 0], &[0, 0])?;
+        for (m, ch) in chars.iter().enumerate() {
+            idx[m + 1] = char_index(&ch.0, &ch.1)?;
+        }
+
+        // The divisor of l0 and v0 = u(P1) + u(P2) + K.
+        let pts = &state0.points;
+        let ua = curve.abel(pts.z1, pts.y1)?;
+        let ub = curve.abel(pts.z2, pts.y2)?;
+        let u0 = [ua[0] + ub[0], ua[1] + ub[1]];
+        let v0 = [u0[0] + rc[0], u0[1] + rc[1]];
+        let jet = plan.jet(&v0, 1)?;
+        let big = jet.values.iter().fold(0.0f64, |m, v| m.max(v.norm()));
+        let th0 = jet.values[idx[0]];
+        if th0.norm() <= DIVISOR_AT_INFINITY_RTOL * big {
+            return Err(singular(format!(
+                "the divisor of l0 contains the point at infinity of the curve (8) \
+                 (|theta(v0)| = {:e} of max |theta[chi](v0)|): the P_L (34) have poles there; \
+                 the solution exists (take l0 at another time of the same trajectory)",
+                th0.norm() / big
+            )));
+        }
+
+        // P_L at l0 in the branch of the reduction: (37) inverted, P_0 from (31b).
+        let sc = state0.curve.c().map(sqrt_principal);
+        // g from (30a) (the reduction's inverse map, sign fixed by the corrected
+        // (42)); G = g (1 − ε P_0) is the constant of the corrected (42), here
+        // without the closed form of K (which cancels by ~1/|d_j − d_k|²).
+        let eps = eps41(&kotter);
+        let g = state0.points.g;
+        let big_g = g * (C::new(1.0, 0.0) - eps * state0.p0);
+        let mut p_at0 = [C::new(0.0, 0.0); 7];
+        p_at0[0] = state0.p0;
+        for j in 0..3 {
+            p_at0[1 + j] = state0.xi[j] / (sc[j] * g);
+            p_at0[4 + j] = state0.eta[j] / (sc[j] * g);
+        }
+        // C_L² at a well-conditioned auxiliary divisor, sign from l0.
+        let c2 = aux_constants_squared(&curve, &state0.curve, &plan, &idx, &rc)?;
+        let mut cl = [C::new(0.0, 0.0); 7];
+        let mut calibration = [0.0; 7];
+        for m in 0..7 {
+            let est = p_at0[m] * th0 / jet.values[idx[m + 1]];
+            let root = sqrt_principal(c2[m]);
+            let (plus, minus) = ((est - root).norm(), (est + root).norm());
+            cl[m] = if plus <= minus { root } else { -root };
+            calibration[m] = plus.min(minus) / root.norm();
+        }
+
+        // (37), (42), (23): l_q = N_q / D.
+        let mut den = [C::new(0.0, 0.0); 8];
+        den[0] = C::new(1.0, 0.0);
+        den[1] = -eps * cl[0];
+        let mut xi_w = [[C::new(0.0, 0.0); 8]; 3];
+        let mut eta_w = [[C::new(0.0, 0.0); 8]; 3];
+        for j in 0..3 {
+            xi_w[j][2 + j] = sc[j] * big_g * cl[1 + j];
+            eta_w[j][5 + j] = sc[j] * big_g * cl[4 + j];
+        }
+        let mut mw = [[C::new(0.0, 0.0); 8]; 3];
+        let mut nw = [[C::new(0.0, 0.0); 8]; 3];
+        for j in 0..3 {
+            for s in 0..8 {
+                mw[j][s] = kotter.alpha[j] * xi_w[j][s] + kotter.beta[j] * eta_w[j][s];
+                nw[j][s] = kotter.gamma[j] * xi_w[j][s] + kotter.delta[j] * eta_w[j][s];
+            }
+        }
+        let neg = |w: [C; 8]| w.map(|v| -v);
+        // l = (m3, −m2, n1, m1, n2, n3)
+        let num = [mw[2], neg(mw[1]), nw[0], mw[0], nw[1], nw[2]];
+
+        // U from (1): (∇N_q − l_q ∇D)·U = l̇_q D at v0.
+        let ldot = so4::vector_field4(&c4, l0);
+        let theta = |m: usize| jet.values[idx[m]];
+        let grad = |m: usize, k: usize| jet.gradient[idx[m] * 2 + k];
+        let dval: C = (0..8).map(|m| den[m] * theta(m)).sum();
+        let dgrad: [C; 2] = std::array::from_fn(|k| (0..8).map(|m| den[m] * grad(m, k)).sum());
+        let mut amat = DMatrix::<C>::zeros(6, 2);
+        let mut rhs = DVector::<C>::zeros(6);
+        for q in 0..6 {
+            let nval: C = (0..8).map(|m| num[q][m] * theta(m)).sum();
+            let lq = nval / dval;
+            let mut row = [C::new(0.0, 0.0); 2];
+            for k in 0..2 {
+                let ng: C = (0..8).map(|m| num[q][m] * grad(m, k)).sum();
+                row[k] = ng - lq * dgrad[k];
+            }
+            let r = C::new(ldot[q], 0.0) * dval;
+            // Rows scaled to unit size: each equation counts alike.
+            let w = row[0].norm().max(row[1].norm()).max(r.norm());
+            if w > 0.0 {
+                amat[(q, 0)] = row[0] / w;
+                amat[(q, 1)] = row[1] / w;
+                rhs[q] = r / w;
+            }
+        }
+        let svd = amat.clone().svd(true, true);
+        let sv = &svd.singular_values;
+        if !(sv[1] > 1e-12 * sv[0]) {
+            return Err(Error::InvalidArgument {
+                what: "state l0",
+                reason: format!(
+                    "the theta-quotient gradients at v0 are degenerate (singular values {:e}, {:e}): \
+                     U is not determined",
+                    sv[0], sv[1]
+                ),
+            });
+        }
+        let sol = svd.solve(&rhs, 0.0).map_err(|e| Error::InvalidArgument {
+            what: "U",
+            reason: e.to_string(),
+        })?;
+        let rate = [sol[0], sol[1]];
+        if !(rate.iter().all(|v| v.re.is_finite() && v.im.is_finite())) {
+            return Err(Error::NonFinite { what: "U", index: 0 });
+        }
+        let (x0, y0) = curve.lattice_coordinates(&v0);
+        let (xr, yr) = curve.lattice_coordinates(&rate);
+        Ok(Solution {
+            a: *a,
+            c4,
+            l0: *l0,
+            kotter,
+            state0,
+            curve,
+            plan,
+            tau,
+            rc,
+            u0,
+            rate,
+            lat0: [x0[0], x0[1], y0[0], y0[1]],
+            lat_rate: [xr[0], xr[1], yr[0], yr[1]],
+            idx,
+            chars,
+            cl,
+            num,
+            den,
+            calibration,
+        })
+    }
+
+    /// The state the solution starts from.
+    pub fn l0(&self) -> &[f64; 6] {
+        &self.l0
+    }
+
+    /// The parameters `a`.
+    pub fn a(&self) -> &[f64; 4] {
+        &self.a
+    }
+
+    /// The Manakov `c_ij` (2), state order.
+    pub fn c4(&self) -> &[f64; 6] {
+        &self.c4
+    }
+
+    /// The level-set constants of the reduction (fixed branches).
+    pub fn kotter(&self) -> &KotterConstants {
+        &self.kotter
+    }
+
+    /// The reduction of `l0`.
+    pub fn state0(&self) -> &KotterState {
+        &self.state0
+    }
+
+    /// The curve (8) with its homology basis, periods and Abel map.
+    pub fn curve(&self) -> &HyperellipticCurve {
+        &self.curve
+    }
+
+    /// `τ`, row-major.
+    pub fn tau(&self) -> [C; 4] {
+        self.tau
+    }
+
+    /// The vector of Riemann constants `K_R` (`v = u + K_R`).
+    pub fn riemann_constant(&self) -> [C; 2] {
+        self.rc
+    }
+
+    /// `u0 = u(P1) + u(P2)`, the Abel image of the divisor of `l0`.
+    pub fn u0(&self) -> [C; 2] {
+        self.u0
+    }
+
+    /// `U`: `u(t) = u0 + U t`.
+    pub fn rate(&self) -> [C; 2] {
+        self.rate
+    }
+
+    /// Characteristics `(a, b)` of [`LABELS`].
+    pub fn characteristics(&self) -> [([u8; 2], [u8; 2]); 7] {
+        self.chars
+    }
+
+    /// `C_L` of (34) for [`LABELS`]: `P_L = C_L θ[χ_L](v)/θ(v)`.
+    pub fn constants(&self) -> [C; 7] {
+        self.cl
+    }
+
+    /// `|C_L − P_L(l0) θ(v0)/θ[χ_L](v0)| / |C_L|`: the agreement of the
+    /// auxiliary-divisor constants with the initial state.
+    pub fn calibration(&self) -> [f64; 7] {
+        self.calibration
+    }
+
+    /// Coefficients of (9)–(10) as they read: `l_q = N_q/D`,
+    /// `N_q = Σ_m num[q][m] θ[idx[m]]`, `D = Σ_m den[m] θ[idx[m]]`.
+    pub fn quotient(&self) -> ([usize; 8], [[C; 8]; 6], [C; 8]) {
+        (self.idx, self.num, self.den)
+    }
+
+    /// The Abel image `u(P1) + u(P2)` of a state on the same level set (the
+    /// branches of `l0`'s reduction), modulo the lattice.
+    pub fn abel(&self, l: &[f64; 6]) -> Result<[C; 2]> {
+        let st = kotter_with(self.kotter.clone(), l)?;
+        let p = &st.points;
+        let ua = self.curve.abel(p.z1, p.y1)?;
+        let ub = self.curve.abel(p.z2, p.y2)?;
+        Ok([ua[0] + ub[0], ua[1] + ub[1]])
+    }
+
+    /// `v(t) = v0 + U t` reduced modulo twice the lattice.
+    #[inline]
+    pub fn v_reduced(&self, t: f64) -> [C; 2] {
+        let x = [
+            phase_mod2(self.lat0[0], self.lat_rate[0], t),
+            phase_mod2(self.lat0[1], self.lat_rate[1], t),
+        ];
+        let y = [
+            phase_mod2(self.lat0[2], self.lat_rate[2], t),
+            phase_mod2(self.lat0[3], self.lat_rate[3], t),
+        ];
+        [
+            C::new(x[0], 0.0) + self.tau[0] * y[0] + self.tau[1] * y[1],
+            C::new(x[1], 0.0) + self.tau[2] * y[0] + self.tau[3] * y[1],
+        ]
+    }
+
+    fn combine(&self, vals: &[C], out: &mut [f64]) {
+        let th: [C; 8] = std::array::from_fn(|m| vals[self.idx[m]]);
+        let d: C = (0..8).map(|m| self.den[m] * th[m]).sum();
+        let dinv = d.inv();
+        for q in 0..6 {
+            let n: C = self.num[q]
+                .iter()
+                .zip(th.iter())
+                .map(|(w, t)| w * t)
+                .sum();
+            out[q] = (n * dinv).re;
+        }
+    }
+
+    fn eval_serial(&self, t: &[f64], out: &mut [f64]) -> Result<()> {
+        let n = t.len();
+        let mut z = vec![C::new(0.0, 0.0); 2 * n];
+        for (i, &ti) in t.iter().enumerate() {
+            let v = self.v_reduced(ti);
+            z[2 * i] = v[0];
+            z[2 * i + 1] = v[1];
+        }
+        let mut vals = vec![C::new(0.0, 0.0); 16 * n];
+        let mut ls = vec![0.0; n];
+        self.plan
+            .eval_batch(&z, &mut vals, &mut [], &mut [], &mut ls)?;
+        for i in 0..n {
+            self.combine(&vals[16 * i..16 * i + 16], &mut out[6 * i..6 * i + 6]);
+        }
+        Ok(())
+    }
+
+    /// `l(t_k)` into `out` (row-major `(N, 6)`); rayon for large batches,
+    /// `cancel` checked between chunks.
+    ///
+    /// Errors: non-finite `t`, wrong `out` size, [`Error::Interrupted`].
+    pub fn l_batch(&self, t: &[f64], out: &mut [f64], cancel: &Cancel) -> Result<()> {
+        if out.len() != 6 * t.len() {
+            return Err(Error::Shape {
+                what: "out",
+                expected: format!("({}, 6)", t.len()),
+                got: format!("{} entries", out.len()),
+            });
+        }
+        crate::error::check_finite("t", t)?;
+        let threads = rayon::current_num_threads();
+        let unit = CHUNK * threads.max(1);
+        for (tc, oc) in t.chunks(unit).zip(out.chunks_mut(6 * unit)) {
+            cancel.check()?;
+            if threads > 1 && tc.len() >= 2 * PAR_PIECE {
+                let piece = tc.len().div_ceil(4 * threads).max(PAR_PIECE);
+                tc.par_chunks(piece)
+                    .zip(oc.par_chunks_mut(6 * piece))
+                    .try_for_each(|(tp, op)| self.eval_serial(tp, op))?;
+            } else {
+                self.eval_serial(tc, oc)?;
+            }
+        }
+        Ok(())
+    }
+
+    /// `l(t)` at one time.
+    pub fn l(&self, t: f64) -> Result<[f64; 6]> {
+        let mut out = [0.0; 6];
+        self.l_batch(&[t], &mut out, &Cancel::never())?;
+        Ok(out)
+    }
+}
+
+/// `ε` by the corrected (41), in root differences of `F`, the sign nearest to
+/// the reduction's `ε` (corrected (40)).
+fn eps41(k: &KotterConstants) -> C {
+    let s = k.s;
+    let sq = sqrt_principal;
+    let sd4 = k.sqrt_d[0] * k.sqrt_d[1] * k.sqrt_d[2];
+    let e = (sq((s[1] - s[2]) * (s[0] - s[3])) - sq((s[0] - s[2]) * (s[1] - s[3])))
+        / (sd4 * sq((s[0] - s[1]) * (s[2] - s[3])));
+    if (e - k.eps).norm() <= (e + k.eps).norm() {
+        e
+    } else {
+        -e
+    }
+}
+
+fn coinciding(i: usize, j: usize, value: C) -> Error {
+    singular(format!(
+        "branch points d{i} and d{j} of the curve (8) coincide (= {value}){}: the genus drops, \
+         the motion is degenerate (the solution exists as a limit in lower-genus functions)",
+        if i == 0 || j == 0 {
+            ", i.e. h0 = 0 or a vanishing d_j"
+        } else {
+            ""
+        }
+    ))
+}
+
+/// `C_L² = P_L² θ(v)²/θ_L(v)²` at the best of a few fixed divisors (the one
+/// whose smallest needed `|θ[χ](v)|` is largest relative to the largest).
+fn aux_constants_squared(
+    curve: &HyperellipticCurve,
+    kc: &KotterCurve,
+    plan: &ThetaPlan,
+    idx: &[usize; 8],
+    rc: &[C; 2],
+) -> Result<[C; 7]> {
+    let bp = kc.branch_points();
+    let center: C = bp.iter().sum::<C>() / 5.0;
+    let radius = bp
+        .iter()
+        .fold(0.0f64, |m, d| m.max((d - center).norm()))
+        .max(f64::MIN_POSITIVE);
+    // Fixed generic offsets in units of the radius (off the real axis, both sheets).
+    const W: [(f64, f64, f64, f64); 4] = [
+        (0.37, 0.61, -0.53, -0.29),
+        (-0.71, 0.43, 0.58, 0.47),
+        (0.12, -0.77, -0.41, 0.66),
+        (0.83, 0.21, -0.19, -0.88),
+    ];
+    let mut best: Option<(f64, [C; 7])> = None;
+    for (k, &(a1, b1, a2, b2)) in W.iter().enumerate() {
+        let x1 = center + C::new(a1, b1) * (1.3 * radius);
+        let x2 = center + C::new(a2, b2) * (1.3 * radius);
+        let y1 = curve.y(x1, 1);
+        let y2 = curve.y(x2, if k % 2 == 0 { -1 } else { 1 });
+        let ua = curve.abel(x1, y1)?;
+        let ub = curve.abel(x2, y2)?;
+        let v = [ua[0] + ub[0] + rc[0], ua[1] + ub[1] + rc[1]];
+        let (vals, _) = plan.theta_all(&v)?;
+        let big = vals.iter().fold(0.0f64, |m, z| m.max(z.norm()));
+        let q = idx
+            .iter()
+            .map(|&i| vals[i].norm() / big)
+            .fold(f64::INFINITY, f64::min);
+        if best.as_ref().is_some_and(|(bq, _)| *bq >= q) {
+            continue;
+        }
+        let w = kc.wurzel(x1, y1, x2, y2, None)?;
+        let p: [C; 7] = [
+            w.p[0],
+            w.pjk[2][3],
+            w.pjk[3][1],
+            w.pjk[1][2],
+            w.pjk[1][4],
+            w.pjk[2][4],
+            w.pjk[3][4],
+        ];
+        let th = vals[idx[0]];
+        let c2: [C; 7] = std::array::from_fn(|m| {
+            let r = p[m] * th / vals[idx[m + 1]];
+            r * r
+        });
+        best = Some((q, c2));
+    }
+    best.map(|(_, c)| c).ok_or(Error::InvalidArgument {
+        what: "curve",
+        reason: "no auxiliary divisor".into(),
+    })
+}
+
+#[cfg(test)]
+mod tests;

@@ -1,0 +1,66 @@
+use super::*;
+use crate::integrate::{integrate, Method, Options};
+use crate::so4::FrahmTop;
+
+/// The four shared tops of /work/shared/reference/problems.json.
+const TOPS: [([f64; 4], [f64; 4], [f64; 6]); 4] = [
+    ([0.3, 1.1, 2.0, 3.7], [0.5, -0.2, 1.4, 0.9], [0.8, -0.3, 0.5, 1.1, -0.7, 0.2]),
+    ([1.0, 2.25, 4.84, 9.61], [1.0, 1.5, 2.2, 3.1], [0.4, 1.2, -0.6, 0.9, 0.3, -1.0]),
+    ([0.01, 1.0, 10.0, 100.0], [2.0, -1.0, 0.5, 3.0], [1.0, 0.5, -0.25, 0.75, -1.5, 0.1]),
+    ([1.0, 1.000001, 2.0, 3.0], [0.3, 0.300002, -0.4, 1.2], [0.2, -0.9, 0.4, 0.6, 1.1, -0.3]),
+];
+
+/// Agreement with gauss16 (dt = 1e-2, error ~1e-15 per unit time) over
+/// [0, 10]: the figure (the Python tests assert it on [0, 100]).
+const SHORT_RTOL: f64 = 1e-11;
+
+/// near_degenerate (d_1 − d_2 = 3.8e-5): the reduction's constants
+/// (`α_j … δ_j`, `d_j`, conditioned like `u/δ²`) leave the U-system
+/// inconsistent at ~1e-11, so U and the phase carry ~1e-11 relative
+/// (measured 3.9e-10 over [0, 10]); a documented shortfall (docs/theorem.md).
+const NEAR_DEGENERATE_RTOL: f64 = 1e-9;
+
+fn max_rel(a: &[f64], b: &[f64], scale: f64) -> f64 {
+    a.iter().zip(b).fold(0.0f64, |m, (x, y)| m.max((x - y).abs())) / scale
+}
+
+#[test]
+fn theta_solution_matches_integration_on_the_four_tops() {
+    for (n, (a, b, l0)) in TOPS.into_iter().enumerate() {
+        let sol = Solution::new(&a, &b, &l0).unwrap();
+        let top = FrahmTop::manakov(&a, &b).unwrap();
+        let times: Vec<f64> = (1..=20).map(|k| 0.5 * k as f64).collect();
+        let opts = Options {
+            method: Method::Gauss16,
+            dt: 1e-2,
+            rtol: 0.0,
+            atol: 0.0,
+            max_steps: 10_000_000,
+        };
+        let traj = integrate(&top, &l0, 0.0, &times, &opts).unwrap();
+        let mut out = vec![0.0; 6 * times.len()];
+        sol.l_batch(&times, &mut out, &Cancel::never()).unwrap();
+        let scale = l0.iter().map(|v| v * v).sum::<f64>().sqrt();
+        let err = max_rel(&out, &traj.y, scale);
+        let l_start = sol.l(0.0).unwrap();
+        let tol = if n == 3 { NEAR_DEGENERATE_RTOL } else { SHORT_RTOL };
+        assert!(err <= tol, "a = {a:?}: {err:e}");
+        assert!(max_rel(&l_start, &l0, scale) <= tol, "a = {a:?}: l(0)");
+    }
+}
+
+#[test]
+fn phase_reduction_is_exact_for_large_t() {
+    // (x0 + X t) mod 2 against an exact rational evaluation: X = 3/7 rounded,
+    // t = 10^6 + 1/4 (both exact doubles), x0 = 1/8.
+    let rate = 3.0 / 7.0;
+    let t = 1.0e6 + 0.25;
+    let r = phase_mod2(0.125, rate, t);
+    // exact: rate * t = rate*1e6 + rate/4, with rate's exact binary value
+    let hi = rate * 1.0e6;
+    let lo = rate.mul_add(1.0e6, -hi) + rate * 0.25;
+    let mut ex = (hi - 2.0 * (0.5 * hi).round()) + lo + 0.125;
+    ex -= 2.0 * (0.5 * ex).round();
+    assert!((r - ex).abs() <= 4.0 * f64::EPSILON, "{r} vs {ex}");
+}
+
