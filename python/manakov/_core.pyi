@@ -15,6 +15,7 @@ __all__ = [
     "curve_wurzel",
     "curve_xi_eta",
     "HyperellipticCore",
+    "frequency_map",
     "gauss_tableau",
     "hamiltonian",
     "integrate",
@@ -33,6 +34,7 @@ __all__ = [
     "theta_jet",
     "theta_plan_info",
     "tori_status_names",
+    "torus_of_state",
     "vector_field",
     "__version__",
 ]
@@ -212,3 +214,14 @@ def real_torus(
     chars: npt.NDArray[np.uint8],
 ) -> tuple[npt.NDArray[np.complex128], npt.NDArray[np.int64], npt.NDArray[np.float64]]: ...
 def tori_status_names() -> list[str]: ...
+def frequency_map(
+    a: npt.NDArray[np.float64], b: npt.NDArray[np.float64], states: npt.NDArray[np.float64]
+) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.uint8]]: ...
+def torus_of_state(
+    a: npt.NDArray[np.float64], b: npt.NDArray[np.float64], l0: npt.NDArray[np.float64]
+) -> tuple[
+    npt.NDArray[np.complex128],
+    npt.NDArray[np.int64],
+    npt.NDArray[np.float64],
+    npt.NDArray[np.complex128],
+]: ...

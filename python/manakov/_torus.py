@@ -13,7 +13,7 @@ import numpy as np
 
 from . import _core
 
-__all__ = ["Torus", "real_torus", "second_flow_b"]
+__all__ = ["Torus", "real_torus", "second_flow_b", "torus_of_state"]
 
 
 class Torus(NamedTuple):
@@ -121,3 +121,32 @@ def second_flow_b(a: Any, b: Any) -> np.ndarray:
     p = np.linalg.solve(np.vander(aa, 4, increasing=True), bb)
     s = float(np.max(np.abs(aa)))
     return aa**3 if abs(p[2]) > abs(p[3]) * s else aa**2
+
+
+def torus_of_state(a: Any, b: Any, l0: Any) -> tuple[Torus, np.ndarray]:
+    """The real torus through ``l0`` of the top ``(a, b)`` and the second velocity ``U'``.
+
+    Runs the Theorem's set-up for ``l0`` (``ManakovTop(a, b).solve(l0)``), takes
+    ``U'`` of the second flow (:func:`second_flow_b`) from the same equations
+    with Frahm's vector field (1) of that flow on the right-hand side, and
+    returns :func:`real_torus` of ``(τ, U, U')``.
+
+    Parameters
+    ----------
+    a, b : array_like, shape (4,)
+    l0 : array_like, shape (6,)
+
+    Returns
+    -------
+    torus : Torus
+    U2 : ndarray, complex, shape (2,)
+
+    Raises
+    ------
+    ValueError
+        On a singular level set (the solution's message names the case) or
+        when the lattice of periods has no rank-2 part in the real plane.
+    """
+    arr = [np.ascontiguousarray(np.asarray(x, dtype=float)) for x in (a, b, l0)]
+    lam, coords, nu, u2 = _core.torus_of_state(*arr)
+    return Torus(_readonly(lam), _readonly(coords), _readonly(nu)), _readonly(u2)

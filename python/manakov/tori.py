@@ -31,7 +31,7 @@ import numpy as np
 
 from . import _core
 from ._progress import ProgressBar
-from ._torus import Torus, real_torus, second_flow_b
+from ._torus import Torus, real_torus, second_flow_b, torus_of_state
 from .problems import problem
 from .top import ManakovTop
 
@@ -42,6 +42,7 @@ __all__ = [
     "Torus",
     "real_torus",
     "second_flow_b",
+    "torus_of_state",
     "frequency_map",
     "casimir_slice",
     "plot_frequency_map",
@@ -178,10 +179,11 @@ def frequency_map(
     """Frequencies ``(ν1, ν2)`` of the real tori through many initial states.
 
     For each state ``l0`` the chain of the Theorem (9)–(10) gives ``τ``,
-    ``U`` and the characteristics of ``l``; the second flow ``U'`` (the
-    Manakov top ``b' = a²``, or ``b' = a³`` when the top's own ``b`` is
-    quadratic in ``a``) spans the real plane with ``U``; then
-    ``U = ν1 λ1 + ν2 λ2`` on the reduced basis of :func:`real_torus`.
+    ``U`` and the characteristics of ``l``; the velocity ``U'`` of a second
+    commuting flow (the Manakov top with ``b'`` of :func:`second_flow_b`, from
+    the same equations) spans the real plane with ``U``; then
+    ``U = ν1 λ1 + ν2 λ2`` on the reduced basis of :func:`real_torus`
+    (:func:`torus_of_state` for one state, with the basis).
 
     Parameters
     ----------
@@ -299,7 +301,7 @@ def plot_frequency_map(
     path: str | os.PathLike[str],
     *,
     client: Any = None,
-    max_order: int = 6,
+    max_order: int = 5,
     progress: bool | None = None,
     dpi: int = 120,
 ) -> FrequencyMap:
@@ -338,6 +340,7 @@ def plot_frequency_map(
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
+    from matplotlib.colors import LogNorm
 
     pr = problem(problem_name)
     top = ManakovTop(pr.a, pr.b)
@@ -350,15 +353,23 @@ def plot_frequency_map(
     fig, ax = plt.subplots(figsize=(7, 5.5))
     ax.set_facecolor("0.6")
     masked = np.ma.masked_invalid(ratio)
-    mesh = ax.pcolormesh(phi, ct, masked, shading="nearest", cmap="viridis")
+    norm = None
+    good = ratio[np.isfinite(ratio) & (ratio > 0)]
+    if good.size:
+        # Log scale between the 1st and 99th percentiles: the rotation number
+        # spans decades near separatrices (one frequency goes to zero).
+        lo, hi = np.percentile(good, [1, 99])
+        if hi > lo:
+            norm = LogNorm(vmin=lo, vmax=hi)
+    mesh = ax.pcolormesh(phi, ct, masked, shading="nearest", cmap="viridis", norm=norm)
     fig.colorbar(mesh, ax=ax, label="rotation number ν1/ν2")
-    if np.any(ok):
-        lo, hi = np.nanmin(ratio), np.nanmax(ratio)
+    if good.size:
+        lo, hi = float(good.min()), float(good.max())
         levels = sorted(
             {
                 float(Fraction(k2, k1))
                 for k1 in range(1, max_order + 1)
-                for k2 in range(0, max_order + 1 - k1)
+                for k2 in range(1, max_order + 1 - k1)
                 if lo < k2 / k1 < hi
             }
         )

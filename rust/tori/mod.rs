@@ -30,6 +30,7 @@
 //! in waves between which the caller's [`Cancel`] is checked; the results do
 //! not depend on the number of threads or on how the batch is split.
 
+pub mod solve;
 #[cfg(test)]
 mod tests;
 
@@ -553,13 +554,14 @@ where
     Ok(out)
 }
 
-/// What [`frequencies_of_state`] needs of the Theorem's solution of one top
-/// at one state: the period matrix, the velocity `U` and the characteristics
-/// of the quotients that enter `l`.
+/// What [`frequencies_of_state`] needs of the Theorem's solution at one
+/// state: the period matrix, the velocity `U` of the top, the velocity `U'`
+/// of the second flow, and the characteristics of the quotients in `l`.
 #[derive(Debug, Clone, PartialEq)]
 pub struct FlowData {
     pub tau: Tau,
     pub u: C2,
+    pub u2: C2,
     pub chars: Vec<Char>,
 }
 
@@ -581,24 +583,18 @@ pub fn second_flow_b(a: &[f64; 4], b: &[f64; 4]) -> [f64; 4] {
 }
 
 /// Relative size of `h1² − 4h0²` below which a state counts as on the
-/// singular level set `h1² = 4h0²` (status 1): `F(s)` of (19) divides by it,
-/// and the reduction's roots lose all digits well before it is zero.
-pub const CASIMIR_SINGULAR_RTOL: f64 = 1e-12;
+/// singular level set `h1² = 4h0²` (status 1): `F(s)` of (19) divides by it.
+/// The solution refuses below 1e-13 (`solution::DEGENERATE_RTOL`); this
+/// pre-check only saves its set-up and reports the same code.
+pub const CASIMIR_SINGULAR_RTOL: f64 = 1e-13;
 
 /// The status and frequencies of one state.
 ///
-/// `solve(b, l0)` runs the Theorem for the top `(a, b)` (the caller closes
-/// over `a`); it is called for the top's `b` and for [`second_flow_b`].
-/// Errors become status codes by `classify`; nothing here panics or raises.
-pub fn frequencies_of_state<S, K>(
-    b: &[f64; 4],
-    b2: &[f64; 4],
-    l0: &[f64; 6],
-    solve: S,
-    classify: K,
-) -> MapEntry
+/// `solve(l0)` runs the Theorem and returns [`FlowData`]; its errors become
+/// status codes by `classify`. Nothing here panics or raises.
+pub fn frequencies_of_state<S, K>(l0: &[f64; 6], solve: S, classify: K) -> MapEntry
 where
-    S: Fn(&[f64; 4], &[f64; 6]) -> Result<FlowData>,
+    S: Fn(&[f64; 6]) -> Result<FlowData>,
     K: Fn(&Error) -> Status,
 {
     if l0.iter().any(|v| !v.is_finite()) {
@@ -610,18 +606,15 @@ where
     let [l12, l13, l14, l23, l24, l34] = *l0;
     let h0 = l12 * l34 - l13 * l24 + l14 * l23;
     let h1: f64 = l0.iter().map(|v| v * v).sum();
-    if (h1 * h1 - 4.0 * h0 * h0).abs() <= CASIMIR_SINGULAR_RTOL * h1 * h1 {
+    let disc = h1 * h1 - 4.0 * h0 * h0;
+    if disc.abs() <= CASIMIR_SINGULAR_RTOL * (h1 * h1 + 4.0 * h0 * h0) {
         return MapEntry::failed(Status::SingularCasimirs);
     }
-    let first = match solve(b, l0) {
+    let d = match solve(l0) {
         Ok(d) => d,
         Err(e) => return MapEntry::failed(classify(&e)),
     };
-    let second = match solve(b2, l0) {
-        Ok(d) => d,
-        Err(e) => return MapEntry::failed(classify(&e)),
-    };
-    match real_torus(&first.tau, &first.u, &second.u, &first.chars) {
+    match real_torus(&d.tau, &d.u, &d.u2, &d.chars) {
         Ok(t) => MapEntry {
             status: Status::Ok,
             nu: t.nu,

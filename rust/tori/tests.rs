@@ -314,10 +314,10 @@ fn second_flow_is_the_other_power() {
 
 #[test]
 fn state_statuses_and_nan_policy() {
-    // A stand-in for the Theorem: the plane of `real_plane_of_a_diagonal_tau`
-    // for every b, or an error chosen by the state.
+    // A stand-in for the Theorem: the plane of `real_plane_of_a_diagonal_tau`,
+    // or an error chosen by the state.
     let tau = [[c(0.0, 1.3), c(0.0, 0.0)], [c(0.0, 0.0), c(0.0, 0.8)]];
-    let solve = |b: &[f64; 4], l0: &[f64; 6]| -> Result<FlowData> {
+    let solve = |l0: &[f64; 6]| -> Result<FlowData> {
         if l0[0] > 10.0 {
             return Err(Error::RepeatedBranchPoints {
                 i: 1,
@@ -325,14 +325,10 @@ fn state_statuses_and_nan_policy() {
                 value: c(1.0, 0.0),
             });
         }
-        let u = if b[0] == 1.0 {
-            [c(0.37, 0.0), c(0.52, 0.0)]
-        } else {
-            [c(-0.2, 0.0), c(0.9, 0.0)]
-        };
         Ok(FlowData {
             tau,
-            u,
+            u: [c(0.37, 0.0), c(0.52, 0.0)],
+            u2: [c(-0.2, 0.0), c(0.9, 0.0)],
             chars: SIMPLE.to_vec(),
         })
     };
@@ -340,8 +336,7 @@ fn state_statuses_and_nan_policy() {
         Error::RepeatedBranchPoints { .. } => Status::CoincidingBranchPoints,
         _ => Status::Singular,
     };
-    let (b, b2) = ([1.0; 4], [2.0; 4]);
-    let run = |l0: [f64; 6]| frequencies_of_state(&b, &b2, &l0, solve, classify);
+    let run = |l0: [f64; 6]| frequencies_of_state(&l0, solve, classify);
     let ok = run([0.8, -0.3, 0.5, 1.1, -0.7, 0.2]);
     assert_eq!(ok.status, Status::Ok);
     assert!((ok.nu[0] - 0.185).abs() < 1e-15 && (ok.nu[1] - 0.26).abs() < 1e-15);
@@ -361,5 +356,116 @@ fn state_statuses_and_nan_policy() {
     );
     for l0 in [[0.0; 6], [11.0, 0.0, 0.0, 0.0, 1.0, 0.0]] {
         assert!(run(l0).nu.iter().all(|v| v.is_nan()));
+    }
+}
+
+mod on_the_solution {
+    use super::super::solve::{c_pairs, flow_data, rate_for, state_frequencies, torus_of_state};
+    use super::super::*;
+    use crate::solution::Solution;
+
+    const GENERIC: ([f64; 4], [f64; 4], [f64; 6]) = (
+        [0.3, 1.1, 2.0, 3.7],
+        [0.5, -0.2, 1.4, 0.9],
+        [0.8, -0.3, 0.5, 1.1, -0.7, 0.2],
+    );
+
+    #[test]
+    fn rate_for_the_tops_own_field_is_the_solutions_rate() {
+        let (a, b, l0) = GENERIC;
+        let s = Solution::new(&a, &b, &l0).unwrap();
+        let u = rate_for(&s, s.c4()).unwrap();
+        let r = s.rate();
+        for k in 0..2 {
+            // The solution fits the ξ, η rows, rate_for the l rows: two fits
+            // of one consistent system, equal to the solution's accuracy.
+            assert!((u[k] - r[k]).norm() <= 1e-10 * r[0].norm().max(r[1].norm()));
+        }
+    }
+
+    #[test]
+    fn velocities_are_linear_in_b() {
+        // c_ij is linear in b, so U(b) = p2 U(a²) + p3 U(a³) for the cubic
+        // interpolant b = p0 + p1 a + p2 a² + p3 a³ (docs/tori.md §2).
+        let (a, b, l0) = GENERIC;
+        let s = Solution::new(&a, &b, &l0).unwrap();
+        let c_of = |bb: [f64; 4]| c_pairs(&a, &bb).unwrap();
+        let u2 = rate_for(&s, &c_of(a.map(|x| x * x))).unwrap();
+        let u3 = rate_for(&s, &c_of(a.map(|x| x * x * x))).unwrap();
+        let v = nalgebra::Matrix4::from_fn(|i, j| a[i].powi(j as i32));
+        let p = v
+            .lu()
+            .solve(&nalgebra::Vector4::from_column_slice(&b))
+            .unwrap();
+        let r = s.rate();
+        for k in 0..2 {
+            let lin = u2[k] * p[2] + u3[k] * p[3];
+            assert!(
+                (lin - r[k]).norm() <= 1e-12 * r[0].norm().max(r[1].norm()),
+                "{lin} vs {}",
+                r[k]
+            );
+        }
+    }
+
+    #[test]
+    fn second_velocity_agrees_with_a_second_solution() {
+        // U' by rate_for (the l rows of (9)–(10) at v0) against the set-up of
+        // ManakovTop(a, a²) itself (its own U): the same curve and divisor
+        // (the reduction depends on a and l0 only), so the same vector.
+        for (a, b, l0) in [
+            GENERIC,
+            (
+                [1.0, 2.25, 4.84, 9.61],
+                [1.0, 1.5, 2.2, 3.1],
+                [0.4, 1.2, -0.6, 0.9, 0.3, -1.0],
+            ),
+        ] {
+            let s = Solution::new(&a, &b, &l0).unwrap();
+            let b2 = a.map(|x| x * x);
+            let u2 = rate_for(&s, &c_pairs(&a, &b2).unwrap()).unwrap();
+            let r = Solution::new(&a, &b2, &l0).unwrap().rate();
+            let scale = r[0].norm().max(r[1].norm());
+            for k in 0..2 {
+                // Two least-squares fits of the same consistent system with
+                // different row sets/weights: agreement to the solution's ~1e-12.
+                assert!(
+                    (u2[k] - r[k]).norm() <= 1e-10 * scale,
+                    "{} vs {}",
+                    u2[k],
+                    r[k]
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn frequencies_of_the_generic_top_are_positive_and_rebuild_u() {
+        let (a, b, l0) = GENERIC;
+        let (t, _) = torus_of_state(&a, &b, &l0).unwrap();
+        let s = Solution::new(&a, &b, &l0).unwrap();
+        let d = flow_data(&s, &second_flow_b(&a, &b)).unwrap();
+        assert!(t.nu[0] > 0.0 && t.nu[1] > 0.0);
+        for k in 0..2 {
+            let f = t.lambda[0][k] * t.nu[0] + t.lambda[1][k] * t.nu[1];
+            assert!((f - d.u[k]).norm() <= 1e-12);
+        }
+        for x in &t.coords {
+            assert!(is_period(&d.chars, x));
+        }
+        let e = state_frequencies(&a, &b, &l0);
+        assert_eq!(e.status, Status::Ok);
+        assert_eq!(e.nu, t.nu);
+    }
+
+    #[test]
+    fn singular_states_get_their_codes() {
+        let (a, b, _) = GENERIC;
+        // h0 = 0: d_0 = 0 coincides with a branch point.
+        let e = state_frequencies(&a, &b, &[1.0, 0.0, 0.0, 0.0, 0.5, 0.0]);
+        assert_eq!(e.status, Status::CoincidingBranchPoints);
+        assert!(e.nu.iter().all(|v| v.is_nan()));
+        let e = state_frequencies(&a, &b, &[0.3, -0.2, 0.5, 0.5, 0.2, 0.3]);
+        assert_eq!(e.status, Status::SingularCasimirs);
     }
 }
