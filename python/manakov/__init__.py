@@ -10,6 +10,7 @@ from .curve import CurvePoints, KotterCurve, Wurzel
 from .problems import Problem, benchmark_setup, problem, problem_names
 from .reduction import Kotter, from_kotter, kotter
 from .riemann import HyperellipticCurve
+from .solution import Solution
 from .theta import (
     CHARACTERISTICS,
     PAPER_CHARACTERISTICS,
@@ -58,6 +59,7 @@ __all__ = [
     "Problem",
     "problem_names",
     "real_torus",
+    "Solution",
     "theta",
     "theta_all",
     "theta_jet",

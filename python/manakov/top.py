@@ -754,6 +754,29 @@ class ManakovTop(FrahmTop):
         self._require_so4("from_kotter")
         return _from_kotter(self._a, self._b, k)
 
+    def solve(self, l0: Any) -> Any:
+        """The explicit solution (9)–(10) through ``l0``: ``l(t)`` as theta quotients.
+
+        Parameters
+        ----------
+        l0 : array_like, shape (6,)
+
+        Returns
+        -------
+        manakov.solution.Solution
+            ``.l(t)``, ``.u0``, ``.U``, ``.tau``, ``.curve``, ``.characteristics``,
+            ``.constants``, ``.abel(l)``.
+
+        Raises
+        ------
+        ValueError
+            Not an so(4) top, or a singular state (the message names the reason).
+        """
+        from .solution import Solution
+
+        self._require_so4("solve")
+        return Solution(self.a, self.b, l0)
+
     def _require_so4(self, what: str) -> None:
         if self.n != 4:
             raise ValueError(f"{what} is defined for so(4) only (n = 4), this top has n = {self.n}")

@@ -13,6 +13,7 @@ mod errors;
 mod kotter;
 mod riemann;
 mod so4;
+mod solution;
 mod theta;
 mod tori;
 
@@ -32,6 +33,7 @@ mod _core {
         curve::register(m)?;
         tori::register(m)?;
         riemann::register(m)?;
+        solution::register(m)?;
         Ok(())
     }
 }

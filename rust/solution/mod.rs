@@ -177,8 +177,14 @@ impl Solution {
         }
         let sum = |p: usize, q: usize| {
             (
-                [(eta[p].0[0] + eta[q].0[0]) % 2, (eta[p].0[1] + eta[q].0[1]) % 2],
-                [(eta[p].1[0] + eta[q].1[0]) % 2, (eta[p].1[1] + eta[q].1[1]) % 2],
+                [
+                    (eta[p].0[0] + eta[q].0[0]) % 2,
+                    (eta[p].0[1] + eta[q].0[1]) % 2,
+                ],
+                [
+                    (eta[p].1[0] + eta[q].1[0]) % 2,
+                    (eta[p].1[1] + eta[q].1[1]) % 2,
+                ],
             )
         };
         let mut chars = [([0u8; 2], [0u8; 2]); 7];
@@ -259,8 +265,14 @@ impl Solution {
         // l = (m3, −m2, n1, m1, n2, n3)
         let num = [mw[2], neg(mw[1]), nw[0], mw[0], nw[1], nw[2]];
 
-        // U from (1): (∇N_q − l_q ∇D)·U = l̇_q D at v0.
+        // U from (1). ξ, η are linear in l with the constant coefficients of
+        // (20), (22), so ξ̇ = ξ(l̇); and ξ_j = Nξ_j(v)/D(v) gives
+        // (∇Nξ_j − ξ_j ∇D)·U = ξ̇_j D at v0 (likewise η): six equations for
+        // the two components of U. (Working in ξ, η rather than l keeps the
+        // inverse map (23), whose α_j … δ_j are the least accurate constants
+        // of the reduction, out of U.)
         let ldot = so4::vector_field4(&c4, l0);
+        let (xi_dot, eta_dot) = crate::kotter::xi_eta(&kotter, &ldot);
         let theta = |m: usize| jet.values[idx[m]];
         let grad = |m: usize, k: usize| jet.gradient[idx[m] * 2 + k];
         let dval: C = (0..8).map(|m| den[m] * theta(m)).sum();
@@ -268,20 +280,25 @@ impl Solution {
         let mut amat = DMatrix::<C>::zeros(6, 2);
         let mut rhs = DVector::<C>::zeros(6);
         for q in 0..6 {
-            let nval: C = (0..8).map(|m| num[q][m] * theta(m)).sum();
-            let lq = nval / dval;
+            let (w, dot) = if q < 3 {
+                (&xi_w[q], xi_dot[q])
+            } else {
+                (&eta_w[q - 3], eta_dot[q - 3])
+            };
+            let nval: C = (0..8).map(|m| w[m] * theta(m)).sum();
+            let xq = nval / dval;
             let mut row = [C::new(0.0, 0.0); 2];
             for k in 0..2 {
-                let ng: C = (0..8).map(|m| num[q][m] * grad(m, k)).sum();
-                row[k] = ng - lq * dgrad[k];
+                let ng: C = (0..8).map(|m| w[m] * grad(m, k)).sum();
+                row[k] = ng - xq * dgrad[k];
             }
-            let r = C::new(ldot[q], 0.0) * dval;
+            let r = dot * dval;
             // Rows scaled to unit size: each equation counts alike.
-            let w = row[0].norm().max(row[1].norm()).max(r.norm());
-            if w > 0.0 {
-                amat[(q, 0)] = row[0] / w;
-                amat[(q, 1)] = row[1] / w;
-                rhs[q] = r / w;
+            let sz = row[0].norm().max(row[1].norm()).max(r.norm());
+            if sz > 0.0 {
+                amat[(q, 0)] = row[0] / sz;
+                amat[(q, 1)] = row[1] / sz;
+                rhs[q] = r / sz;
             }
         }
         let svd = amat.clone().svd(true, true);
@@ -302,7 +319,10 @@ impl Solution {
         })?;
         let rate = [sol[0], sol[1]];
         if !(rate.iter().all(|v| v.re.is_finite() && v.im.is_finite())) {
-            return Err(Error::NonFinite { what: "U", index: 0 });
+            return Err(Error::NonFinite {
+                what: "U",
+                index: 0,
+            });
         }
         let (x0, y0) = curve.lattice_coordinates(&v0);
         let (xr, yr) = curve.lattice_coordinates(&rate);
@@ -433,11 +453,7 @@ impl Solution {
         let d: C = (0..8).map(|m| self.den[m] * th[m]).sum();
         let dinv = d.inv();
         for q in 0..6 {
-            let n: C = self.num[q]
-                .iter()
-                .zip(th.iter())
-                .map(|(w, t)| w * t)
-                .sum();
+            let n: C = self.num[q].iter().zip(th.iter()).map(|(w, t)| w * t).sum();
             out[q] = (n * dinv).re;
         }
     }

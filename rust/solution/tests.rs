@@ -4,10 +4,26 @@ use crate::so4::FrahmTop;
 
 /// The four shared tops of /work/shared/reference/problems.json.
 const TOPS: [([f64; 4], [f64; 4], [f64; 6]); 4] = [
-    ([0.3, 1.1, 2.0, 3.7], [0.5, -0.2, 1.4, 0.9], [0.8, -0.3, 0.5, 1.1, -0.7, 0.2]),
-    ([1.0, 2.25, 4.84, 9.61], [1.0, 1.5, 2.2, 3.1], [0.4, 1.2, -0.6, 0.9, 0.3, -1.0]),
-    ([0.01, 1.0, 10.0, 100.0], [2.0, -1.0, 0.5, 3.0], [1.0, 0.5, -0.25, 0.75, -1.5, 0.1]),
-    ([1.0, 1.000001, 2.0, 3.0], [0.3, 0.300002, -0.4, 1.2], [0.2, -0.9, 0.4, 0.6, 1.1, -0.3]),
+    (
+        [0.3, 1.1, 2.0, 3.7],
+        [0.5, -0.2, 1.4, 0.9],
+        [0.8, -0.3, 0.5, 1.1, -0.7, 0.2],
+    ),
+    (
+        [1.0, 2.25, 4.84, 9.61],
+        [1.0, 1.5, 2.2, 3.1],
+        [0.4, 1.2, -0.6, 0.9, 0.3, -1.0],
+    ),
+    (
+        [0.01, 1.0, 10.0, 100.0],
+        [2.0, -1.0, 0.5, 3.0],
+        [1.0, 0.5, -0.25, 0.75, -1.5, 0.1],
+    ),
+    (
+        [1.0, 1.000001, 2.0, 3.0],
+        [0.3, 0.300002, -0.4, 1.2],
+        [0.2, -0.9, 0.4, 0.6, 1.1, -0.3],
+    ),
 ];
 
 /// Agreement with gauss16 (dt = 1e-2, error ~1e-15 per unit time) over
@@ -21,7 +37,10 @@ const SHORT_RTOL: f64 = 1e-11;
 const NEAR_DEGENERATE_RTOL: f64 = 1e-9;
 
 fn max_rel(a: &[f64], b: &[f64], scale: f64) -> f64 {
-    a.iter().zip(b).fold(0.0f64, |m, (x, y)| m.max((x - y).abs())) / scale
+    a.iter()
+        .zip(b)
+        .fold(0.0f64, |m, (x, y)| m.max((x - y).abs()))
+        / scale
 }
 
 #[test]
@@ -43,7 +62,11 @@ fn theta_solution_matches_integration_on_the_four_tops() {
         let scale = l0.iter().map(|v| v * v).sum::<f64>().sqrt();
         let err = max_rel(&out, &traj.y, scale);
         let l_start = sol.l(0.0).unwrap();
-        let tol = if n == 3 { NEAR_DEGENERATE_RTOL } else { SHORT_RTOL };
+        let tol = if n == 3 {
+            NEAR_DEGENERATE_RTOL
+        } else {
+            SHORT_RTOL
+        };
         assert!(err <= tol, "a = {a:?}: {err:e}");
         assert!(max_rel(&l_start, &l0, scale) <= tol, "a = {a:?}: l(0)");
     }
@@ -63,4 +86,3 @@ fn phase_reduction_is_exact_for_large_t() {
     ex -= 2.0 * (0.5 * ex).round();
     assert!((r - ex).abs() <= 4.0 * f64::EPSILON, "{r} vs {ex}");
 }
-

@@ -1,0 +1,162 @@
+"""The Theorem (9)-(10) as code: ``top.solve(l0)`` against integration (docs/theorem.md).
+
+References are independent of the theta side: the gauss16 integrator of (1)
+and the Abel map of the states it produces.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import manakov
+
+#: Issue 10: max over 201 times in [0, 100] of |l_theta - l_int| / |l0|. The
+#: gauss16 reference at dt = 1e-3 is good to ~3e-14 there (roundoff of 1e5 steps).
+SHORT_RTOL = 1e-11
+#: Issue 10 at t = 1e4 (gauss16 at dt = 1e-2, itself good to ~1e-11).
+T1E4_RTOL = 1e-9
+#: Issue 10 for random states on [0, 20].
+RANDOM_RTOL = 1e-10
+#: sol.abel(l_int(t)) - u0 - U t lies in the period lattice to this (lattice
+#: coordinates; Abel integrals ~1e-15, integration ~1e-14 over [0, 2]).
+AFFINE_TOL = 1e-12
+#: Slope of the unwrapped Abel image against U, relative.
+SLOPE_RTOL = 1e-12
+
+NEAR_DEGENERATE_SHORTFALL = (
+    "near_degenerate (d1 - d2 = 3.8e-5): the reduction's constants are known to ~1e-11 "
+    "(conditioned like u/|d1 - d2|^2), U inherits it; measured 7e-9 on [0, 100] "
+    "(docs/theorem.md, Accuracy)"
+)
+
+
+def _params() -> list:
+    out = []
+    for name in ("generic", "physical", "wide", "near_degenerate"):
+        marks = (
+            [pytest.mark.xfail(strict=True, reason=NEAR_DEGENERATE_SHORTFALL)]
+            if name == "near_degenerate"
+            else []
+        )
+        out.append(pytest.param(name, marks=marks))
+    return out
+
+
+def _lattice(tau: np.ndarray, z: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Real (x, y) with z = x + tau y."""
+    y = np.linalg.solve(tau.imag, z.imag)
+    return z.real - tau.real @ y, y
+
+
+@pytest.mark.parametrize("name", _params())
+def test_theorem_matches_integration_on_0_100(name: str) -> None:
+    p = manakov.problem(name)
+    top = manakov.ManakovTop(p.a, p.b)
+    sol = top.solve(p.l0)
+    t = np.linspace(0.0, 100.0, 201)
+    l_int = top.integrate(p.l0, 100.0, t_eval=t, dt=1e-3).l
+    err = np.max(np.abs(sol.l(t) - l_int)) / np.linalg.norm(p.l0)
+    assert err <= SHORT_RTOL, err
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("name", ["generic", "physical", "wide"])
+def test_theorem_matches_integration_at_1e4(name: str) -> None:
+    p = manakov.problem(name)
+    top = manakov.ManakovTop(p.a, p.b)
+    sol = top.solve(p.l0)
+    tr = top.integrate(p.l0, 1e4, t_eval=np.array([0.0, 1e4]), dt=1e-2)
+    err = np.max(np.abs(sol.l(1e4) - tr.l[-1])) / np.linalg.norm(p.l0)
+    assert err <= T1E4_RTOL, err
+
+
+@pytest.mark.parametrize("name", ["generic", "physical", "wide", "near_degenerate"])
+def test_abel_image_is_affine_with_slope_U(name: str) -> None:
+    p = manakov.problem(name)
+    top = manakov.ManakovTop(p.a, p.b)
+    sol = top.solve(p.l0)
+    t = np.linspace(0.0, 2.0, 21)
+    l_int = top.integrate(p.l0, 2.0, t_eval=t, dt=1e-3).l
+    u = np.array([sol.abel(li) for li in l_int])
+    assert np.allclose(u[0], sol.u0, rtol=0, atol=1e-13)
+    tau = sol.tau
+    x, y = _lattice(tau, (u - sol.u0[None, :] - t[:, None] * sol.U[None, :]).T)
+    assert np.max(np.abs(x - np.round(x))) <= AFFINE_TOL
+    assert np.max(np.abs(y - np.round(y))) <= AFFINE_TOL
+    # unwrap by the lattice vectors and fit the slope (least squares, independent of U)
+    uw = u - (np.round(x).T + np.round(y).T @ tau.T)
+    a = np.vstack([np.ones_like(t), t]).T
+    coef, *_ = np.linalg.lstsq(a, uw, rcond=None)
+    slope = coef[1]
+    assert np.max(np.abs(slope - sol.U)) <= SLOPE_RTOL * np.max(np.abs(sol.U))
+
+
+def test_shapes_and_attributes() -> None:
+    p = manakov.problem("generic")
+    sol = manakov.ManakovTop(p.a, p.b).solve(p.l0)
+    assert sol.l(0.5).shape == (6,)
+    assert sol.l(np.zeros((3, 4))).shape == (3, 4, 6)
+    np.testing.assert_allclose(sol.l(0.0), p.l0, rtol=0, atol=1e-13)
+    assert sol.U.shape == (2,) and sol.u0.shape == (2,) and sol.tau.shape == (2, 2)
+    np.testing.assert_allclose(sol.tau, sol.curve.tau, rtol=0, atol=1e-14)
+    assert "U = [" in repr(sol) and "d = [" in repr(sol)
+    ch = sol.characteristics
+    # chi_jk = chi_j + chi_k: P23 + P31 = P12 + 2 chi_3 ... check one closed relation
+    s = [(ch["P23"][0][i] + ch["P31"][0][i] + ch["P12"][0][i]) % 2 for i in range(2)]
+    assert len(set(map(tuple, [v[0] + v[1] for v in ch.values()]))) == 7
+    assert s in ([0, 0], [1, 1], [0, 1], [1, 0])
+    assert set(sol.constants) == set(manakov.solution.LABELS)
+    with pytest.raises(ValueError):
+        sol.l(np.nan)
+
+
+def test_characteristics_are_branch_point_half_periods() -> None:
+    """chi_j = eta(d_j) from the curve's own Abel map of the branch points."""
+    p = manakov.problem("physical")
+    sol = manakov.ManakovTop(p.a, p.b).solve(p.l0)
+    curve = sol.curve
+    eta = [curve.branch_char(j) for j in range(5)]
+
+    def add(j: int, k: int) -> tuple:
+        return tuple(
+            tuple(int((eta[j][s][i] + eta[k][s][i]) % 2) for i in range(2)) for s in range(2)
+        )
+
+    ch = sol.characteristics
+    assert ch["P0"] == tuple(tuple(int(v) for v in eta[0][s]) for s in range(2))
+    assert ch["P23"] == add(2, 3) and ch["P31"] == add(3, 1) and ch["P12"] == add(1, 2)
+    assert ch["P14"] == add(1, 4) and ch["P24"] == add(2, 4) and ch["P34"] == add(3, 4)
+
+
+@pytest.mark.parametrize(
+    "l0, reason",
+    [
+        (np.zeros(6), "l0 = 0"),
+        (np.array([1.0, 0.0, 0.0, 0.0, 0.0, 0.0]), "h0"),
+        # m = n (self-dual): l = (m3, -m2, n1, m1, n2, n3) with m = n = (0.3, 0.5, 0.7)
+        (np.array([0.7, -0.5, 0.3, 0.3, 0.5, 0.7]), "h1^2 - 4 h0^2"),
+    ],
+)
+def test_singular_states_name_the_reason(l0: np.ndarray, reason: str) -> None:
+    p = manakov.problem("generic")
+    with pytest.raises(ValueError, match=reason.replace("^", r"\^")):
+        manakov.ManakovTop(p.a, p.b).solve(l0)
+
+
+def test_random_states_small() -> None:
+    """The default-run version of tests/data/theorem_random_stats.py (seed differs)."""
+    rng = np.random.default_rng(20261123)
+    ok = 0
+    for _ in range(12):
+        a = np.sort(rng.uniform(0.0, 5.0, 4))
+        b = rng.normal(size=4)
+        l0 = rng.normal(size=6)
+        top = manakov.ManakovTop(a, b)
+        sol = top.solve(l0)
+        t = np.linspace(0.0, 20.0, 41)
+        l_int = top.integrate(l0, 20.0, t_eval=t, dt=2e-3).l
+        err = np.max(np.abs(sol.l(t) - l_int)) / np.linalg.norm(l0)
+        assert err <= RANDOM_RTOL, (a, b, l0, err)
+        ok += 1
+    assert ok == 12
