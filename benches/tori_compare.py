@@ -58,8 +58,10 @@ def integrate_naff(top, l0, nu_ref, periods=500):
     lines, amps = naff(tr.l[:, 0], dt, max_lines=40, rel_threshold=1e-6)
     k = np.arange(-20, 21)
     rows, freqs = [], []
-    for f in lines:
-        if f == 0.0:
+    for f, amp in zip(lines, amps):
+        # The fit uses the well-resolved lines (≥ 1e-4 of the largest): weak
+        # lines next to strong ones carry the leakage error of the window.
+        if f == 0.0 or amp < 1e-4 * amps[0]:
             continue
         comb = k[:, None] * nu1 + k[None, :] * nu2
         i = np.unravel_index(np.argmin(np.abs(comb - f)), comb.shape)
