@@ -52,6 +52,7 @@ fn real_torus_py<'py>(
 /// the whole chain per state, in parallel, with the GIL released and Ctrl-C
 /// checked between waves of states.
 #[pyfunction(name = "frequency_map")]
+#[allow(clippy::type_complexity)]
 fn frequency_map_py<'py>(
     py: Python<'py>,
     a: PyReadonlyArray1<'py, f64>,
