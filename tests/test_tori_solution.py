@@ -289,3 +289,46 @@ def test_dask_frequency_map_survives_a_killed_worker(client):
     assert start < killed["t"] < end
     assert np.array_equal(local.nu, remote.nu, equal_nan=True)
     assert np.array_equal(local.status, remote.status)
+
+
+def test_frequency_map_takes_any_layout_and_leaves_input_alone():
+    top, states = _slice(6)
+    ref = tori.frequency_map(top, states)
+    wide = np.zeros((states.shape[0], 12))
+    wide[:, ::2] = states
+    view = wide[:, ::2]  # non-contiguous
+    ro = states.copy()
+    ro.setflags(write=False)
+    for x in (view, ro, states.tolist(), np.asfortranarray(states)):
+        got = tori.frequency_map(top, x)
+        assert np.array_equal(got.nu, ref.nu, equal_nan=True)
+        assert np.array_equal(got.status, ref.status)
+    one = tori.frequency_map(top, states[0])
+    assert one.nu.shape == (2,) and one.status.shape == ()
+    with pytest.raises(ValueError, match="real"):
+        tori.frequency_map(top, states.astype(complex))
+
+
+def test_ctrl_c_stops_a_long_map():
+    import subprocess
+    import sys
+
+    code = (
+        "import numpy as np, manakov\n"
+        "from manakov import tori\n"
+        "p = manakov.problem('generic')\n"
+        "top = manakov.ManakovTop(p.a, p.b)\n"
+        "print('start', flush=True)\n"
+        "tori.frequency_map(top, np.tile(p.l0, (10**6, 1)), chunk_size=10**6)\n"
+    )
+    proc = subprocess.Popen(
+        [sys.executable, "-c", code], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True
+    )
+    assert proc.stdout.readline().strip() == "start"
+    time.sleep(1.0)
+    proc.send_signal(signal.SIGINT)
+    t0 = time.perf_counter()
+    _, err = proc.communicate(timeout=30)
+    # One chunk of 10^6 states (minutes of work): only the core's polling stops it.
+    assert time.perf_counter() - t0 < 2.0
+    assert "KeyboardInterrupt" in err
