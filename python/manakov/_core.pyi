@@ -16,6 +16,7 @@ __all__ = [
     "curve_xi_eta",
     "HyperellipticCore",
     "frequency_map",
+    "SolutionCore",
     "gauss_tableau",
     "hamiltonian",
     "integrate",
@@ -234,7 +235,7 @@ class SolutionCore:
         b: npt.NDArray[np.float64],
         l0: npt.NDArray[np.float64],
     ) -> SolutionCore: ...
-    def l(self, t: npt.NDArray[np.float64]) -> npt.NDArray[np.float64]: ...
+    def l(self, t: npt.NDArray[np.float64]) -> npt.NDArray[np.float64]: ...  # noqa: E743
     def abel(self, l: npt.NDArray[np.float64]) -> npt.NDArray[np.complex128]: ...
     @property
     def u0(self) -> npt.NDArray[np.complex128]: ...

@@ -1,3 +1,4 @@
+# ruff: noqa: E741, E743  (l is the paper's name for the state)
 """The Theorem (9)–(10): ``l(t)`` as genus-2 theta quotients with a linear argument.
 
 ``ManakovTop.solve(l0)`` returns a :class:`Solution`. The recipe, equation by

@@ -11,6 +11,13 @@ use crate::solution::Solution;
 
 type C = Complex64;
 
+/// `(idx, num, den)` of [`SolutionCore::quotient`].
+type Quotient<'py> = (
+    Bound<'py, PyArray1<i64>>,
+    Bound<'py, PyArray2<C>>,
+    Bound<'py, PyArray1<C>>,
+);
+
 /// The explicit theta-function solution through one state.
 #[pyclass(name = "SolutionCore", module = "manakov._core", frozen)]
 pub struct SolutionCore {
@@ -116,14 +123,7 @@ impl SolutionCore {
     }
 
     /// `(idx (8,), num (6, 8), den (8,))` of `l_q = N_q/D`.
-    fn quotient<'py>(
-        &self,
-        py: Python<'py>,
-    ) -> PyResult<(
-        Bound<'py, PyArray1<i64>>,
-        Bound<'py, PyArray2<C>>,
-        Bound<'py, PyArray1<C>>,
-    )> {
+    fn quotient<'py>(&self, py: Python<'py>) -> PyResult<Quotient<'py>> {
         let (idx, num, den) = self.sol.quotient();
         let flat: Vec<C> = num.iter().flatten().copied().collect();
         Ok((

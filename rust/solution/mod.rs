@@ -303,7 +303,7 @@ impl Solution {
         }
         let svd = amat.clone().svd(true, true);
         let sv = &svd.singular_values;
-        if !(sv[1] > 1e-12 * sv[0]) {
+        if sv[1].is_nan() || sv[1] <= 1e-12 * sv[0] {
             return Err(Error::InvalidArgument {
                 what: "state l0",
                 reason: format!(
@@ -452,9 +452,9 @@ impl Solution {
         let th: [C; 8] = std::array::from_fn(|m| vals[self.idx[m]]);
         let d: C = (0..8).map(|m| self.den[m] * th[m]).sum();
         let dinv = d.inv();
-        for q in 0..6 {
-            let n: C = self.num[q].iter().zip(th.iter()).map(|(w, t)| w * t).sum();
-            out[q] = (n * dinv).re;
+        for (o, w) in out.iter_mut().zip(self.num.iter()) {
+            let n: C = w.iter().zip(th.iter()).map(|(w, t)| w * t).sum();
+            *o = (n * dinv).re;
         }
     }
 
@@ -501,6 +501,24 @@ impl Solution {
             } else {
                 self.eval_serial(tc, oc)?;
             }
+        }
+        Ok(())
+    }
+
+    /// [`Solution::l_batch`] on the calling thread only (for benchmarks and
+    /// callers that parallelise themselves).
+    pub fn l_batch_serial(&self, t: &[f64], out: &mut [f64], cancel: &Cancel) -> Result<()> {
+        if out.len() != 6 * t.len() {
+            return Err(Error::Shape {
+                what: "out",
+                expected: format!("({}, 6)", t.len()),
+                got: format!("{} entries", out.len()),
+            });
+        }
+        crate::error::check_finite("t", t)?;
+        for (tc, oc) in t.chunks(CHUNK).zip(out.chunks_mut(6 * CHUNK)) {
+            cancel.check()?;
+            self.eval_serial(tc, oc)?;
         }
         Ok(())
     }
