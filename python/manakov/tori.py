@@ -77,9 +77,10 @@ SINGULAR = 9
 #: Ctrl-C checks of the Python loop (the Rust core also polls within a chunk).
 #: See docs/tori.md for the measurement behind both defaults.
 LOCAL_CHUNK = 4096
-#: States per dask task: large enough that the per-task overhead of the
-#: scheduler (~1 ms) and of shipping a chunk is < 1 % of its compute time.
-DASK_CHUNK = 8192
+#: States per dask task: the measured per-task overhead (scheduling, shipping
+#: the chunk and the result: 9-15 ms on a LocalCluster) stays < 1 % of the
+#: ~2.5 s a chunk takes on one core at ~150 us per state (docs/tori.md).
+DASK_CHUNK = 16384
 #: Above this many states the progress bar is shown by default (on a terminal).
 PROGRESS_MIN_STATES = 20000
 
