@@ -11,7 +11,8 @@
 //!
 //! state `l` ([`so4`], [`integrate`]) → Schottky's `l(s)`, `f(s)` and Kötter's
 //! `ξ, η, d_j` ([`kotter`]) → points on the curve (8) and the Abel map
-//! ([`curve`]) → theta functions ([`theta`]).
+//! ([`curve`]) → theta functions ([`theta`]) → real tori and frequency maps
+//! ([`tori`]).
 //!
 //! The crate is pure Rust; the Python bindings live behind the `python`
 //! feature in a private module.
@@ -25,6 +26,7 @@ pub mod riemann;
 pub mod so4;
 pub mod solution;
 pub mod theta;
+pub mod tori;
 
 pub use error::{Error, Result};
 

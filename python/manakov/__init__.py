@@ -31,6 +31,7 @@ from .top import (
     poisson_tensor,
     to_matrix,
 )
+from .tori import FrequencyMap, Torus, frequency_map, real_torus
 
 __all__ = [
     "benchmark_setup",
@@ -40,6 +41,8 @@ __all__ = [
     "ConvergenceError",
     "CurvePoints",
     "FrahmTop",
+    "frequency_map",
+    "FrequencyMap",
     "HyperellipticCurve",
     "from_kotter",
     "from_matrix",
@@ -56,11 +59,13 @@ __all__ = [
     "problem",
     "Problem",
     "problem_names",
+    "real_torus",
     "Solution",
     "theta",
     "theta_all",
     "theta_jet",
     "to_matrix",
+    "Torus",
     "Trajectory",
     "Wurzel",
     "__version__",

@@ -16,6 +16,7 @@ __all__ = [
     "curve_wurzel",
     "curve_xi_eta",
     "HyperellipticCore",
+    "frequency_map",
     "SolutionCore",
     "gauss_tableau",
     "hamiltonian",
@@ -30,9 +31,12 @@ __all__ = [
     "manakov_integral_labels",
     "manakov_integrals",
     "poisson_tensor",
+    "real_torus",
     "so4_integrals",
     "theta_jet",
     "theta_plan_info",
+    "tori_status_names",
+    "torus_of_state",
     "vector_field",
     "__version__",
 ]
@@ -209,6 +213,24 @@ def kotter_from_points(
     branch: npt.NDArray[np.int8],
     zd: npt.NDArray[np.complex128] | None = None,
 ) -> npt.NDArray[np.float64]: ...
+def real_torus(
+    tau: npt.NDArray[np.complex128],
+    u: npt.NDArray[np.complex128],
+    u2: npt.NDArray[np.complex128],
+    chars: npt.NDArray[np.uint8],
+) -> tuple[npt.NDArray[np.complex128], npt.NDArray[np.int64], npt.NDArray[np.float64]]: ...
+def tori_status_names() -> list[str]: ...
+def frequency_map(
+    a: npt.NDArray[np.float64], b: npt.NDArray[np.float64], states: npt.NDArray[np.float64]
+) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.uint8]]: ...
+def torus_of_state(
+    a: npt.NDArray[np.float64], b: npt.NDArray[np.float64], l0: npt.NDArray[np.float64]
+) -> tuple[
+    npt.NDArray[np.complex128],
+    npt.NDArray[np.int64],
+    npt.NDArray[np.float64],
+    npt.NDArray[np.complex128],
+]: ...
 
 @final
 class SolutionCore:

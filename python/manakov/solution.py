@@ -32,6 +32,7 @@ import numpy as np
 
 from . import _core
 from ._checks import _float_array
+from ._torus import Torus, torus_of_state
 from .riemann import HyperellipticCurve
 
 __all__ = ["LABELS", "Solution", "plot_theorem"]
@@ -80,7 +81,7 @@ class Solution:
     ``l(10**6)`` costs and keeps what ``l(1)`` does.
     """
 
-    __slots__ = ("_a", "_b", "_l0", "_core", "_curve")
+    __slots__ = ("_a", "_b", "_l0", "_core", "_curve", "_torus")
 
     def __init__(self, a: Any, b: Any, l0: Any) -> None:
         aa = _float_array(a, "a").astype(float)
@@ -92,6 +93,7 @@ class Solution:
         self._a, self._b, self._l0 = _frozen(aa.copy()), _frozen(bb.copy()), _frozen(ll.copy())
         self._core = _core.SolutionCore(self._a, self._b, self._l0)
         self._curve: HyperellipticCurve | None = None
+        self._torus: Torus | None = None
 
     @property
     def a(self) -> np.ndarray:
@@ -195,6 +197,29 @@ class Solution:
     def calibration(self) -> np.ndarray:
         """``|C_L − P_L(l0) θ(v0)/θ[χ_L](v0)| / |C_L|`` (``C_L`` from an auxiliary divisor)."""
         return _frozen(self._core.calibration)
+
+    @property
+    def torus(self) -> Torus:
+        """The real torus of the motion (docs/tori.md): a reduced basis ``λ1, λ2``
+        of the periods of ``l`` in the real plane of ``U`` and a second
+        commuting flow, and ``(ν1, ν2)`` with ``U = ν1 λ1 + ν2 λ2``."""
+        if self._torus is None:
+            self._torus = torus_of_state(self._a, self._b, self._l0)[0]
+        return self._torus
+
+    @property
+    def frequencies(self) -> np.ndarray:
+        """``(ν1, ν2) ≥ 0`` in cycles per unit time, ``U = ν1 λ1 + ν2 λ2``."""
+        return self.torus.frequencies
+
+    @property
+    def rotation_number(self) -> float:
+        """``ν1/ν2``."""
+        return self.torus.rotation_number
+
+    def angles(self, t: Any) -> np.ndarray:
+        """Torus angles ``(ν1 t, ν2 t) mod 1`` from the initial point, shape ``(..., 2)``."""
+        return self.torus.angles(t)
 
     def quotient(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """``(idx, num, den)``: ``l_q = Re(Σ_m num[q, m] θ[idx[m]](v) / Σ_m den[m] θ[idx[m]](v))``

@@ -15,6 +15,7 @@ mod riemann;
 mod so4;
 mod solution;
 mod theta;
+mod tori;
 
 #[pymodule]
 mod _core {
@@ -30,6 +31,7 @@ mod _core {
         theta::register(m)?;
         kotter::register(m)?;
         curve::register(m)?;
+        tori::register(m)?;
         riemann::register(m)?;
         solution::register(m)?;
         Ok(())

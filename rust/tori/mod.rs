@@ -1,0 +1,624 @@
+//! Real Liouville tori of the Manakov top: the lattice of periods of `l(u)`,
+//! the real torus that carries a motion, its frequencies, and frequency maps.
+//!
+//! By the Theorem (9)–(10), `l` is a rational function of the quotients
+//! `P_L = C_L θ[χ_L](v)/θ(v)` (`v = u + K`) for the seven labels
+//! `L ∈ {0, 23, 31, 12, 14, 24, 34}`, and `u = u0 + U t` moves on a straight
+//! line in `C²`. With the package's theta convention (README),
+//! `θ[a;b](v + m + τn) = (−1)^{a·m + b·n} e(v, n) θ[a;b](v)` with a factor
+//! `e(v, n) = exp(−iπ nᵀτn − 2πi nᵀv)` common to all characteristics, so the
+//! quotient `θ[a;b]/θ[0;0]` picks up the sign `(−1)^{a·m + b·n}`. Hence
+//! `λ = m + τn` is a period of `l` iff `a_L·m + b_L·n ≡ 0 (mod 2)` for every
+//! characteristic `χ_L = [a_L; b_L]` that enters `l` (sufficiency is the sign
+//! rule; necessity is in docs/tori.md). These `λ` form the lattice `Λ'`,
+//! `2Λ ⊂ Λ' ⊂ Λ = Z² + τZ²`.
+//!
+//! The real torus through `u0` is the closure of `u0 + U t` modulo `Λ'`. Its
+//! real tangent plane `P` is spanned (over R) by `U` and the velocity `U'` of
+//! a second commuting flow of the Manakov family. `Λ' ∩ P` is a lattice of
+//! rank 2; [`real_torus`] finds it exactly (the integer kernel of the
+//! projection of `Λ'` onto the complement of `P`), reduces it, and writes
+//! `U = ν1 λ1 + ν2 λ2`.
+//!
+//! **Basis convention** (intrinsic, so that maps are continuous wherever the
+//! torus family is): Lagrange–Gauss reduction in the polarisation metric
+//! `‖z‖² = z^H (Im τ)^{-1} z`, which is invariant under symplectic changes of
+//! the homology basis; `‖λ1‖ ≤ ‖λ2‖`, `|⟨λ1, λ2⟩| ≤ ‖λ1‖²/2`; the signs of
+//! `λ1`, `λ2` are chosen so that `ν1 ≥ 0`, `ν2 ≥ 0`.
+//!
+//! [`map_states`] runs a per-state function over a batch in parallel (rayon),
+//! in waves between which the caller's [`Cancel`] is checked; the results do
+//! not depend on the number of threads or on how the batch is split.
+
+pub mod solve;
+#[cfg(test)]
+mod tests;
+
+use num_complex::Complex64;
+use rayon::prelude::*;
+
+use crate::cancel::Cancel;
+use crate::error::{Error, Result};
+
+/// A point of `C²`.
+pub type C2 = [Complex64; 2];
+/// A 2×2 period matrix, `tau[i][j] = τ_ij`.
+pub type Tau = [[Complex64; 2]; 2];
+/// A half-integer characteristic `[a1 a2; b1 b2]` as the bits `(a1, a2, b1, b2)`
+/// (the package's theta order: index = bits a1 a2 b1 b2).
+pub type Char = [u8; 4];
+/// Integer coordinates `(m1, m2, n1, n2)` of the lattice point `λ = m + τ n`.
+pub type Coords = [i64; 4];
+
+/// The largest denominator accepted in the kernel of the projection of `Λ`
+/// onto the complement of the real plane. The kernel's entries are rationals
+/// whose denominators divide small minors of the integer matrix of the real
+/// structure in the homology basis (entries 0, ±1, ±2 for the bases the
+/// Riemann-surface layer builds); 64 leaves a wide margin and keeps the
+/// enumeration over `[0, 2D)²` below 2¹⁴ points.
+pub const MAX_DENOMINATOR: i64 = 64;
+
+/// Tolerance for recognising the kernel entries as rationals `p/D`. `U`, `U'`
+/// carry the solution's relative error (~1e-12); the entries are ratios of
+/// 2×2 minors of O(1) size, so their error is ~1e-11. 1e-7 is far above that
+/// and far below the spacing 1/D² ≥ 2.4e-4 between distinct candidates.
+pub const RATIONAL_TOL: f64 = 1e-7;
+
+/// Below this sine of the angle between `U` and `U'` (in the polarisation
+/// metric) the two flows do not span a plane within the solution's accuracy.
+pub const PLANE_TOL: f64 = 1e-8;
+
+/// Largest accepted distance of `U` from the plane of the reduced basis,
+/// relative to `‖U‖` (the plane contains `U` by construction; a failure means
+/// non-finite or inconsistent input).
+pub const RESIDUAL_TOL: f64 = 1e-9;
+
+/// Why a real torus could not be found.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum TorusFailure {
+    /// A non-finite entry in `τ`, `U` or `U'`.
+    NonFinite,
+    /// `Im τ` is not positive definite.
+    ImagTauNotPositive,
+    /// `U` and `U'` are (nearly) R-linearly dependent: `sin_angle` between them.
+    DegeneratePlane { sin_angle: f64 },
+    /// The integer kernel of the projection could not be recognised: no
+    /// denominator `≤ MAX_DENOMINATOR` makes it integral to `RATIONAL_TOL`
+    /// (`residual` at the best one). The orbit is then not on a compact
+    /// real 2-torus (or `U'` is not a flow of the same family).
+    NoRealLattice { residual: f64 },
+}
+
+impl From<TorusFailure> for Error {
+    fn from(f: TorusFailure) -> Error {
+        let reason = match f {
+            TorusFailure::NonFinite => "tau, U or U' is not finite".to_string(),
+            TorusFailure::ImagTauNotPositive => "Im tau is not positive definite".to_string(),
+            TorusFailure::DegeneratePlane { sin_angle } => {
+                format!("the two flows do not span a real plane (sin of their angle {sin_angle:e})")
+            }
+            TorusFailure::NoRealLattice { residual } => format!(
+                "the lattice of periods meets the real plane of the flows in no rank-2 lattice \
+                 (kernel not rational: residual {residual:e} at denominators <= {MAX_DENOMINATOR})"
+            ),
+        };
+        Error::InvalidArgument {
+            what: "real torus",
+            reason,
+        }
+    }
+}
+
+/// The real torus carrying a motion and its frequencies.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RealTorus {
+    /// The reduced basis `λ1, λ2` of `Λ' ∩ P` as points of `C²`.
+    pub lambda: [C2; 2],
+    /// Their integer coordinates `(m1, m2, n1, n2)`, `λ = m + τ n`.
+    pub coords: [Coords; 2],
+    /// `(ν1, ν2)`, `U = ν1 λ1 + ν2 λ2` (cycles per unit time).
+    pub nu: [f64; 2],
+}
+
+/// The lattice point `m + τ n` of coordinates `x = (m1, m2, n1, n2)`.
+pub fn lattice_point(tau: &Tau, x: &Coords) -> C2 {
+    let (m1, m2, n1, n2) = (x[0] as f64, x[1] as f64, x[2] as f64, x[3] as f64);
+    [
+        tau[0][0] * n1 + tau[0][1] * n2 + m1,
+        tau[1][0] * n1 + tau[1][1] * n2 + m2,
+    ]
+}
+
+/// The sign `(−1)^{a·m + b·n}` that `θ[a;b](v)/θ[0;0](v)` picks up under
+/// `v → v + m + τ n`, as `+1` or `−1`.
+pub fn quotient_sign(chi: &Char, x: &Coords) -> i32 {
+    let s = (chi[0] as i64) * x[0]
+        + (chi[1] as i64) * x[1]
+        + (chi[2] as i64) * x[2]
+        + (chi[3] as i64) * x[3];
+    if s.rem_euclid(2) == 0 {
+        1
+    } else {
+        -1
+    }
+}
+
+/// Whether `m + τ n` is a period of every quotient `θ[χ]/θ`, `χ ∈ chars`.
+pub fn is_period(chars: &[Char], x: &Coords) -> bool {
+    chars.iter().all(|c| quotient_sign(c, x) == 1)
+}
+
+/// The classes of `Λ'` modulo `2Λ`: the residues `r ∈ {0,1}⁴` with
+/// `a·r_m + b·r_n ≡ 0 (mod 2)` for every `χ = [a;b]` in `chars`.
+pub fn period_residues(chars: &[Char]) -> Vec<[u8; 4]> {
+    (0u8..16)
+        .map(|k| [(k >> 3) & 1, (k >> 2) & 1, (k >> 1) & 1, k & 1])
+        .filter(|r| is_period(chars, &r.map(|v| v as i64)))
+        .collect()
+}
+
+/// `(Re z1, Re z2, Im z1, Im z2)`.
+fn real4(z: &C2) -> [f64; 4] {
+    [z[0].re, z[1].re, z[0].im, z[1].im]
+}
+
+/// The polarisation metric `Re(z^H (Im τ)^{-1} w)` on `R⁴ = C²`, i.e.
+/// `blockdiag(H, H)` with `H = (Im τ)^{-1}` in the coordinates of [`real4`].
+struct Metric {
+    h: [[f64; 2]; 2],
+}
+
+impl Metric {
+    fn new(tau: &Tau) -> Option<Metric> {
+        let (p, q, r) = (
+            tau[0][0].im,
+            0.5 * (tau[0][1].im + tau[1][0].im),
+            tau[1][1].im,
+        );
+        let det = p * r - q * q;
+        if !(p > 0.0 && det > 0.0) {
+            return None;
+        }
+        Some(Metric {
+            h: [[r / det, -q / det], [-q / det, p / det]],
+        })
+    }
+
+    fn dot(&self, x: &[f64; 4], y: &[f64; 4]) -> f64 {
+        let h = &self.h;
+        let half = |a: f64, b: f64, c: f64, d: f64| {
+            a * (h[0][0] * c + h[0][1] * d) + b * (h[1][0] * c + h[1][1] * d)
+        };
+        half(x[0], x[1], y[0], y[1]) + half(x[2], x[3], y[2], y[3])
+    }
+
+    fn norm2(&self, x: &[f64; 4]) -> f64 {
+        self.dot(x, x)
+    }
+}
+
+fn axpy(a: f64, x: &[f64; 4], y: &[f64; 4]) -> [f64; 4] {
+    std::array::from_fn(|k| y[k] + a * x[k])
+}
+
+/// `y − Σ ⟨e_i, y⟩ e_i` over orthonormal `es`.
+fn reject(g: &Metric, es: &[[f64; 4]], y: &[f64; 4]) -> [f64; 4] {
+    es.iter().fold(*y, |acc, e| axpy(-g.dot(e, &acc), e, &acc))
+}
+
+/// The real torus of the motion `u0 + U t` on `C²/Λ'`.
+///
+/// `tau` is the period matrix, `u` the velocity `U` of the motion, `u2` the
+/// velocity `U'` of a second commuting flow on the same level set, and
+/// `chars` the characteristics `χ_L` of the quotients that enter `l`. See the
+/// module documentation for the method and the basis convention.
+pub fn real_torus(
+    tau: &Tau,
+    u: &C2,
+    u2: &C2,
+    chars: &[Char],
+) -> std::result::Result<RealTorus, TorusFailure> {
+    let finite = |z: &Complex64| z.re.is_finite() && z.im.is_finite();
+    if !(tau.iter().flatten().all(finite) && u.iter().all(finite) && u2.iter().all(finite)) {
+        return Err(TorusFailure::NonFinite);
+    }
+    let g = Metric::new(tau).ok_or(TorusFailure::ImagTauNotPositive)?;
+
+    // Orthonormal basis (e1, e2) of the plane P, then (q1, q2) of its complement.
+    let (p1, p2) = (real4(u), real4(u2));
+    let n1 = g.norm2(&p1).sqrt();
+    let n2 = g.norm2(&p2).sqrt();
+    if !(n1 > 0.0 && n2 > 0.0) {
+        return Err(TorusFailure::DegeneratePlane { sin_angle: 0.0 });
+    }
+    let e1 = p1.map(|v| v / n1);
+    let r2 = reject(&g, &[e1], &p2);
+    let sin_angle = g.norm2(&r2).sqrt() / n2;
+    if sin_angle.is_nan() || sin_angle <= PLANE_TOL {
+        return Err(TorusFailure::DegeneratePlane { sin_angle });
+    }
+    let e2 = r2.map(|v| v / (sin_angle * n2));
+    let mut basis = vec![e1, e2];
+    for _ in 0..2 {
+        // The unit vector with the largest component off the current span.
+        let best = (0..4)
+            .map(|k| {
+                let mut y = [0.0; 4];
+                y[k] = 1.0;
+                reject(&g, &basis, &y)
+            })
+            .max_by(|a, b| g.norm2(a).total_cmp(&g.norm2(b)))
+            .unwrap_or([0.0; 4]);
+        let nb = g.norm2(&best).sqrt();
+        basis.push(best.map(|v| v / nb));
+    }
+    let (q1, q2) = (basis[2], basis[3]);
+
+    // M (2×4): the components off P of the generators 1, 1, τ·1, τ·2 of Λ.
+    let unit = |k: usize| {
+        let mut x = [0i64; 4];
+        x[k] = 1;
+        x
+    };
+    let gens: [[f64; 4]; 4] = std::array::from_fn(|k| real4(&lattice_point(tau, &unit(k))));
+    let m: [[f64; 4]; 2] = [
+        std::array::from_fn(|k| g.dot(&q1, &gens[k])),
+        std::array::from_fn(|k| g.dot(&q2, &gens[k])),
+    ];
+
+    // Pivot on the best-conditioned pair of columns: x_piv = R x_free.
+    let pairs = [(0, 1), (0, 2), (0, 3), (1, 2), (1, 3), (2, 3)];
+    let minor = |i: usize, j: usize| m[0][i] * m[1][j] - m[0][j] * m[1][i];
+    let &(pi, pj) = pairs
+        .iter()
+        .max_by(|a, b| minor(a.0, a.1).abs().total_cmp(&minor(b.0, b.1).abs()))
+        .unwrap_or(&(0, 1));
+    let free: Vec<usize> = (0..4).filter(|&k| k != pi && k != pj).collect();
+    let (fk, fl) = (free[0], free[1]);
+    let det = minor(pi, pj);
+    if det == 0.0 || !det.is_finite() {
+        return Err(TorusFailure::NoRealLattice {
+            residual: f64::INFINITY,
+        });
+    }
+    // Mp^{-1} = [[m1j, −m0j], [−m1i, m0i]]/det; R = −Mp^{-1} Mf.
+    let r: [[f64; 2]; 2] = std::array::from_fn(|row| {
+        std::array::from_fn(|col| {
+            let f = [fk, fl][col];
+            let (a, b) = (m[0][f], m[1][f]);
+            if row == 0 {
+                -(m[1][pj] * a - m[0][pj] * b) / det
+            } else {
+                -(-m[1][pi] * a + m[0][pi] * b) / det
+            }
+        })
+    });
+
+    // The smallest denominator making R integral.
+    let mut best_res = f64::INFINITY;
+    let mut found = None;
+    for d in 1..=MAX_DENOMINATOR {
+        let res = r
+            .iter()
+            .flatten()
+            .map(|&v| {
+                let dv = d as f64 * v;
+                (dv - dv.round()).abs() / dv.abs().max(1.0)
+            })
+            .fold(0.0f64, f64::max);
+        best_res = best_res.min(res);
+        if res <= RATIONAL_TOL {
+            found = Some(d);
+            break;
+        }
+    }
+    let d = found.ok_or(TorusFailure::NoRealLattice { residual: best_res })?;
+    let ri: [[i64; 2]; 2] = r.map(|row| row.map(|v| (d as f64 * v).round() as i64));
+
+    // x_free ∈ Z² with D | Ri x_free and x ∈ Λ'; the set contains 2D Z².
+    let full = |f: [i64; 2]| -> Option<Coords> {
+        let s0 = ri[0][0] * f[0] + ri[0][1] * f[1];
+        let s1 = ri[1][0] * f[0] + ri[1][1] * f[1];
+        if s0 % d != 0 || s1 % d != 0 {
+            return None;
+        }
+        let mut x = [0i64; 4];
+        x[pi] = s0 / d;
+        x[pj] = s1 / d;
+        x[fk] = f[0];
+        x[fl] = f[1];
+        is_period(chars, &x).then_some(x)
+    };
+    let span = 2 * d;
+    let mut h = Hnf2::new(span);
+    for f0 in 0..span {
+        for f1 in 0..span {
+            if (f0, f1) != (0, 0) && full([f0, f1]).is_some() {
+                h.add([f0, f1]);
+            }
+        }
+    }
+    let [b1, b2] = h.basis();
+    let (x1, x2) = match (full(b1), full(b2)) {
+        (Some(x1), Some(x2)) => (x1, x2),
+        // Unreachable: HNF rows are integer combinations of members.
+        _ => return Err(TorusFailure::NoRealLattice { residual: best_res }),
+    };
+
+    let (mut a, mut b) = (
+        (x1, real4(&lattice_point(tau, &x1))),
+        (x2, real4(&lattice_point(tau, &x2))),
+    );
+    gauss_reduce(&g, &mut a, &mut b);
+
+    // U = ν1 λ1 + ν2 λ2 by the normal equations in the metric.
+    let (g11, g12, g22) = (g.norm2(&a.1), g.dot(&a.1, &b.1), g.norm2(&b.1));
+    let (r1, r2) = (g.dot(&a.1, &p1), g.dot(&b.1, &p1));
+    let gd = g11 * g22 - g12 * g12;
+    let mut nu = [(g22 * r1 - g12 * r2) / gd, (g11 * r2 - g12 * r1) / gd];
+    let fit = axpy(-nu[1], &b.1, &axpy(-nu[0], &a.1, &p1));
+    let residual = g.norm2(&fit).sqrt() / n1;
+    if residual.is_nan() || residual > RESIDUAL_TOL {
+        return Err(TorusFailure::NoRealLattice { residual });
+    }
+    for (k, v) in [&mut a, &mut b].into_iter().enumerate() {
+        if nu[k] < 0.0 {
+            nu[k] = -nu[k];
+            v.0 = v.0.map(|c| -c);
+        }
+    }
+    let (c1, c2) = (a.0, b.0);
+    Ok(RealTorus {
+        lambda: [lattice_point(tau, &c1), lattice_point(tau, &c2)],
+        coords: [c1, c2],
+        nu,
+    })
+}
+
+/// Lagrange–Gauss reduction of the pair `(a, b)` (coordinates, real image) in
+/// the metric `g`: afterwards `‖a‖ ≤ ‖b‖` and `|⟨a, b⟩| ≤ ‖a‖²/2`. (Exact
+/// ties, `‖a‖ = ‖b‖`, happen on a set of measure zero of a torus family.)
+fn gauss_reduce(g: &Metric, a: &mut (Coords, [f64; 4]), b: &mut (Coords, [f64; 4])) {
+    let sub = |b: &mut (Coords, [f64; 4]), a: &(Coords, [f64; 4]), q: i64| {
+        b.0 = std::array::from_fn(|k| b.0[k] - q * a.0[k]);
+        b.1 = axpy(-(q as f64), &a.1, &b.1);
+    };
+    if g.norm2(&a.1) > g.norm2(&b.1) {
+        std::mem::swap(a, b);
+    }
+    // Each pass strictly shortens b (or stops); 200 passes bound the
+    // loop far beyond the O(log) passes a lattice of bounded entries needs.
+    for _ in 0..200 {
+        let q = (g.dot(&a.1, &b.1) / g.norm2(&a.1)).round();
+        if q != 0.0 {
+            sub(b, a, q as i64);
+        }
+        if g.norm2(&b.1) < g.norm2(&a.1) {
+            std::mem::swap(a, b);
+        } else {
+            break;
+        }
+    }
+}
+
+/// Hermite normal form of a rank-2 lattice `L` with `span·Z² ⊂ L ⊂ Z²`, built
+/// by adding generators: rows `(p, q)` and `(0, s)`, `0 < p, s`, `0 ≤ q < s`.
+struct Hnf2 {
+    p: i64,
+    q: i64,
+    s: i64,
+}
+
+fn egcd(a: i64, b: i64) -> (i64, i64, i64) {
+    if b == 0 {
+        (a.abs(), a.signum(), 0)
+    } else {
+        let (g, x, y) = egcd(b, a.rem_euclid(b));
+        (g, y, x - (a.div_euclid(b)) * y)
+    }
+}
+
+impl Hnf2 {
+    fn new(span: i64) -> Self {
+        Hnf2 {
+            p: span,
+            q: 0,
+            s: span,
+        }
+    }
+
+    fn add(&mut self, v: [i64; 2]) {
+        // Combine (p, q) and v on the first coordinate; the leftover
+        // second-coordinate vector joins (0, s).
+        let (gcd, x, y) = egcd(self.p, v[0]);
+        let (p, q) = (gcd, x * self.q + y * v[1]);
+        let (ap, av) = (self.p / gcd, v[0] / gcd);
+        // av·(p, q)_old − ap·v has first coordinate 0.
+        let t = av * self.q - ap * v[1];
+        self.s = egcd(self.s, t).0.max(1);
+        self.p = p;
+        self.q = q.rem_euclid(self.s);
+    }
+
+    fn basis(&self) -> [[i64; 2]; 2] {
+        [[self.p, self.q], [0, self.s]]
+    }
+}
+
+/// Status of one state in a frequency map (the `status` array of
+/// `manakov.frequency_map`; the codes are part of the API).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[repr(u8)]
+pub enum Status {
+    /// Frequencies computed.
+    Ok = 0,
+    /// `h1² = 4 h0²`: `F(s)` of (19) is undefined (the level set is singular).
+    SingularCasimirs = 1,
+    /// Two branch points `d_j` of (8) coincide (`h0 = 0` included): the genus drops,
+    /// a separatrix or a degenerate torus.
+    CoincidingBranchPoints = 2,
+    /// The divisor of the initial state has a point at infinity.
+    DivisorAtInfinity = 3,
+    /// An iteration of the solution did not converge.
+    NoConvergence = 4,
+    /// `l0 = 0`.
+    ZeroState = 5,
+    /// A non-finite entry in the state.
+    NonFinite = 6,
+    /// The top's flow and the second flow do not span a real plane.
+    DegeneratePlane = 7,
+    /// No rank-2 lattice of periods in the real plane (not a compact torus).
+    NoRealLattice = 8,
+    /// Any other refusal of the solution (its message names the reason).
+    Singular = 9,
+}
+
+/// Short names of the status codes, indexed by code.
+pub const STATUS_NAMES: [&str; 10] = [
+    "ok",
+    "h1^2 = 4 h0^2",
+    "coinciding branch points",
+    "divisor at infinity",
+    "no convergence",
+    "zero state",
+    "non-finite state",
+    "degenerate plane",
+    "no real lattice",
+    "singular",
+];
+
+impl From<TorusFailure> for Status {
+    fn from(f: TorusFailure) -> Status {
+        match f {
+            TorusFailure::NonFinite => Status::NonFinite,
+            TorusFailure::ImagTauNotPositive => Status::Singular,
+            TorusFailure::DegeneratePlane { .. } => Status::DegeneratePlane,
+            TorusFailure::NoRealLattice { .. } => Status::NoRealLattice,
+        }
+    }
+}
+
+/// The result for one state of a map: a status and `(ν1, ν2)`. When the
+/// status is not [`Status::Ok`] the frequencies are NaN (the status says why).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct MapEntry {
+    pub status: Status,
+    pub nu: [f64; 2],
+}
+
+impl MapEntry {
+    /// A failed entry.
+    pub fn failed(status: Status) -> Self {
+        MapEntry {
+            status,
+            nu: [f64::NAN; 2],
+        }
+    }
+}
+
+/// States per task of the thread pool: ~64 × 0.3 ms ≈ 20 ms of work, so a
+/// wave of tasks ends (and `cancel` is polled) every few tens of milliseconds.
+pub const BLOCK: usize = 64;
+
+/// Run `per_state` over `states` in parallel, in order.
+///
+/// The work goes in waves of `BLOCK` states per thread; between waves the
+/// calling thread checks `cancel` (so a Python caller sees Ctrl-C), and
+/// within a wave each block checks the shared flag. The result of a state
+/// depends only on that state.
+pub fn map_states<S, T, F>(states: &[S], per_state: F, cancel: &Cancel) -> Result<Vec<T>>
+where
+    S: Sync,
+    T: Send,
+    F: Fn(&S) -> T + Sync,
+{
+    let wave = BLOCK * rayon::current_num_threads().max(1);
+    let mut out = Vec::new();
+    out.try_reserve_exact(states.len())
+        .map_err(|_| Error::InvalidArgument {
+            what: "states",
+            reason: format!("cannot allocate results for {} states", states.len()),
+        })?;
+    for part in states.chunks(wave) {
+        cancel.check()?;
+        let res: Result<Vec<Vec<T>>> = part
+            .par_chunks(BLOCK)
+            .map(|block| {
+                cancel.check()?;
+                Ok(block.iter().map(&per_state).collect())
+            })
+            .collect();
+        out.extend(res?.into_iter().flatten());
+    }
+    cancel.check()?;
+    Ok(out)
+}
+
+/// What [`frequencies_of_state`] needs of the Theorem's solution at one
+/// state: the period matrix, the velocity `U` of the top, the velocity `U'`
+/// of the second flow, and the characteristics of the quotients in `l`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FlowData {
+    pub tau: Tau,
+    pub u: C2,
+    pub u2: C2,
+    pub chars: Vec<Char>,
+}
+
+/// `b'` of the second commuting flow (see `docs/tori.md` §2): with the cubic
+/// interpolant `b_i = p0 + p1 a_i + p2 a_i² + p3 a_i³`, `a³` if
+/// `|p2| > |p3| max|a|` (the top's flow is mostly the `a²` flow), else `a²`.
+pub fn second_flow_b(a: &[f64; 4], b: &[f64; 4]) -> [f64; 4] {
+    let v = nalgebra::Matrix4::from_fn(|i, j| a[i].powi(j as i32));
+    let p = v
+        .lu()
+        .solve(&nalgebra::Vector4::from_column_slice(b))
+        .unwrap_or_else(nalgebra::Vector4::zeros);
+    let s = a.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+    if p[2].abs() > p[3].abs() * s {
+        a.map(|x| x * x * x)
+    } else {
+        a.map(|x| x * x)
+    }
+}
+
+/// Relative size of `h1² − 4h0²` below which a state counts as on the
+/// singular level set `h1² = 4h0²` (status 1): `F(s)` of (19) divides by it.
+/// The solution refuses below 1e-13 (`solution::DEGENERATE_RTOL`); this
+/// pre-check only saves its set-up and reports the same code.
+pub const CASIMIR_SINGULAR_RTOL: f64 = 1e-13;
+
+/// The status and frequencies of one state.
+///
+/// `solve(l0)` runs the Theorem and returns [`FlowData`]; its errors become
+/// status codes by `classify`. Nothing here panics or raises.
+pub fn frequencies_of_state<S, K>(l0: &[f64; 6], solve: S, classify: K) -> MapEntry
+where
+    S: Fn(&[f64; 6]) -> Result<FlowData>,
+    K: Fn(&Error) -> Status,
+{
+    if l0.iter().any(|v| !v.is_finite()) {
+        return MapEntry::failed(Status::NonFinite);
+    }
+    if l0.iter().all(|&v| v == 0.0) {
+        return MapEntry::failed(Status::ZeroState);
+    }
+    let [l12, l13, l14, l23, l24, l34] = *l0;
+    let h0 = l12 * l34 - l13 * l24 + l14 * l23;
+    let h1: f64 = l0.iter().map(|v| v * v).sum();
+    let disc = h1 * h1 - 4.0 * h0 * h0;
+    if disc.abs() <= CASIMIR_SINGULAR_RTOL * (h1 * h1 + 4.0 * h0 * h0) {
+        return MapEntry::failed(Status::SingularCasimirs);
+    }
+    let d = match solve(l0) {
+        Ok(d) => d,
+        Err(e) => return MapEntry::failed(classify(&e)),
+    };
+    match real_torus(&d.tau, &d.u, &d.u2, &d.chars) {
+        Ok(t) => MapEntry {
+            status: Status::Ok,
+            nu: t.nu,
+        },
+        Err(f) => MapEntry::failed(f.into()),
+    }
+}

@@ -1,0 +1,471 @@
+use super::*;
+use crate::theta::theta_all;
+
+fn c(re: f64, im: f64) -> Complex64 {
+    Complex64::new(re, im)
+}
+
+/// The seven characteristics of P_0, P_23, P_31, P_12, P_14, P_24, P_34 on the
+/// `simple` curve of docs/theta_quotients.md (bits a1 a2 b1 b2).
+const SIMPLE: [Char; 7] = [
+    [1, 0, 0, 0],
+    [0, 0, 0, 1],
+    [1, 1, 0, 1],
+    [1, 1, 0, 0],
+    [1, 0, 0, 1],
+    [0, 1, 0, 1],
+    [0, 1, 0, 0],
+];
+
+/// A small deterministic generator (no dependency on rand).
+struct Lcg(u64);
+impl Lcg {
+    fn next(&mut self) -> f64 {
+        self.0 = self
+            .0
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        ((self.0 >> 11) as f64) / ((1u64 << 53) as f64)
+    }
+    fn int(&mut self, lo: i64, hi: i64) -> i64 {
+        lo + ((self.next() * (hi - lo + 1) as f64) as i64).min(hi - lo)
+    }
+}
+
+fn random_tau(r: &mut Lcg) -> Tau {
+    let (x, y, z) = (r.next() - 0.5, r.next() - 0.5, r.next() - 0.5);
+    // Im τ = B Bᵀ + 0.3 I, positive definite.
+    let b = [
+        [r.next() + 0.2, r.next() - 0.5],
+        [r.next() - 0.5, r.next() + 0.2],
+    ];
+    let im =
+        |i: usize, j: usize| b[i][0] * b[j][0] + b[i][1] * b[j][1] + if i == j { 0.3 } else { 0.0 };
+    [
+        [c(x, im(0, 0)), c(y, im(0, 1))],
+        [c(y, im(1, 0)), c(z, im(1, 1))],
+    ]
+}
+
+fn im_inv(tau: &Tau) -> [[f64; 2]; 2] {
+    let (p, q, r) = (tau[0][0].im, tau[0][1].im, tau[1][1].im);
+    let d = p * r - q * q;
+    [[r / d, -q / d], [-q / d, p / d]]
+}
+
+/// Re(z^H (Im τ)^{-1} w), written out independently of `Metric`.
+fn herm(tau: &Tau, z: &C2, w: &C2) -> f64 {
+    let h = im_inv(tau);
+    let mut s = Complex64::new(0.0, 0.0);
+    for i in 0..2 {
+        for j in 0..2 {
+            s += z[i].conj() * h[i][j] * w[j];
+        }
+    }
+    s.re
+}
+
+fn lin(a: f64, x: &C2, b: f64, y: &C2) -> C2 {
+    [x[0] * a + y[0] * b, x[1] * a + y[1] * b]
+}
+
+/// All lattice points of Λ' in the box |x_i| ≤ B whose image lies in the
+/// real span of (p, q), by brute force (distance from the plane by least squares).
+fn brute_force(tau: &Tau, p: &C2, q: &C2, chars: &[Char], bound: i64) -> Vec<Coords> {
+    let mut hits = Vec::new();
+    let (pp, pq, qq) = (herm(tau, p, p), herm(tau, p, q), herm(tau, q, q));
+    let det = pp * qq - pq * pq;
+    for m1 in -bound..=bound {
+        for m2 in -bound..=bound {
+            for n1 in -bound..=bound {
+                for n2 in -bound..=bound {
+                    let x = [m1, m2, n1, n2];
+                    if x == [0; 4] || !is_period(chars, &x) {
+                        continue;
+                    }
+                    let z = lattice_point(tau, &x);
+                    let (zp, zq) = (herm(tau, p, &z), herm(tau, q, &z));
+                    let a = (qq * zp - pq * zq) / det;
+                    let b = (pp * zq - pq * zp) / det;
+                    let f = lin(a, p, b, q);
+                    let d = [z[0] - f[0], z[1] - f[1]];
+                    if herm(tau, &d, &d).sqrt() <= 1e-9 * herm(tau, &z, &z).sqrt() {
+                        hits.push(x);
+                    }
+                }
+            }
+        }
+    }
+    hits
+}
+
+/// Integer coefficients (k1, k2) with x = k1 c1 + k2 c2, if there are any.
+fn int_combination(c1: &Coords, c2: &Coords, x: &Coords) -> Option<(i64, i64)> {
+    // Solve on the best-conditioned pair of coordinates, then check all four.
+    for i in 0..4 {
+        for j in i + 1..4 {
+            let d = c1[i] * c2[j] - c1[j] * c2[i];
+            if d == 0 {
+                continue;
+            }
+            let n1 = x[i] * c2[j] - x[j] * c2[i];
+            let n2 = c1[i] * x[j] - c1[j] * x[i];
+            if n1 % d != 0 || n2 % d != 0 {
+                return None;
+            }
+            let (k1, k2) = (n1 / d, n2 / d);
+            return (0..4)
+                .all(|k| k1 * c1[k] + k2 * c2[k] == x[k])
+                .then_some((k1, k2));
+        }
+    }
+    None
+}
+
+fn check_torus(tau: &Tau, u: &C2, u2: &C2, chars: &[Char], t: &RealTorus, bound: i64) {
+    let [l1, l2] = &t.lambda;
+    // The basis is in Λ', reduced, oriented, and reproduces U.
+    for x in &t.coords {
+        assert!(is_period(chars, x));
+    }
+    let (n1, n2, d12) = (herm(tau, l1, l1), herm(tau, l2, l2), herm(tau, l1, l2));
+    assert!(n1 <= n2 * (1.0 + 1e-12), "|λ1|² = {n1} > |λ2|² = {n2}");
+    assert!(d12.abs() <= 0.5 * n1 * (1.0 + 1e-12));
+    assert!(t.nu[0] >= 0.0 && t.nu[1] >= 0.0);
+    let f = lin(t.nu[0], l1, t.nu[1], l2);
+    let d = [u[0] - f[0], u[1] - f[1]];
+    // U is rebuilt from two O(1) vectors: roundoff only.
+    assert!(herm(tau, &d, &d).sqrt() <= 1e-12 * herm(tau, u, u).sqrt());
+    // Every lattice point of Λ' in the plane (box search) is an integer
+    // combination of the basis, and the basis vectors themselves are found.
+    let hits = brute_force(tau, u, u2, chars, bound);
+    assert!(!hits.is_empty());
+    for x in &hits {
+        assert!(
+            int_combination(&t.coords[0], &t.coords[1], x).is_some(),
+            "{x:?} not in the span of {:?}",
+            t.coords
+        );
+    }
+    for x in &t.coords {
+        if x.iter().all(|v| v.abs() <= bound) {
+            assert!(hits.contains(x));
+        }
+    }
+}
+
+#[test]
+fn residues_of_the_simple_table_form_a_subgroup_of_order_two() {
+    // The seven characteristics span a 3-dimensional subspace of F_2^4
+    // (docs/theta_quotients.md), so Λ'/2Λ has 2^(4-3) = 2 elements.
+    let r = period_residues(&SIMPLE);
+    assert_eq!(r.len(), 2);
+    assert!(r.contains(&[0, 0, 0, 0]));
+}
+
+#[test]
+fn quotient_signs_match_theta_functions() {
+    // θ[χ](v+λ)/θ(v+λ) = sign · θ[χ](v)/θ(v), with theta values from the
+    // theta module (independent of the sign rule).
+    let mut r = Lcg(7);
+    let tau = random_tau(&mut r);
+    let flat = [tau[0][0], tau[0][1], tau[1][0], tau[1][1]];
+    let v = [c(0.13, 0.07), c(-0.21, 0.11)];
+    let (t0, _) = theta_all(&v, &flat, 1e-15).unwrap();
+    for _ in 0..20 {
+        let x = [r.int(-2, 2), r.int(-2, 2), r.int(-2, 2), r.int(-2, 2)];
+        let l = lattice_point(&tau, &x);
+        let (t1, _) = theta_all(&[v[0] + l[0], v[1] + l[1]], &flat, 1e-15).unwrap();
+        for idx in 0..16 {
+            let chi: Char = [
+                (idx >> 3) as u8 & 1,
+                (idx >> 2) as u8 & 1,
+                (idx >> 1) as u8 & 1,
+                idx as u8 & 1,
+            ];
+            let ratio = (t1[idx] / t1[0]) / (t0[idx] / t0[0]);
+            let s = quotient_sign(&chi, &x) as f64;
+            // Quotients of O(1) theta values at O(1) arguments: roundoff.
+            assert!(
+                (ratio - s).norm() < 1e-9,
+                "x {x:?} chi {chi:?} ratio {ratio}"
+            );
+        }
+    }
+}
+
+#[test]
+fn real_plane_of_a_diagonal_tau() {
+    // τ = i diag(1.3, 0.8), U and U' real: the plane is Re C² = R², which
+    // meets Λ in Z² (n = 0); Λ' ∩ R² is {m : (m, 0) ∈ Λ'}.
+    let tau = [[c(0.0, 1.3), c(0.0, 0.0)], [c(0.0, 0.0), c(0.0, 0.8)]];
+    let u = [c(0.37, 0.0), c(0.52, 0.0)];
+    let u2 = [c(-0.2, 0.0), c(0.9, 0.0)];
+    let t = real_torus(&tau, &u, &u2, &SIMPLE).unwrap();
+    check_torus(&tau, &u, &u2, &SIMPLE, &t, 4);
+    for x in &t.coords {
+        assert_eq!((x[2], x[3]), (0, 0));
+    }
+}
+
+#[test]
+fn random_lattices_match_a_brute_force_search() {
+    let mut r = Lcg(2026);
+    let mut n_ok = 0;
+    for case in 0..40 {
+        let tau = random_tau(&mut r);
+        // A plane through two random points of Λ' (doubled if needed).
+        let pick = |r: &mut Lcg| {
+            let x = [r.int(-2, 2), r.int(-2, 2), r.int(-2, 2), r.int(-2, 2)];
+            if is_period(&SIMPLE, &x) {
+                x
+            } else {
+                x.map(|v| 2 * v)
+            }
+        };
+        let (x1, x2) = (pick(&mut r), pick(&mut r));
+        let (l1, l2) = (lattice_point(&tau, &x1), lattice_point(&tau, &x2));
+        if herm(&tau, &l1, &l1) * herm(&tau, &l2, &l2) - herm(&tau, &l1, &l2).powi(2) < 1e-3 {
+            continue;
+        }
+        let u = lin(r.next() + 0.1, &l1, r.next() - 0.5, &l2);
+        let u2 = lin(r.next() - 0.5, &l1, r.next() + 0.1, &l2);
+        let t = real_torus(&tau, &u, &u2, &SIMPLE).unwrap_or_else(|e| panic!("case {case}: {e:?}"));
+        check_torus(&tau, &u, &u2, &SIMPLE, &t, 5);
+        for x in [&x1, &x2] {
+            assert!(int_combination(&t.coords[0], &t.coords[1], x).is_some());
+        }
+        n_ok += 1;
+    }
+    assert!(n_ok >= 30);
+}
+
+#[test]
+fn basis_convention_is_independent_of_the_spanning_flows() {
+    // The same plane from another pair of flows gives the same reduced basis
+    // and frequencies of the same U.
+    let mut r = Lcg(11);
+    let tau = random_tau(&mut r);
+    let (x1, x2) = ([2, 0, 1, -1], [0, 2, 0, 2]);
+    let (l1, l2) = (lattice_point(&tau, &x1), lattice_point(&tau, &x2));
+    let u = lin(0.31, &l1, 0.17, &l2);
+    let a = real_torus(&tau, &u, &lin(-0.4, &l1, 1.1, &l2), &SIMPLE).unwrap();
+    let b = real_torus(&tau, &u, &lin(2.0, &l1, 0.3, &l2), &SIMPLE).unwrap();
+    assert_eq!(a.coords, b.coords);
+    for k in 0..2 {
+        assert!((a.nu[k] - b.nu[k]).abs() <= 1e-13 * a.nu[0].max(a.nu[1]));
+    }
+}
+
+#[test]
+fn failures_are_named() {
+    let tau = [[c(0.0, 1.3), c(0.0, 0.0)], [c(0.0, 0.0), c(0.0, 0.8)]];
+    let u = [c(0.37, 0.0), c(0.52, 0.0)];
+    let par = [c(0.74, 0.0), c(1.04, 0.0)];
+    assert!(matches!(
+        real_torus(&tau, &u, &par, &SIMPLE),
+        Err(TorusFailure::DegeneratePlane { .. })
+    ));
+    // A generic complex plane meets the lattice in no rank-2 lattice.
+    let w = [c(0.3, 0.1 * std::f64::consts::SQRT_2), c(0.5, -0.7)];
+    let w2 = [c(-0.2, std::f64::consts::E / 7.0), c(0.9, 0.11)];
+    assert!(matches!(
+        real_torus(&tau, &w, &w2, &SIMPLE),
+        Err(TorusFailure::NoRealLattice { .. })
+    ));
+    let nan = [c(f64::NAN, 0.0), c(0.0, 0.0)];
+    assert_eq!(
+        real_torus(&tau, &nan, &u, &SIMPLE),
+        Err(TorusFailure::NonFinite)
+    );
+    let bad = [[c(0.0, -1.0), c(0.0, 0.0)], [c(0.0, 0.0), c(0.0, 0.8)]];
+    assert_eq!(
+        real_torus(&bad, &u, &w, &SIMPLE),
+        Err(TorusFailure::ImagTauNotPositive)
+    );
+    let e: Error = TorusFailure::DegeneratePlane { sin_angle: 0.0 }.into();
+    assert!(e.to_string().contains("real plane"));
+}
+
+#[test]
+fn map_states_keeps_order_and_stops_when_cancelled() {
+    let states: Vec<u64> = (0..1000).collect();
+    let out = map_states(&states, |&s| s * s, &Cancel::never()).unwrap();
+    assert_eq!(out, states.iter().map(|s| s * s).collect::<Vec<_>>());
+    let c = Cancel::never();
+    c.cancel();
+    assert_eq!(map_states(&states, |&s| s, &c), Err(Error::Interrupted));
+    assert!(map_states::<u64, u64, _>(&[], |&s| s, &Cancel::never())
+        .unwrap()
+        .is_empty());
+}
+
+#[test]
+fn second_flow_is_the_other_power() {
+    let a = [0.3, 1.1, 2.0, 3.7];
+    let sq = a.map(|x| x * x);
+    let cu = a.map(|x| x * x * x);
+    // b = a²: the top's flow is the a² flow, so the second is a³; and back.
+    assert_eq!(second_flow_b(&a, &sq), cu);
+    assert_eq!(second_flow_b(&a, &cu), sq);
+    let mixed: [f64; 4] = std::array::from_fn(|i| 0.5 + sq[i] - 0.1 * cu[i]);
+    assert_eq!(second_flow_b(&a, &mixed), cu);
+}
+
+#[test]
+fn state_statuses_and_nan_policy() {
+    // A stand-in for the Theorem: the plane of `real_plane_of_a_diagonal_tau`,
+    // or an error chosen by the state.
+    let tau = [[c(0.0, 1.3), c(0.0, 0.0)], [c(0.0, 0.0), c(0.0, 0.8)]];
+    let solve = |l0: &[f64; 6]| -> Result<FlowData> {
+        if l0[0] > 10.0 {
+            return Err(Error::RepeatedBranchPoints {
+                i: 1,
+                j: 2,
+                value: c(1.0, 0.0),
+            });
+        }
+        Ok(FlowData {
+            tau,
+            u: [c(0.37, 0.0), c(0.52, 0.0)],
+            u2: [c(-0.2, 0.0), c(0.9, 0.0)],
+            chars: SIMPLE.to_vec(),
+        })
+    };
+    let classify = |e: &Error| match e {
+        Error::RepeatedBranchPoints { .. } => Status::CoincidingBranchPoints,
+        _ => Status::Singular,
+    };
+    let run = |l0: [f64; 6]| frequencies_of_state(&l0, solve, classify);
+    let ok = run([0.8, -0.3, 0.5, 1.1, -0.7, 0.2]);
+    assert_eq!(ok.status, Status::Ok);
+    assert!((ok.nu[0] - 0.185).abs() < 1e-15 && (ok.nu[1] - 0.26).abs() < 1e-15);
+    assert_eq!(run([0.0; 6]).status, Status::ZeroState);
+    assert_eq!(
+        run([f64::NAN, 0.0, 0.0, 0.0, 0.0, 0.0]).status,
+        Status::NonFinite
+    );
+    // m = n (m = (l23, l31, l12), n = (l14, l24, l34)): h1 = 2 h0.
+    assert_eq!(
+        run([0.3, -0.2, 0.5, 0.5, 0.2, 0.3]).status,
+        Status::SingularCasimirs
+    );
+    assert_eq!(
+        run([11.0, 0.0, 0.0, 0.0, 1.0, 0.0]).status,
+        Status::CoincidingBranchPoints
+    );
+    for l0 in [[0.0; 6], [11.0, 0.0, 0.0, 0.0, 1.0, 0.0]] {
+        assert!(run(l0).nu.iter().all(|v| v.is_nan()));
+    }
+}
+
+mod on_the_solution {
+    use super::super::solve::{c_pairs, flow_data, rate_for, state_frequencies, torus_of_state};
+    use super::super::*;
+    use crate::solution::Solution;
+
+    const GENERIC: ([f64; 4], [f64; 4], [f64; 6]) = (
+        [0.3, 1.1, 2.0, 3.7],
+        [0.5, -0.2, 1.4, 0.9],
+        [0.8, -0.3, 0.5, 1.1, -0.7, 0.2],
+    );
+
+    #[test]
+    fn rate_for_the_tops_own_field_is_the_solutions_rate() {
+        let (a, b, l0) = GENERIC;
+        let s = Solution::new(&a, &b, &l0).unwrap();
+        let u = rate_for(&s, s.c4()).unwrap();
+        let r = s.rate();
+        for k in 0..2 {
+            // The solution fits the ξ, η rows, rate_for the l rows: two fits
+            // of one consistent system, equal to the solution's accuracy.
+            assert!((u[k] - r[k]).norm() <= 1e-10 * r[0].norm().max(r[1].norm()));
+        }
+    }
+
+    #[test]
+    fn velocities_are_linear_in_b() {
+        // c_ij is linear in b, so U(b) = p2 U(a²) + p3 U(a³) for the cubic
+        // interpolant b = p0 + p1 a + p2 a² + p3 a³ (docs/tori.md §2).
+        let (a, b, l0) = GENERIC;
+        let s = Solution::new(&a, &b, &l0).unwrap();
+        let c_of = |bb: [f64; 4]| c_pairs(&a, &bb).unwrap();
+        let u2 = rate_for(&s, &c_of(a.map(|x| x * x))).unwrap();
+        let u3 = rate_for(&s, &c_of(a.map(|x| x * x * x))).unwrap();
+        let v = nalgebra::Matrix4::from_fn(|i, j| a[i].powi(j as i32));
+        let p = v
+            .lu()
+            .solve(&nalgebra::Vector4::from_column_slice(&b))
+            .unwrap();
+        let r = s.rate();
+        for k in 0..2 {
+            let lin = u2[k] * p[2] + u3[k] * p[3];
+            assert!(
+                (lin - r[k]).norm() <= 1e-12 * r[0].norm().max(r[1].norm()),
+                "{lin} vs {}",
+                r[k]
+            );
+        }
+    }
+
+    #[test]
+    fn second_velocity_agrees_with_a_second_solution() {
+        // U' by rate_for (the l rows of (9)–(10) at v0) against the set-up of
+        // ManakovTop(a, a²) itself (its own U): the same curve and divisor
+        // (the reduction depends on a and l0 only), so the same vector.
+        for (a, b, l0) in [
+            GENERIC,
+            (
+                [1.0, 2.25, 4.84, 9.61],
+                [1.0, 1.5, 2.2, 3.1],
+                [0.4, 1.2, -0.6, 0.9, 0.3, -1.0],
+            ),
+        ] {
+            let s = Solution::new(&a, &b, &l0).unwrap();
+            let b2 = a.map(|x| x * x);
+            let u2 = rate_for(&s, &c_pairs(&a, &b2).unwrap()).unwrap();
+            let r = Solution::new(&a, &b2, &l0).unwrap().rate();
+            let scale = r[0].norm().max(r[1].norm());
+            for k in 0..2 {
+                // Two least-squares fits of the same consistent system with
+                // different row sets/weights: agreement to the solution's ~1e-12.
+                assert!(
+                    (u2[k] - r[k]).norm() <= 1e-10 * scale,
+                    "{} vs {}",
+                    u2[k],
+                    r[k]
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn frequencies_of_the_generic_top_are_positive_and_rebuild_u() {
+        let (a, b, l0) = GENERIC;
+        let (t, _) = torus_of_state(&a, &b, &l0).unwrap();
+        let s = Solution::new(&a, &b, &l0).unwrap();
+        let d = flow_data(&s, &second_flow_b(&a, &b)).unwrap();
+        assert!(t.nu[0] > 0.0 && t.nu[1] > 0.0);
+        for k in 0..2 {
+            let f = t.lambda[0][k] * t.nu[0] + t.lambda[1][k] * t.nu[1];
+            assert!((f - d.u[k]).norm() <= 1e-12);
+        }
+        for x in &t.coords {
+            assert!(is_period(&d.chars, x));
+        }
+        let e = state_frequencies(&a, &b, &l0);
+        assert_eq!(e.status, Status::Ok);
+        assert_eq!(e.nu, t.nu);
+    }
+
+    #[test]
+    fn singular_states_get_their_codes() {
+        let (a, b, _) = GENERIC;
+        // h0 = 0: d_0 = 0 coincides with a branch point.
+        let e = state_frequencies(&a, &b, &[1.0, 0.0, 0.0, 0.0, 0.5, 0.0]);
+        assert_eq!(e.status, Status::CoincidingBranchPoints);
+        assert!(e.nu.iter().all(|v| v.is_nan()));
+        let e = state_frequencies(&a, &b, &[0.3, -0.2, 0.5, 0.5, 0.2, 0.3]);
+        assert_eq!(e.status, Status::SingularCasimirs);
+    }
+}
