@@ -407,7 +407,7 @@ def test_sigint_writes_partial_output_and_exits_130(tmp_path, suffix):
 
 def test_commands_registry_builds_the_parser():
     names = [c.name for c in cli.COMMANDS]
-    assert names[:4] == ["simulate", "kotter", "theta", "theorem"]
+    assert names == ["simulate", "kotter", "theta", "theorem", "frequency-map"]
     for c in cli.COMMANDS:
         assert callable(c.run) and callable(c.add_arguments) and c.example.startswith("manakov ")
 
@@ -435,3 +435,19 @@ def test_theorem_subcommand_writes_png_and_reports_the_error(tmp_path, capsys):
 def test_theorem_subcommand_rejects_unknown_problem():
     r = _run("theorem", "nope")
     assert r.returncode == 2 and "invalid choice" in r.stderr
+
+
+def test_frequency_map_subcommand_writes_png_and_counts_states(tmp_path, capsys):
+    png = tmp_path / "fm.png"
+    argv = ["frequency-map", "generic", "--grid", "4", "-o", str(png), "--no-progress"]
+    assert cli.main(argv) == 0
+    text = capsys.readouterr().out
+    assert png.exists() and png.stat().st_size > 0
+    assert "generic: 16 states (" in text
+    counted = sum(int(n) for n in re.findall(r": (\d+)", text.split("(", 1)[1]))
+    assert counted == 16
+
+
+def test_frequency_map_subcommand_rejects_a_tiny_grid():
+    r = _run("frequency-map", "generic", "--grid", "1")
+    assert r.returncode != 0 and "--grid must be >= 2" in r.stderr

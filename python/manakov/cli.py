@@ -564,6 +564,39 @@ def _run_theorem(args: argparse.Namespace) -> int:
     return 0
 
 
+def _add_frequency_map(p: argparse.ArgumentParser) -> None:
+    p.add_argument("problem", choices=problem_names(), help="a built-in top")
+    p.add_argument("--grid", type=int, default=64, help="states per side of the slice (default 64)")
+    p.add_argument(
+        "-o", "--output", default=None, help="PNG path (default: <problem>-frequency-map.png)"
+    )
+    p.add_argument(
+        "--max-order", type=int, default=5, help="resonances k1 nu1 + k2 nu2 = 0, |k1|+|k2| <= this"
+    )
+    p.add_argument("--no-progress", action="store_true", help="no progress bar")
+
+
+def _run_frequency_map(args: argparse.Namespace) -> int:
+    from .tori import STATUS_NAMES, plot_frequency_map
+
+    if args.grid < 2:
+        raise ValueError(f"--grid must be >= 2, got {args.grid}")
+    out = Path(args.output or f"{args.problem}-frequency-map.png")
+    fm = plot_frequency_map(
+        args.problem,
+        args.grid,
+        out,
+        max_order=args.max_order,
+        progress=False if args.no_progress else None,
+    )
+    status = np.asarray(fm.status)
+    codes, counts = np.unique(status, return_counts=True)
+    summary = ", ".join(f"{STATUS_NAMES[int(c)]}: {int(n)}" for c, n in zip(codes, counts))
+    print(f"{args.problem}: {status.size} states ({summary})")
+    print(f"wrote {out}")
+    return 0
+
+
 # --------------------------------------------------------------------- registry
 
 COMMANDS: tuple[Command, ...] = (
@@ -611,6 +644,16 @@ COMMANDS: tuple[Command, ...] = (
         "  manakov theorem generic --t-end 1000 --samples 2001",
         _add_theorem,
         _run_theorem,
+    ),
+    Command(
+        "frequency-map",
+        "frequencies of the invariant tori over a slice of states, as a PNG",
+        "The frequencies (nu1, nu2) of the real Liouville tori from the Theorem "
+        "(docs/tori.md) over a grid of states at fixed Casimirs h0, h1; the colour is "
+        "nu1/nu2, with the resonance lines k1 nu1 + k2 nu2 = 0 overlaid.",
+        "manakov frequency-map generic --grid 128 -o generic-fmap.png",
+        _add_frequency_map,
+        _run_frequency_map,
     ),
 )
 
