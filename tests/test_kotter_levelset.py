@@ -10,6 +10,7 @@ map along the vector field, not from the samples themselves.
 
 from __future__ import annotations
 
+import inspect
 from functools import cache
 
 import mpmath
@@ -150,7 +151,11 @@ def _mp_roots(a: np.ndarray, l: np.ndarray) -> list:
     P2 = [sum(P[i] * P[k - i] for i in range(3) if 0 <= k - i <= 2) for k in range(5)]
     num = [P2[i] - 4 * h0**2 * G[i] for i in range(5)]
     assert abs(num[0] - (h1**2 - 4 * h0**2)) < mpmath.mpf(10) ** -40
-    roots = mpmath.polyroots(num, maxsteps=200, extraprec=200)
+    # mpmath >= 1.4 deprecates descending coefficients unless asc= is given.
+    if "asc" in inspect.signature(mpmath.polyroots).parameters:
+        roots = mpmath.polyroots(num[::-1], maxsteps=200, extraprec=200, asc=True)
+    else:
+        roots = mpmath.polyroots(num, maxsteps=200, extraprec=200)
     out = []
     for r in roots:
         fp = mpmath.fprod(r - q for q in roots if q is not r)
