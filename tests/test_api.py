@@ -4,6 +4,8 @@ non-contiguous inputs, inputs never modified, exact exception types, no panics."
 # ruff: noqa: E741
 from __future__ import annotations
 
+import warnings
+
 import numpy as np
 import pytest
 
@@ -205,6 +207,16 @@ def test_matrix_helpers_reject_complex_and_non_finite():
         manakov.from_matrix(manakov.to_matrix(l) + 0j)
     with pytest.raises(ValueError, match="finite"):
         manakov.from_matrix(np.full((3, 3), np.nan))
+
+
+def test_from_matrix_skew_check_does_not_overflow():
+    """Issue 11 fuzz: m + m^T overflowed (a RuntimeWarning) for entries near 1e308."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        with pytest.raises(ValueError, match="skew"):
+            manakov.from_matrix([[0.0, 1e308], [1e308, 0.0]])
+        l = manakov.from_matrix([[0.0, 1.7e308], [-1.7e308, 0.0]])
+    assert l.tolist() == [1.7e308]
 
 
 @pytest.mark.parametrize("t_eval", [[1e-320], [1e-320, 1.0], [0.0, 5e-324, 1.0]])

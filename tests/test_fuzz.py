@@ -564,10 +564,6 @@ def test_fuzz_slow(prop):
     _run(prop, SLOW_EXAMPLES, derandomize=False)
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="issue 11 fuzz item 6, fixed on branch 'batch': remove this marker after the merge",
-)
 def test_integrate_does_not_return_the_callers_t_eval():
     p = PROBLEMS[0]
     top = manakov.ManakovTop(p.a, p.b)

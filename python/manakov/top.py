@@ -128,9 +128,11 @@ def from_matrix(m: Any, *, check: bool = True) -> np.ndarray:
         raise ValueError(f"m must have shape (..., n, n), got {arr.shape}")
     if check:
         scale = np.max(np.abs(arr), initial=0.0)
-        asym = np.max(np.abs(arr + np.swapaxes(arr, -1, -2)), initial=0.0)
-        if asym > 8 * np.finfo(float).eps * scale:
-            raise ValueError(f"m must be skew-symmetric; max |m + m^T| = {asym:e}")
+        # Halved before adding so entries near the double limit cannot overflow.
+        half = 0.5 * arr
+        asym_half = np.max(np.abs(half + np.swapaxes(half, -1, -2)), initial=0.0)
+        if asym_half > 4 * np.finfo(float).eps * scale:
+            raise ValueError(f"m must be skew-symmetric; max |m + m^T| / 2 = {asym_half:e}")
     n = arr.shape[-1]
     iu = np.triu_indices(n, 1)
     return arr[..., iu[0], iu[1]].copy()
