@@ -637,3 +637,12 @@ def test_nearly_equal_a_over_budget_names_the_cause():
     with pytest.raises(ValueError, match=r"nearly equal a_i.*move the a_i apart"):
         top.integrate(p.l0, 1000.0)
     assert time.perf_counter() - t0 < REFUSAL_SECONDS
+
+
+def test_integrate_many_with_a_state_near_the_double_limit_raises_cleanly():
+    # Slow-fuzz reproducer: the batch default step overflowed |l0| with a
+    # RuntimeWarning (an error under pytest) before the ValueError naming the cause.
+    top = manakov.ManakovTop([0.3, 1.1, 2.0, 3.7], [0.5, -0.2, 1.4, 0.9])
+    l0s = np.array([[0.0, 0.0, 0.0, 0.0, 1.7e308, 1.7e308]])
+    with pytest.raises(ValueError, match="too large"):
+        top.integrate_many(l0s, 1.0, method="gauss16", max_steps=1)

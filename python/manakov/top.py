@@ -685,7 +685,10 @@ class FrahmTop:
             else:
                 big = np.max(np.abs(flat), axis=1, keepdims=True)
                 safe = np.where(big > 0, big, 1.0)
-                norms = big[:, 0] * np.linalg.norm(flat / safe, axis=1)
+                # Only the argmax is used: a norm overflowing to inf still picks the
+                # largest state, whose default_dt then names the cause.
+                with np.errstate(over="ignore"):
+                    norms = big[:, 0] * np.linalg.norm(flat / safe, axis=1)
                 dtf = self.default_dt(flat[int(np.argmax(norms))], method)
         else:
             dtf = self._options(np.zeros(self.dim), method, dt)
