@@ -56,6 +56,11 @@ pub const DEGENERATE_RTOL: f64 = 1e-13;
 /// this small relative to the largest `|θ[χ](v0)|`.
 pub const DIVISOR_AT_INFINITY_RTOL: f64 = 1e-10;
 
+/// The estimate of the `C_L²` at `v0` takes part in the consensus of
+/// [`aux_constants_squared`] when every needed `|θ[χ](v0)|` is at least this
+/// fraction of the largest (below, the quotient `P_L θ/θ_L` loses digits).
+const AUX_V0_MIN: f64 = 1e-3;
+
 /// Times per work unit between two cancellation checks (~2 ms on one core).
 const CHUNK: usize = 8192;
 
@@ -224,7 +229,6 @@ impl Solution {
         // without the closed form of K (which cancels by ~1/|d_j − d_k|²).
         let eps = eps41(&kotter);
         let g = state0.points.g;
-        let big_g = g * (C::new(1.0, 0.0) - eps * state0.p0);
         let mut p_at0 = [C::new(0.0, 0.0); 7];
         p_at0[0] = state0.p0;
         for j in 0..3 {
@@ -232,7 +236,18 @@ impl Solution {
             p_at0[4 + j] = state0.eta[j] / (sc[j] * g);
         }
         // C_L² at a well-conditioned auxiliary divisor, sign from l0.
-        let c2 = aux_constants_squared(&curve, &state0.curve, &plan, &idx, &rc)?;
+        // The estimate at v0 votes too, unless a θ[χ_L](v0) is too small to divide by.
+        let qv0 = idx
+            .iter()
+            .map(|&i| jet.values[i].norm() / big)
+            .fold(f64::INFINITY, f64::min);
+        let est0 = (qv0 > AUX_V0_MIN).then(|| {
+            std::array::from_fn(|m| {
+                let r = p_at0[m] * th0 / jet.values[idx[m + 1]];
+                r * r
+            })
+        });
+        let c2 = aux_constants_squared(&curve, &state0.curve, &plan, &idx, &rc, est0)?;
         let mut cl = [C::new(0.0, 0.0); 7];
         let mut calibration = [0.0; 7];
         for m in 0..7 {
@@ -242,6 +257,24 @@ impl Solution {
             cl[m] = if plus <= minus { root } else { -root };
             calibration[m] = plus.min(minus) / root.norm();
         }
+        // G = g (1 − ε P_0) at v0 from the theta side: the P_L(v0) of the
+        // calibrated (34), g by least squares from the six equations (37)
+        // `(ξ_j, η_j) = √c_j g P_L(v0)`. The reduction's own g, P_0 ((30a), (31b))
+        // are sums that cancel when the |d_j| spread over many orders of
+        // magnitude (P_0 loses up to 1e-6 there); the fit keeps l(v0) = l0.
+        let p_th: [C; 7] = std::array::from_fn(|m| cl[m] * jet.values[idx[m + 1]] / th0);
+        let (mut num_g, mut den_g) = (C::new(0.0, 0.0), 0.0);
+        for j in 0..3 {
+            for (w, r) in [
+                (sc[j] * p_th[1 + j], state0.xi[j]),
+                (sc[j] * p_th[4 + j], state0.eta[j]),
+            ] {
+                num_g += w.conj() * r;
+                den_g += w.norm_sqr();
+            }
+        }
+        let g_fit = if den_g > 0.0 { num_g / den_g } else { g };
+        let big_g = g_fit * (C::new(1.0, 0.0) - eps * p_th[0]);
 
         // (37), (42), (23): l_q = N_q / D.
         let mut den = [C::new(0.0, 0.0); 8];
@@ -265,41 +298,31 @@ impl Solution {
         // l = (m3, −m2, n1, m1, n2, n3)
         let num = [mw[2], neg(mw[1]), nw[0], mw[0], nw[1], nw[2]];
 
-        // U from (1). ξ, η are linear in l with the constant coefficients of
-        // (20), (22), so ξ̇ = ξ(l̇); and ξ_j = Nξ_j(v)/D(v) gives
-        // (∇Nξ_j − ξ_j ∇D)·U = ξ̇_j D at v0 (likewise η): six equations for
-        // the two components of U. (Working in ξ, η rather than l keeps the
-        // inverse map (23), whose α_j … δ_j are the least accurate constants
-        // of the reduction, out of U.)
-        let ldot = so4::vector_field4(&c4, l0);
-        let (xi_dot, eta_dot) = crate::kotter::xi_eta(&kotter, &ldot);
+        // U from (1): l_q = N_q(v)/D(v) gives (∇N_q − l_q ∇D)·U = l̇_q D at v0,
+        // six equations for the two components of U, solved by least squares.
+        // The rows are the components of l itself, unscaled (they share the
+        // scale |l|): on tops with a nearly symmetric pair a_i ≈ a_j (|U| ~ 100)
+        // this keeps U to ~1e-14, where rows in ξ, η scaled to unit size lost
+        // up to 1e-12 of U (1e-9 of l at t = 20).
         let theta = |m: usize| jet.values[idx[m]];
         let grad = |m: usize, k: usize| jet.gradient[idx[m] * 2 + k];
         let dval: C = (0..8).map(|m| den[m] * theta(m)).sum();
         let dgrad: [C; 2] = std::array::from_fn(|k| (0..8).map(|m| den[m] * grad(m, k)).sum());
+        let lq: [C; 6] =
+            std::array::from_fn(|q| (0..8).map(|m| num[q][m] * theta(m)).sum::<C>() / dval);
+        // l̇ of (1) at the quotient's own value at v0 (it differs from l0 by the
+        // rounding of the constants, ~1e-13): U is then the exact rate of the
+        // theta quotient's flow, consistent to roundoff (with l0 in its place,
+        // U missed by up to 1e-13 relative on the fast tops).
+        let ldot = so4::vector_field4(&c4, &lq.map(|z| z.re));
         let mut amat = DMatrix::<C>::zeros(6, 2);
         let mut rhs = DVector::<C>::zeros(6);
-        for q in 0..6 {
-            let (w, dot) = if q < 3 {
-                (&xi_w[q], xi_dot[q])
-            } else {
-                (&eta_w[q - 3], eta_dot[q - 3])
-            };
-            let nval: C = (0..8).map(|m| w[m] * theta(m)).sum();
-            let xq = nval / dval;
-            let mut row = [C::new(0.0, 0.0); 2];
+        for (q, w) in num.iter().enumerate() {
             for k in 0..2 {
                 let ng: C = (0..8).map(|m| w[m] * grad(m, k)).sum();
-                row[k] = ng - xq * dgrad[k];
+                amat[(q, k)] = ng - lq[q] * dgrad[k];
             }
-            let r = dot * dval;
-            // Rows scaled to unit size: each equation counts alike.
-            let sz = row[0].norm().max(row[1].norm()).max(r.norm());
-            if sz > 0.0 {
-                amat[(q, 0)] = row[0] / sz;
-                amat[(q, 1)] = row[1] / sz;
-                rhs[q] = r / sz;
-            }
+            rhs[q] = ldot[q] * dval;
         }
         let svd = amat.clone().svd(true, true);
         let sv = &svd.singular_values;
@@ -531,19 +554,24 @@ impl Solution {
     }
 }
 
-/// `ε` by the corrected (41), in root differences of `F`, the sign nearest to
-/// the reduction's `ε` (corrected (40)).
+/// `ε` by the corrected (41), in root differences of `F`: with
+/// `Y = √((s2−s3)(s1−s4))`, `W = √((s1−s3)(s2−s4))`, `Z = √((s1−s2)(s3−s4))`
+/// the two combinations `(Y ∓ W)/(√d_4 Z)` are `ε` and `−1/(d_4 ε)`
+/// (`Y² − W² = −Z²`), and principal roots do not tell which is which; the
+/// one (and the sign) nearest the reduction's `ε` (corrected (40)) is taken.
+/// (41) serves because it keeps its digits where (40)'s sums cancel.
 fn eps41(k: &KotterConstants) -> C {
     let s = k.s;
     let sq = sqrt_principal;
     let sd4 = k.sqrt_d[0] * k.sqrt_d[1] * k.sqrt_d[2];
-    let e = (sq((s[1] - s[2]) * (s[0] - s[3])) - sq((s[0] - s[2]) * (s[1] - s[3])))
-        / (sd4 * sq((s[0] - s[1]) * (s[2] - s[3])));
-    if (e - k.eps).norm() <= (e + k.eps).norm() {
-        e
-    } else {
-        -e
-    }
+    let y = sq((s[1] - s[2]) * (s[0] - s[3]));
+    let w = sq((s[0] - s[2]) * (s[1] - s[3]));
+    let den = sd4 * sq((s[0] - s[1]) * (s[2] - s[3]));
+    [(y - w) / den, (y + w) / den]
+        .into_iter()
+        .flat_map(|e| [e, -e])
+        .min_by(|p, q| (p - k.eps).norm().total_cmp(&(q - k.eps).norm()))
+        .unwrap_or(k.eps)
 }
 
 fn coinciding(i: usize, j: usize, value: C) -> Error {
@@ -558,14 +586,29 @@ fn coinciding(i: usize, j: usize, value: C) -> Error {
     ))
 }
 
-/// `C_L² = P_L² θ(v)²/θ_L(v)²` at the best of a few fixed divisors (the one
-/// whose smallest needed `|θ[χ](v)|` is largest relative to the largest).
+/// Relative agreement of two estimates of the `C_L²` that counts as a vote
+/// in [`aux_constants_squared`]: estimates from well-conditioned divisors
+/// agree to ~1e-14, a poorly conditioned one misses by 1e-10 … 1e-5.
+const AUX_AGREE_RTOL: f64 = 1e-12;
+
+/// `C_L² = P_L² θ(v)²/θ_L(v)²` by consensus over a few fixed divisors and the
+/// estimate `est0` at `v0` (`None` where a `θ_L(v0)` is too small to divide by).
+///
+/// A single divisor is not enough: where the branch points span many orders
+/// of magnitude (`|d_4| / |d_3|` up to 1e10 when two `a_j` nearly coincide), a
+/// divisor at the scale of the largest one loses up to 1e-9 of `C_L²` (a
+/// common factor in all seven), while divisors at the geometric mean of the
+/// scales keep roundoff. So divisors are placed at both scales, each gives an
+/// estimate, and the estimate that agrees ([`AUX_AGREE_RTOL`]) with the most
+/// others wins; ties go to the divisor whose smallest needed `|θ[χ](v)|` is
+/// largest relative to the largest.
 fn aux_constants_squared(
     curve: &HyperellipticCurve,
     kc: &KotterCurve,
     plan: &ThetaPlan,
     idx: &[usize; 8],
     rc: &[C; 2],
+    est0: Option<[C; 7]>,
 ) -> Result<[C; 7]> {
     let bp = kc.branch_points();
     let center: C = bp.iter().sum::<C>() / 5.0;
@@ -573,52 +616,86 @@ fn aux_constants_squared(
         .iter()
         .fold(0.0f64, |m, d| m.max((d - center).norm()))
         .max(f64::MIN_POSITIVE);
-    // Fixed generic offsets in units of the radius (off the real axis, both sheets).
+    // Geometric mean of the non-zero |d_j|: a point at that modulus is, in
+    // ratio, far from every branch point, whatever their spread.
+    let (log_sum, count) = bp
+        .iter()
+        .filter(|d| d.norm() > 0.0)
+        .fold((0.0f64, 0u32), |(s, n), d| (s + d.norm().ln(), n + 1));
+    let geo = if count > 0 {
+        (log_sum / f64::from(count)).exp()
+    } else {
+        radius
+    };
+    // Fixed generic offsets (off the real axis, both sheets).
     const W: [(f64, f64, f64, f64); 4] = [
         (0.37, 0.61, -0.53, -0.29),
         (-0.71, 0.43, 0.58, 0.47),
         (0.12, -0.77, -0.41, 0.66),
         (0.83, 0.21, -0.19, -0.88),
     ];
-    let mut best: Option<(f64, [C; 7])> = None;
-    for (k, &(a1, b1, a2, b2)) in W.iter().enumerate() {
-        let x1 = center + C::new(a1, b1) * (1.3 * radius);
-        let x2 = center + C::new(a2, b2) * (1.3 * radius);
-        let y1 = curve.y(x1, 1);
-        let y2 = curve.y(x2, if k % 2 == 0 { -1 } else { 1 });
-        let ua = curve.abel(x1, y1)?;
-        let ub = curve.abel(x2, y2)?;
-        let v = [ua[0] + ub[0] + rc[0], ua[1] + ub[1] + rc[1]];
-        let (vals, _) = plan.theta_all(&v)?;
-        let big = vals.iter().fold(0.0f64, |m, z| m.max(z.norm()));
-        let q = idx
-            .iter()
-            .map(|&i| vals[i].norm() / big)
-            .fold(f64::INFINITY, f64::min);
-        if best.as_ref().is_some_and(|(bq, _)| *bq >= q) {
-            continue;
-        }
-        let w = kc.wurzel(x1, y1, x2, y2, None)?;
-        let p: [C; 7] = [
-            w.p[0],
-            w.pjk[2][3],
-            w.pjk[3][1],
-            w.pjk[1][2],
-            w.pjk[1][4],
-            w.pjk[2][4],
-            w.pjk[3][4],
-        ];
-        let th = vals[idx[0]];
-        let c2: [C; 7] = std::array::from_fn(|m| {
-            let r = p[m] * th / vals[idx[m + 1]];
-            r * r
-        });
-        best = Some((q, c2));
+    let mut cands: Vec<(f64, [C; 7])> = Vec::with_capacity(9);
+    if let Some(e) = est0 {
+        cands.push((0.0, e));
     }
-    best.map(|(_, c)| c).ok_or(Error::InvalidArgument {
-        what: "curve",
-        reason: "no auxiliary divisor".into(),
-    })
+    for (k, &(a1, b1, a2, b2)) in W.iter().enumerate() {
+        for (origin, scale) in [(center, 1.3 * radius), (C::new(0.0, 0.0), geo)] {
+            let x1 = origin + C::new(a1, b1) * scale;
+            let x2 = origin + C::new(a2, b2) * scale;
+            let y1 = curve.y(x1, 1);
+            let y2 = curve.y(x2, if k % 2 == 0 { -1 } else { 1 });
+            let ua = curve.abel(x1, y1)?;
+            let ub = curve.abel(x2, y2)?;
+            let v = [ua[0] + ub[0] + rc[0], ua[1] + ub[1] + rc[1]];
+            let (vals, _) = plan.theta_all(&v)?;
+            let big = vals.iter().fold(0.0f64, |m, z| m.max(z.norm()));
+            let q = idx
+                .iter()
+                .map(|&i| vals[i].norm() / big)
+                .fold(f64::INFINITY, f64::min);
+            if q.is_nan() || q <= 0.0 {
+                continue;
+            }
+            let Ok(w) = kc.wurzel(x1, y1, x2, y2, None) else {
+                continue;
+            };
+            let p: [C; 7] = [
+                w.p[0],
+                w.pjk[2][3],
+                w.pjk[3][1],
+                w.pjk[1][2],
+                w.pjk[1][4],
+                w.pjk[2][4],
+                w.pjk[3][4],
+            ];
+            let th = vals[idx[0]];
+            let c2: [C; 7] = std::array::from_fn(|m| {
+                let r = p[m] * th / vals[idx[m + 1]];
+                r * r
+            });
+            if c2.iter().all(|z| z.re.is_finite() && z.im.is_finite()) {
+                cands.push((q, c2));
+            }
+        }
+    }
+    let agree = |x: &[C; 7], y: &[C; 7]| {
+        x.iter()
+            .zip(y)
+            .all(|(p, q)| (p - q).norm() <= AUX_AGREE_RTOL * p.norm().max(q.norm()))
+    };
+    let votes: Vec<usize> = cands
+        .iter()
+        .map(|(_, x)| cands.iter().filter(|(_, y)| agree(x, y)).count())
+        .collect();
+    cands
+        .iter()
+        .zip(&votes)
+        .max_by(|((qa, _), va), ((qb, _), vb)| va.cmp(vb).then(qa.total_cmp(qb)))
+        .map(|((_, c), _)| *c)
+        .ok_or(Error::InvalidArgument {
+            what: "curve",
+            reason: "no auxiliary divisor gives finite Wurzelfunktionen".into(),
+        })
 }
 
 #[cfg(test)]
