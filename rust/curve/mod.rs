@@ -49,6 +49,11 @@ use num_complex::Complex64;
 
 use crate::error::{Error, Result};
 
+/// Floor of the relative weights of the Gauss–Newton polish of the points
+/// (a fraction of the largest of the six targets): below it a component is
+/// fitted absolutely.
+const REL_FLOOR: f64 = 1e-8;
+
 /// Relative residual `|y² − R(z)| / Π_j (|z| + |d_j|)` above which a point is
 /// rejected as not lying on the curve. `Π_j (|z| + |d_j|)` bounds the size of
 /// the terms of `R(z)`, so rounding in any reasonable computation of `y`
@@ -511,6 +516,27 @@ impl KotterCurve {
         g_ref: Option<Complex64>,
         rtol: f64,
     ) -> Result<WurzelPoints> {
+        self.points_from_xi_eta_fit(xi, eta, sqrt_c, g_ref, rtol, None)
+    }
+
+    /// [`KotterCurve::points_from_xi_eta`] with the polish fitting
+    /// `(ξ, η)` in the norm of a downstream linear map: `lmap = [α, β, γ, δ]`
+    /// weighs the residuals `r_ξj, r_ηj` as `α_j r_ξj + β_j r_ηj` and
+    /// `γ_j r_ξj + δ_j r_ηj` ((23): the error the points cause in `m_j, n_j`).
+    /// Without it each component is fitted relative to its own size.
+    ///
+    /// Data computed in floating point lie off the quadrics (11) by a few
+    /// ulps of their largest terms; the polish has to move some component by
+    /// that much, and `lmap` makes it move the ones `l` is least sensitive to.
+    pub fn points_from_xi_eta_fit(
+        &self,
+        xi: [Complex64; 3],
+        eta: [Complex64; 3],
+        sqrt_c: Option<[Complex64; 3]>,
+        g_ref: Option<Complex64>,
+        rtol: f64,
+        lmap: Option<&[[Complex64; 3]; 4]>,
+    ) -> Result<WurzelPoints> {
         check_finite_c("xi", &xi)?;
         check_finite_c("eta", &eta)?;
         if let Some(gr) = g_ref {
@@ -608,7 +634,7 @@ impl KotterCurve {
                 }
             }
         }
-        let mut b = self.refine(best, &target, &sc);
+        let mut b = self.refine(best, &target, &sc, lmap);
         b.g *= scale;
         b.residual *= scale;
         if (b.z1 - b.z2).norm() <= NEAR_DOUBLE_ROOT * b.z1.norm().max(b.z2.norm()) {
@@ -667,6 +693,7 @@ impl KotterCurve {
         start: WurzelPoints,
         target: &[Complex64; 6],
         sc: &[Complex64; 3],
+        lmap: Option<&[[Complex64; 3]; 4]>,
     ) -> WurzelPoints {
         let d = self.d;
         let zero = Complex64::new(0.0, 0.0);
@@ -703,6 +730,34 @@ impl KotterCurve {
                 .map(|i| ((target[i] - f[i]) * sc[i % 3]).norm())
                 .fold(0.0, nan_max)
         };
+        // Newton works on relative residuals: (23) maps ξ, η to l with
+        // coefficients α_j … δ_j that grow where ξ_j is small (one |d_j| of
+        // 1e5 … 1e6 makes a component 100× smaller than the largest), so an
+        // absolute fit left that component 1e-12 off relatively and the round
+        // trip l → l 3e-12 off. A floor keeps an exactly vanishing one finite.
+        let tmax = target.iter().fold(0.0f64, |m, v| m.max(v.norm()));
+        let wt: [f64; 6] = std::array::from_fn(|i| 1.0 / target[i].norm().max(REL_FLOOR * tmax));
+        // The rows the polish minimises: a residual (or Jacobian column) in the
+        // P-space of the six targets, mapped to l-space by `lmap` (through
+        // ξ = √c P), else weighted relatively.
+        let rows = |v: &[Complex64; 6]| -> [Complex64; 6] {
+            match lmap {
+                Some([al, be, ga, de]) => std::array::from_fn(|q| {
+                    let j = q % 3;
+                    let (x, y) = (sc[j] * v[j], sc[j] * v[j + 3]);
+                    if q < 3 {
+                        al[j] * x + be[j] * y
+                    } else {
+                        ga[j] * x + de[j] * y
+                    }
+                }),
+                None => std::array::from_fn(|i| v[i] * wt[i]),
+            }
+        };
+        let obj_of = |f: &[Complex64; 6]| -> f64 {
+            let r: [Complex64; 6] = std::array::from_fn(|i| target[i] - f[i]);
+            rows(&r).iter().map(|v| v.norm()).fold(0.0, nan_max)
+        };
         let six = |r1: &[Complex64; 5], r2: &[Complex64; 5], g: Complex64| {
             let dz = dz_of(r1[b1], r2[b2]);
             let w = wurzel_from_roots(r1, r2, dz, &[1.0; 5]);
@@ -728,7 +783,8 @@ impl KotterCurve {
             })
         };
         let mut f = six(&r1, &r2, g);
-        let mut resid = resid_of(&f);
+        let obj_start = obj_of(&f);
+        let mut obj = obj_start;
         for _ in 0..8 {
             if g == zero || dz_of(r1[b1], r2[b2]) == zero {
                 break;
@@ -741,12 +797,15 @@ impl KotterCurve {
             let fp2 = six(&r1, &moved(&r2, b2, &dd2, c(h2)), g);
             let fm2 = six(&r1, &moved(&r2, b2, &dd2, c(-h2)), g);
             let mut rhs = nalgebra::SVector::<Complex64, 6>::zeros();
+            let col0 = rows(&std::array::from_fn(|i| (fp1[i] - fm1[i]) / (2.0 * h1)));
+            let col1 = rows(&std::array::from_fn(|i| (fp2[i] - fm2[i]) / (2.0 * h2)));
+            let col2 = rows(&std::array::from_fn(|i| f[i] / g));
+            let res = rows(&std::array::from_fn(|i| target[i] - f[i]));
             for i in 0..6 {
-                let w = sc[i % 3];
-                jac[(i, 0)] = w * (fp1[i] - fm1[i]) / (2.0 * h1);
-                jac[(i, 1)] = w * (fp2[i] - fm2[i]) / (2.0 * h2);
-                jac[(i, 2)] = w * f[i] / g;
-                rhs[i] = w * (target[i] - f[i]);
+                jac[(i, 0)] = col0[i];
+                jac[(i, 1)] = col1[i];
+                jac[(i, 2)] = col2[i];
+                rhs[i] = res[i];
             }
             // nalgebra's SVD never returns on a NaN entry and panics on an
             // infinite one (curves of scale 1e27 and beyond overflow here):
@@ -779,15 +838,16 @@ impl KotterCurve {
             let nr2 = moved(&r2, b2, &dd2, step[1]);
             let ng = g + step[2];
             let nf = six(&nr1, &nr2, ng);
-            let nres = resid_of(&nf);
-            if nres.is_nan() || nres >= resid {
+            let nobj = obj_of(&nf);
+            if nobj.is_nan() || nobj >= obj {
                 break;
             }
-            (g, r1, r2, f, resid) = (ng, nr1, nr2, nf, nres);
+            (g, r1, r2, f, obj) = (ng, nr1, nr2, nf, nobj);
         }
-        if resid >= start.residual {
+        if obj >= obj_start {
             return start;
         }
+        let resid = resid_of(&f);
         let (w1, w2) = (r1[b1], r2[b2]);
         let zd1: [Complex64; 5] = std::array::from_fn(|j| w1 * w1 + dd1[j]);
         let zd2: [Complex64; 5] = std::array::from_fn(|j| w2 * w2 + dd2[j]);

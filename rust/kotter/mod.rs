@@ -1199,7 +1199,14 @@ pub fn kotter_with(constants: KotterConstants, l: &[f64; 6]) -> Result<KotterSta
         });
     }
     let g42 = sqrt_principal(C::new(constants.h[0], 0.0) / constants.k) / one_m;
-    let points = curve.points_from_xi_eta(xi, eta, None, Some(g42), UNIFORM_RTOL)?;
+    let lmap = [
+        constants.alpha,
+        constants.beta,
+        constants.gamma,
+        constants.delta,
+    ];
+    let points =
+        curve.points_from_xi_eta_fit(xi, eta, None, Some(g42), UNIFORM_RTOL, Some(&lmap))?;
     let mis = (points.g - g42).norm();
     if mis.is_nan() || mis > G42_RTOL * g42.norm() {
         return Err(Error::InvalidArgument {
