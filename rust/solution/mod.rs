@@ -598,9 +598,10 @@ const AUX_AGREE_RTOL: f64 = 1e-12;
 /// of magnitude (`|d_4| / |d_3|` up to 1e10 when two `a_j` nearly coincide), a
 /// divisor at the scale of the largest one loses up to 1e-9 of `C_L²` (a
 /// common factor in all seven), while divisors at the geometric mean of the
-/// scales keep roundoff. So divisors are placed at both scales, each gives an
-/// estimate, and the estimate that agrees ([`AUX_AGREE_RTOL`]) with the most
-/// others wins; ties go to the divisor whose smallest needed `|θ[χ](v)|` is
+/// scales keep roundoff. So four divisors are placed at the geometric-mean
+/// scale, four more at the outer scale only if fewer than three estimates
+/// agree, each gives an estimate, and the estimate that agrees
+/// ([`AUX_AGREE_RTOL`]) with the most others wins; ties go to the divisor whose smallest needed `|θ[χ](v)|` is
 /// largest relative to the largest.
 fn aux_constants_squared(
     curve: &HyperellipticCurve,
@@ -638,8 +639,26 @@ fn aux_constants_squared(
     if let Some(e) = est0 {
         cands.push((0.0, e));
     }
-    for (k, &(a1, b1, a2, b2)) in W.iter().enumerate() {
-        for (origin, scale) in [(center, 1.3 * radius), (C::new(0.0, 0.0), geo)] {
+    let agree = |x: &[C; 7], y: &[C; 7]| {
+        x.iter()
+            .zip(y)
+            .all(|(p, q)| (p - q).norm() <= AUX_AGREE_RTOL * p.norm().max(q.norm()))
+    };
+    // (votes, q, index) of the best-supported candidate.
+    let best = |cands: &[(f64, [C; 7])]| {
+        cands
+            .iter()
+            .enumerate()
+            .map(|(i, (q, x))| (cands.iter().filter(|(_, y)| agree(x, y)).count(), *q, i))
+            .max_by(|a, b| a.0.cmp(&b.0).then(a.1.total_cmp(&b.1)))
+    };
+    // The geometric-mean scale first; the outer scale only when fewer than
+    // three estimates agree there (a clustered curve: the two scales coincide).
+    for (origin, scale) in [(C::new(0.0, 0.0), geo), (center, 1.3 * radius)] {
+        if best(&cands).is_some_and(|(votes, _, _)| votes >= 3) {
+            break;
+        }
+        for (k, &(a1, b1, a2, b2)) in W.iter().enumerate() {
             let x1 = origin + C::new(a1, b1) * scale;
             let x2 = origin + C::new(a2, b2) * scale;
             let y1 = curve.y(x1, 1);
@@ -678,20 +697,8 @@ fn aux_constants_squared(
             }
         }
     }
-    let agree = |x: &[C; 7], y: &[C; 7]| {
-        x.iter()
-            .zip(y)
-            .all(|(p, q)| (p - q).norm() <= AUX_AGREE_RTOL * p.norm().max(q.norm()))
-    };
-    let votes: Vec<usize> = cands
-        .iter()
-        .map(|(_, x)| cands.iter().filter(|(_, y)| agree(x, y)).count())
-        .collect();
-    cands
-        .iter()
-        .zip(&votes)
-        .max_by(|((qa, _), va), ((qb, _), vb)| va.cmp(vb).then(qa.total_cmp(qb)))
-        .map(|((_, c), _)| *c)
+    best(&cands)
+        .map(|(_, _, i)| cands[i].1)
         .ok_or(Error::InvalidArgument {
             what: "curve",
             reason: "no auxiliary divisor gives finite Wurzelfunktionen".into(),
