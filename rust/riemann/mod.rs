@@ -51,12 +51,21 @@ use num_complex::Complex64;
 use crate::curve::sqrt_principal;
 use crate::error::{Error, Result};
 use crate::theta::ThetaPlan;
-use quad::{nodes_for, Piece, SegmentSqrt};
+use quad::{abs_fast, focal_half_sum_sqrt, nodes_for, sqrt_fast, Piece, SegmentSqrt, SqrtProduct};
 
 type C = Complex64;
 
 /// Largest genus accepted (the theta layer's limit).
 pub const MAX_GENUS: usize = crate::theta::MAX_GENUS;
+
+/// Most finite branch points (`2 MAX_GENUS + 2`): the size of the per-point
+/// stack buffers.
+const MAX_N: usize = 2 * MAX_GENUS + 2;
+
+/// One unnormalised or normalised Abel vector on the stack (first `g` entries).
+type Row = [C; MAX_GENUS];
+
+const ZERO_ROW: Row = [C::new(0.0, 0.0); MAX_GENUS];
 
 /// Two branch points closer than this relative to their modulus are one
 /// (the curve is singular to double precision).
@@ -127,6 +136,11 @@ pub struct HyperellipticCurve {
     u_branch: Vec<Vec<C>>,
     /// Even `n`: `∫_{P0}^{∞+} ω` (unnormalised), `∞±` where `y/x^{g+1} → ±1`.
     u_inf: Vec<C>,
+    /// `|e_k|`, `|e_k − e_m|` (row-major `n × n`) and `|e_k − center|`: the
+    /// per-point route choice and point check need only distances to `x`.
+    e_abs: Vec<f64>,
+    e_dist: Vec<f64>,
+    c_dist: Vec<f64>,
     derived: OnceLock<std::result::Result<Derived, Error>>,
 }
 
@@ -209,6 +223,9 @@ impl HyperellipticCurve {
         let radius = e.iter().map(|v| (v - center).norm()).fold(0.0, f64::max);
 
         let tree = basis::spanning_tree(&e)?;
+        let e_abs = e.iter().map(|&v| v.norm()).collect();
+        let e_dist = (0..n * n).map(|i| (e[i / n] - e[i % n]).norm()).collect();
+        let c_dist = e.iter().map(|&v| (v - center).norm()).collect();
         let mut this = HyperellipticCurve {
             e,
             g,
@@ -227,6 +244,9 @@ impl HyperellipticCurve {
             im_tau_inv: DMatrix::zeros(g, g),
             u_branch: Vec::new(),
             u_inf: vec![C::new(0.0, 0.0); g],
+            e_abs,
+            e_dist,
+            c_dist,
             derived: OnceLock::new(),
         };
         this.build()?;
@@ -394,8 +414,8 @@ impl HyperellipticCurve {
             // middle, composite Gauss–Legendre (the bisection follows the
             // nearby singularity).
             let y_mid = i_unit * h * unrot * prod_at(0.0);
-            let from_p = self.path_from_branch(p, mid, y_mid)?;
-            let from_q = self.path_from_branch(q, mid, y_mid)?;
+            let from_p = self.path_from_branch(p, mid, y_mid, None)?;
+            let from_q = self.path_from_branch(q, mid, y_mid, None)?;
             for i in 0..g {
                 per[i] = 2.0 * (from_p[i] - from_q[i]);
             }
@@ -426,8 +446,8 @@ impl HyperellipticCurve {
                 .fold(0.0, f64::max);
         let xr = self.e[r] + d * len;
         let yr = self.y(xr, 1);
-        let part1 = self.path_from_branch(r, xr, yr)?;
-        let (part2, lam) = self.to_infinity(self.e[r], xr, yr)?;
+        let part1 = self.path_from_branch(r, xr, yr, None)?;
+        let (part2, lam) = self.to_infinity(self.e[r], xr, yr, None)?;
         let ray: Vec<C> = (0..g).map(|i| part1[i] + part2[i]).collect(); // ∫_{e_r}^{∞} ω
         let root = if n % 2 == 1 { r } else { 0 };
         let mut u = vec![zero.clone(); n];
@@ -465,63 +485,73 @@ impl HyperellipticCurve {
     /// `∫_{e_k}^{(x, y)} ω` (unnormalised) along the straight segment, on the
     /// sheet of `y`. With `x(σ) = e + (x − e)σ²`, `y = σ q Π_{m≠k} φ_m`,
     /// `q² = x − e`: `dx/y = 2 q dσ / Π φ_m(σ²)`, analytic on `[0, 1]`.
-    fn path_from_branch(&self, k: usize, x: C, y: C) -> Result<Vec<C>> {
-        let g = self.g;
+    /// `fhs`: the route's focal half sum ([`Self::branch_quality`]) if the
+    /// caller has it.
+    fn path_from_branch(&self, k: usize, x: C, y: C, known: Option<(&[f64], f64)>) -> Result<Row> {
+        let n = self.e.len();
         let ek = self.e[k];
         let dx = x - ek;
-        let mut out = vec![C::new(0.0, 0.0); g];
+        let mut out = ZERO_ROW;
         if dx == C::new(0.0, 0.0) {
             return Ok(out);
         }
-        let q = sqrt_principal(dx);
-        // Stack buffers (n ≤ 2 MAX_GENUS + 2): this is the per-point hot path.
-        let one = C::new(1.0, 0.0);
-        let mut sing_buf = [one; 4 * MAX_GENUS + 4];
-        let mut seg_buf = [(one, SegmentSqrt::new(one, one)); 2 * MAX_GENUS + 2];
+        let mut dist_buf = [0.0; MAX_N];
+        let (dist, fhs) = match known {
+            Some(v) => v,
+            None => {
+                for (d, &em) in dist_buf.iter_mut().zip(&self.e) {
+                    *d = abs_fast(x - em);
+                }
+                (&dist_buf[..n], self.branch_quality(k, &dist_buf[..n]))
+            }
+        };
+        let q = sqrt_fast(dx);
+        // Stack buffers: this is the per-point hot path. Factor m ≠ k is
+        // a_m + s² dx, a_m = e_k − e_m, with |a_m| = |e_k − e_m| and
+        // |a_m + dx| = |x − e_m|.
+        let (mut a, b) = ([dx; MAX_N], [dx; MAX_N]);
+        let (mut abs_a, mut abs_e) = ([0.0; MAX_N], [0.0; MAX_N]);
         let mut ns = 0;
         for (m, &em) in self.e.iter().enumerate() {
             if m == k {
                 continue;
             }
-            let a = ek - em;
-            seg_buf[ns] = (a, SegmentSqrt::new(a, dx));
-            let s = sqrt_principal(-a / dx);
-            sing_buf[2 * ns] = s;
-            sing_buf[2 * ns + 1] = -s;
+            a[ns] = ek - em;
+            abs_a[ns] = self.e_dist[k * n + m];
+            abs_e[ns] = dist[m];
             ns += 1;
         }
-        let segs = &seg_buf[..ns];
-        let sing = &sing_buf[..2 * ns];
-        let unrot: C = segs.iter().map(|(_, s)| s.unrot()).product();
-        let y1 = q * unrot * segs.iter().map(|(a, s)| s.rotated(a + dx)).product::<C>();
+        let prod = SqrtProduct::new(&a[..ns], &b[..ns], &abs_a[..ns], &abs_e[..ns]);
+        let unrot = prod.unrot();
+        let y1 = q * unrot * prod.rotated(1.0);
         let sign = if (y * y1.conj()).re < 0.0 { -1.0 } else { 1.0 };
+        let acc = &mut out[..self.g];
         let integrand = |s: f64, w: f64, acc: &mut [C]| {
             let s2 = s * s;
-            let prod: C = segs.iter().map(|(a, sg)| sg.rotated(a + dx * s2)).product();
             let xs = ek + dx * s2;
-            let mut f = C::new(w, 0.0) / prod;
+            let mut f = prod.inv_rotated(s2) * w;
             for v in acc.iter_mut() {
                 *v += f;
                 f *= xs;
             }
         };
         // Singularities ±√t_m come in pairs: the ellipse of [−1, 1] decides.
-        let lr = sing
-            .iter()
-            .step_by(2)
-            .map(|&z| quad::focal_half_sum(z))
-            .fold(f64::INFINITY, f64::min)
-            .acosh();
-        let nn = nodes_for(lr);
+        let nn = nodes_for(fhs.acosh());
         if nn <= quad::GL_MAX as f64 {
-            quad::integrate_even(nn as usize, &mut out, integrand);
+            quad::integrate_even(nn as usize, acc, integrand);
         } else {
+            let mut sing = [C::new(0.0, 0.0); 2 * MAX_N];
+            for (i, &am) in a[..ns].iter().enumerate() {
+                let s = sqrt_fast(-am / dx);
+                sing[2 * i] = s;
+                sing[2 * i + 1] = -s;
+            }
             let mut pieces: Vec<Piece> = Vec::new();
-            quad::plan_pieces(sing, &mut pieces)?;
-            quad::integrate(&pieces, &mut out, integrand);
+            quad::plan_pieces(&sing[..2 * ns], &mut pieces)?;
+            quad::integrate(&pieces, acc, integrand);
         }
         let fac = 2.0 * sign * q / unrot;
-        out.iter_mut().for_each(|v| *v *= fac);
+        acc.iter_mut().for_each(|v| *v *= fac);
         Ok(out)
     }
 
@@ -530,34 +560,49 @@ impl HyperellipticCurve {
     /// `ψ_m² = X + τ²(c − e_m)`:
     /// `∫_x^∞ ω_i = (2X/s) ∫_0^1 (cτ² + X)^{i−1} τ^{n−2i−1} / Πψ_m dτ`, `s = ±1`
     /// the sheet. `λ = s Πψ_m(0) / X^{g+1}` is `±1` for even `n` (which of
-    /// `∞±` the ray reaches) and meaningless for odd `n`.
-    fn to_infinity(&self, c: C, x: C, y: C) -> Result<(Vec<C>, C)> {
+    /// `∞±` the ray reaches); for odd `n` it is meaningless and returned as 1.
+    /// `fhs`: the route's focal half sum (odd `n`, [`Self::infinity_quality`]
+    /// for `c` the centre) if the caller has it.
+    fn to_infinity(&self, c: C, x: C, y: C, known: Option<(&[f64], f64)>) -> Result<(Row, C)> {
         let (n, g) = (self.e.len(), self.g);
+        let odd = n % 2 == 1;
         let xx = x - c;
-        let mut sing: Vec<C> = Vec::with_capacity(2 * n);
-        let mut segs: Vec<(C, SegmentSqrt)> = Vec::with_capacity(n);
-        for &em in &self.e {
-            let b = c - em;
-            segs.push((b, SegmentSqrt::new(xx, b)));
-            if b != C::new(0.0, 0.0) {
-                let s = sqrt_principal(-xx / b);
-                sing.push(s);
-                sing.push(-s);
+        let ax = abs_fast(xx);
+        let mut dist_buf = [0.0; MAX_N];
+        let dist = match known {
+            Some((d, _)) => d,
+            None => {
+                for (d, &em) in dist_buf.iter_mut().zip(&self.e) {
+                    *d = abs_fast(x - em);
+                }
+                &dist_buf[..n]
             }
+        };
+        // Factor m is X + τ² (c − e_m): |X| and |X + c − e_m| = |x − e_m|.
+        let mut b = [xx; MAX_N];
+        for (bm, &em) in b.iter_mut().zip(&self.e) {
+            *bm = c - em;
         }
-        let unrot: C = segs.iter().map(|(_, s)| s.unrot()).product();
-        let y1 = unrot * segs.iter().map(|(b, s)| s.rotated(xx + b)).product::<C>();
+        let a = [xx; MAX_N];
+        let prod = SqrtProduct::new(&a[..n], &b[..n], &[ax; MAX_N][..n], dist);
+        let unrot = prod.unrot();
+        let y1 = unrot * prod.rotated(1.0);
         let sign = if (y * y1.conj()).re < 0.0 { -1.0 } else { 1.0 };
-        let y0 = unrot * segs.iter().map(|(_, s)| s.rotated(xx)).product::<C>();
-        let lam = sign * y0 / xx.powi(g as i32 + 1);
-        let mut out = vec![C::new(0.0, 0.0); g];
+        let lam = if odd {
+            C::new(1.0, 0.0)
+        } else {
+            let y0 = unrot * prod.rotated(0.0);
+            sign * y0 / xx.powi(g as i32 + 1)
+        };
+        let mut out = ZERO_ROW;
+        let acc = &mut out[..g];
+        // τ^{n−2i−1} for i = 1..g: τ^{n−2g−1} (τ⁰ or τ¹) times falling powers of τ².
+        let t_odd = !odd;
         let integrand = |t: f64, w: f64, acc: &mut [C]| {
             let t2 = t * t;
-            let prod: C = segs.iter().map(|(b, sg)| sg.rotated(xx + b * t2)).product();
             let xs = c * t2 + xx;
-            let inv = C::new(w, 0.0) / prod;
-            // (cτ² + X)^{i−1} τ^{n−2i−1}: powers of xs up, of τ² down from τ^{n−3}.
-            let mut tp = t.powi(n as i32 - 2 * g as i32 - 1);
+            let inv = prod.inv_rotated(t2) * w;
+            let mut tp = if t_odd { t } else { 1.0 };
             let mut tps = [0.0f64; MAX_GENUS + 1];
             for i in (0..g).rev() {
                 tps[i] = tp;
@@ -569,25 +614,44 @@ impl HyperellipticCurve {
                 xp *= xs;
             }
         };
-        let lr = if n % 2 == 1 {
-            sing.iter()
-                .step_by(2)
-                .map(|&z| quad::focal_half_sum(z))
-                .fold(f64::INFINITY, f64::min)
-                .acosh()
+        let lr = if odd {
+            match known {
+                Some((_, fhs)) => fhs,
+                None => {
+                    let mut best = f64::INFINITY;
+                    for (&bm, &dm) in b[..n].iter().zip(dist) {
+                        let ab = abs_fast(bm);
+                        if ab > 0.0 {
+                            best = best.min(focal_half_sum_sqrt(ax / ab, dm / ab));
+                        }
+                    }
+                    best
+                }
+            }
+            .acosh()
         } else {
             0.0
         };
         let nn = nodes_for(lr);
-        if n % 2 == 1 && nn <= quad::GL_MAX as f64 {
-            quad::integrate_even(nn as usize, &mut out, integrand);
+        if odd && nn <= quad::GL_MAX as f64 {
+            quad::integrate_even(nn as usize, acc, integrand);
         } else {
+            let mut sing = [C::new(0.0, 0.0); 2 * MAX_N];
+            let mut ns = 0;
+            for &bm in &b[..n] {
+                if bm != C::new(0.0, 0.0) {
+                    let s = sqrt_fast(-xx / bm);
+                    sing[ns] = s;
+                    sing[ns + 1] = -s;
+                    ns += 2;
+                }
+            }
             let mut pieces: Vec<Piece> = Vec::new();
-            quad::plan_pieces(&sing, &mut pieces)?;
-            quad::integrate(&pieces, &mut out, integrand);
+            quad::plan_pieces(&sing[..ns], &mut pieces)?;
+            quad::integrate(&pieces, acc, integrand);
         }
         let fac = 2.0 * sign * xx / unrot;
-        out.iter_mut().for_each(|v| *v *= fac);
+        acc.iter_mut().for_each(|v| *v *= fac);
         Ok((out, lam))
     }
 }
@@ -686,6 +750,18 @@ impl HyperellipticCurve {
                 reason: format!("x = {x}, y = {y} must be finite"),
             });
         }
+        let mut dist = [0.0; MAX_N];
+        for (d, &em) in dist.iter_mut().zip(&self.e) {
+            *d = abs_fast(x - em);
+        }
+        self.check_point_with(x, y, &dist[..self.e.len()])
+    }
+
+    /// [`Self::check_point`] for finite `x, y` given `dist[k] = |x − e_k|`.
+    /// Where `|R(x)|` and `|y|²` are well inside the double range the ratio
+    /// `q² = y²/R(x)` is formed directly (one complex product chain instead
+    /// of `n` square roots); otherwise factor by factor.
+    fn check_point_with(&self, x: C, y: C, dist: &[f64]) -> Result<()> {
         if let Some(k) = self.e.iter().position(|&ek| x == ek) {
             let scale: f64 = self.e.iter().map(|ek| x.norm() + ek.norm()).product();
             if y.norm() > (ON_CURVE_RTOL * scale).sqrt() {
@@ -696,19 +772,31 @@ impl HyperellipticCurve {
             }
             return Ok(());
         }
-        let mut q = y;
+        let ax = abs_fast(x);
         let mut bound = ON_CURVE_RTOL;
-        for &ek in &self.e {
-            q /= sqrt_principal(x - ek);
-            bound *= (x.norm() + ek.norm()) / (x - ek).norm();
+        let mut r = C::new(1.0, 0.0);
+        for ((&ek, &aek), &d) in self.e.iter().zip(&self.e_abs).zip(dist) {
+            r *= x - ek;
+            bound *= (ax + aek) / d;
         }
-        let dev = (q * q - 1.0).norm();
-        if !is_finite_c(q) {
-            return Err(Error::InvalidArgument {
-                what: "point",
-                reason: format!("x = {x}: |x| is too large for y = R(x)^(1/2) in double precision"),
-            });
-        }
+        let (rn, yn) = (r.norm_sqr(), y.norm_sqr());
+        let dev = if rn > 1e-200 && rn < 1e200 && yn < 1e200 {
+            (crate::curve::cdiv(y * y, r) - 1.0).norm()
+        } else {
+            let mut q = y;
+            for &ek in &self.e {
+                q /= sqrt_principal(x - ek);
+            }
+            if !is_finite_c(q) {
+                return Err(Error::InvalidArgument {
+                    what: "point",
+                    reason: format!(
+                        "x = {x}: |x| is too large for y = R(x)^(1/2) in double precision"
+                    ),
+                });
+            }
+            (q * q - 1.0).norm()
+        };
         if dev > bound {
             return Err(Error::InvalidArgument {
                 what: "point",
@@ -721,52 +809,77 @@ impl HyperellipticCurve {
         Ok(())
     }
 
-    /// `(|z−1| + |z+1|)/2` of the route's worst singularity (larger is
-    /// better): branch routes and, for odd `n`, the ray from `∞` have even
-    /// integrands with paired singularities `±z` (ellipse of `[−1, 1]`); the
-    /// ray for even `n` has singularities `z` on `[0, 1]`, mapped.
-    fn route_quality(&self, route: Route, x: C) -> f64 {
-        match route {
-            Route::Branch(k) => {
-                let dx = x - self.e[k];
-                self.e
-                    .iter()
-                    .enumerate()
-                    .filter(|&(m, _)| m != k)
-                    .map(|(_, &em)| quad::focal_half_sum(sqrt_principal((em - self.e[k]) / dx)))
-                    .fold(f64::INFINITY, f64::min)
-            }
-            Route::Infinity => {
-                let xx = x - self.center;
-                let odd = self.e.len() % 2 == 1;
-                self.e
-                    .iter()
-                    .map(|&em| {
-                        let z = sqrt_principal(xx / (em - self.center));
-                        if odd {
-                            quad::focal_half_sum(z)
-                        } else {
-                            quad::focal_half_sum(2.0 * z - 1.0)
-                                .min(quad::focal_half_sum(-2.0 * z - 1.0))
-                        }
-                    })
-                    .fold(f64::INFINITY, f64::min)
+    /// Focal half sum `(|z−1| + |z+1|)/2` of the worst singularity of the
+    /// route from `e_k` (larger is better): the integrand is even with
+    /// singularities `±√w_m`, `w_m = (e_m − e_k)/(x − e_k)`, and
+    /// [`focal_half_sum_sqrt`] needs only `|w_m|` and `|w_m − 1|`, i.e. the
+    /// distances `|e_m − e_k|` (per curve) and `dist[m] = |x − e_m|`.
+    fn branch_quality(&self, k: usize, dist: &[f64]) -> f64 {
+        let n = self.e.len();
+        let dk = dist[k];
+        let row = &self.e_dist[k * n..(k + 1) * n];
+        let mut best = f64::INFINITY;
+        for m in 0..n {
+            if m != k {
+                best = best.min(focal_half_sum_sqrt(row[m] / dk, dist[m] / dk));
             }
         }
+        best
+    }
+
+    /// As [`Self::branch_quality`] for the ray from the centre `c` through
+    /// `x`: singularities at `τ² = w_m`, `w_m = (x − c)/(e_m − c)`. Odd `n`:
+    /// even integrand, pairs `±√w_m` (ellipse of `[−1, 1]`). Even `n`: the
+    /// integrand on `[0, 1]` has singularities `±√w_m`, mapped to `[−1, 1]` by
+    /// `2z − 1`: `(|2z − 2| + |2z|)/2 = |z| + |z − 1|`, so the worse of `±√w`
+    /// gives `|z| + min(|z − 1|, |z + 1|)`, where `|z ∓ 1|` are the roots of
+    /// `a² + b² = 2|w| + 2`, `ab = |w − 1|`. A branch point at `c` imposes
+    /// nothing (its factor is constant along the ray).
+    fn infinity_quality(&self, x: C, dist: &[f64]) -> f64 {
+        let dc = abs_fast(x - self.center);
+        let odd = self.e.len() % 2 == 1;
+        let mut best = f64::INFINITY;
+        for (&cm, &dm) in self.c_dist.iter().zip(dist) {
+            if cm == 0.0 {
+                continue;
+            }
+            let (aw, aw1) = (dc / cm, dm / cm);
+            let v = if odd {
+                focal_half_sum_sqrt(aw, aw1)
+            } else {
+                let sum = (2.0 * (aw + 1.0 + aw1)).sqrt();
+                let diff = (2.0 * (aw + 1.0 - aw1)).max(0.0).sqrt();
+                (aw.sqrt() + 0.5 * (sum - diff)).max(1.0)
+            };
+            best = best.min(v);
+        }
+        best
     }
 
     /// `∫_{P0}^{(x, y)} ω`, unnormalised, along the best route (no point check).
-    fn abel_unnormalised(&self, x: C, y: C) -> Result<Vec<C>> {
+    fn abel_unnormalised(&self, x: C, y: C) -> Result<Row> {
+        let n = self.e.len();
+        let mut dist = [0.0; MAX_N];
+        for (d, &em) in dist.iter_mut().zip(&self.e) {
+            *d = abs_fast(x - em);
+        }
+        self.abel_raw(x, y, &dist[..n])
+    }
+
+    /// [`Self::abel_unnormalised`] given `dist[m] = |x − e_m|`.
+    fn abel_raw(&self, x: C, y: C, dist: &[f64]) -> Result<Row> {
+        let g = self.g;
+        let mut out = ZERO_ROW;
         if let Some(k) = self.e.iter().position(|&ek| ek == x) {
-            return Ok(self.u_branch[k].clone());
+            out[..g].copy_from_slice(&self.u_branch[k]);
+            return Ok(out);
         }
         // Candidates: the ray from ∞ and the segments from the ROUTE_CANDIDATES
         // nearest branch points (a far start is never better: its segment
         // passes the nearer ones). Any route is exact to the target; the
         // choice only sets the node count.
         let mut near = [(f64::INFINITY, 0usize); ROUTE_CANDIDATES];
-        for (k, &ek) in self.e.iter().enumerate() {
-            let d = (x - ek).norm_sqr();
+        for (k, &d) in dist.iter().enumerate() {
             if d < near[ROUTE_CANDIDATES - 1].0 {
                 let mut i = ROUTE_CANDIDATES - 1;
                 while i > 0 && near[i - 1].0 > d {
@@ -776,10 +889,10 @@ impl HyperellipticCurve {
                 near[i] = (d, k);
             }
         }
-        let mut best = (Route::Infinity, self.route_quality(Route::Infinity, x));
+        let mut best = (Route::Infinity, self.infinity_quality(x, dist));
         for &(d, k) in &near {
             if d.is_finite() {
-                let q = self.route_quality(Route::Branch(k), x);
+                let q = self.branch_quality(k, dist);
                 if q > best.1 {
                     best = (Route::Branch(k), q);
                 }
@@ -787,19 +900,24 @@ impl HyperellipticCurve {
         }
         match best.0 {
             Route::Branch(k) => {
-                let v = self.path_from_branch(k, x, y)?;
-                Ok((0..self.g).map(|i| self.u_branch[k][i] + v[i]).collect())
+                let v = self.path_from_branch(k, x, y, Some((dist, best.1)))?;
+                for i in 0..g {
+                    out[i] = self.u_branch[k][i] + v[i];
+                }
             }
             Route::Infinity => {
-                let (v, lam) = self.to_infinity(self.center, x, y)?;
+                let (v, lam) = self.to_infinity(self.center, x, y, Some((dist, best.1)))?;
                 let s = if self.e.len() % 2 == 1 || lam.re > 0.0 {
                     1.0
                 } else {
                     -1.0
                 };
-                Ok((0..self.g).map(|i| s * self.u_inf[i] - v[i]).collect())
+                for i in 0..g {
+                    out[i] = s * self.u_inf[i] - v[i];
+                }
             }
         }
+        Ok(out)
     }
 
     /// The integral `∫_{(x0,y0)}^{(x, y)} ω` (unnormalised) along a path
@@ -807,10 +925,16 @@ impl HyperellipticCurve {
     /// path independence.
     pub fn abel_via(&self, x: C, y: C, route: Option<usize>) -> Result<Vec<C>> {
         self.check_point(x, y)?;
-        let raw = match route {
+        let raw: Row = match route {
             Some(k) if k < self.e.len() => {
-                let v = self.path_from_branch(k, x, y)?;
-                (0..self.g).map(|i| self.u_branch[k][i] + v[i]).collect()
+                let v = self.path_from_branch(k, x, y, None)?;
+                std::array::from_fn(|i| {
+                    if i < self.g {
+                        self.u_branch[k][i] + v[i]
+                    } else {
+                        v[i]
+                    }
+                })
             }
             Some(k) => {
                 return Err(Error::InvalidArgument {
@@ -819,25 +943,36 @@ impl HyperellipticCurve {
                 })
             }
             None => {
-                let (v, lam) = self.to_infinity(self.center, x, y)?;
+                let (v, lam) = self.to_infinity(self.center, x, y, None)?;
                 let s = if self.e.len() % 2 == 1 || lam.re > 0.0 {
                     1.0
                 } else {
                     -1.0
                 };
-                (0..self.g)
-                    .map(|i| s * self.u_inf[i] - v[i])
-                    .collect::<Vec<C>>()
+                std::array::from_fn(|i| {
+                    if i < self.g {
+                        s * self.u_inf[i] - v[i]
+                    } else {
+                        v[i]
+                    }
+                })
             }
         };
         Ok(self.normalise(&raw))
     }
 
     fn normalise(&self, raw: &[C]) -> Vec<C> {
+        let mut out = ZERO_ROW;
+        self.normalise_into(raw, &mut out[..self.g]);
+        out[..self.g].to_vec()
+    }
+
+    #[inline]
+    fn normalise_into(&self, raw: &[C], out: &mut [C]) {
         let g = self.g;
-        (0..g)
-            .map(|i| (0..g).map(|j| self.a_inv[(i, j)] * raw[j]).sum())
-            .collect()
+        for (i, o) in out.iter_mut().enumerate().take(g) {
+            *o = (0..g).map(|j| self.a_inv[(i, j)] * raw[j]).sum();
+        }
     }
 
     /// The Abel map `u(P) = A^{-1} ∫_{P0}^{P} ω` of `P = (x, y)` (`y` picks the
@@ -845,8 +980,27 @@ impl HyperellipticCurve {
     ///
     /// Errors: `(x, y)` not on the curve to [`ON_CURVE_RTOL`], non-finite input.
     pub fn abel(&self, x: C, y: C) -> Result<Vec<C>> {
-        self.check_point(x, y)?;
-        Ok(self.normalise(&self.abel_unnormalised(x, y)?))
+        let mut out = ZERO_ROW;
+        self.abel_into(x, y, &mut out[..self.g])?;
+        Ok(out[..self.g].to_vec())
+    }
+
+    /// [`Self::abel`] into `out` (length `g`), without allocating: the
+    /// distances `|x − e_m|` serve the point check, the route choice and the
+    /// node count.
+    fn abel_into(&self, x: C, y: C, out: &mut [C]) -> Result<()> {
+        let n = self.e.len();
+        if !is_finite_c(x) || !is_finite_c(y) {
+            return self.check_point(x, y);
+        }
+        let mut dist = [0.0; MAX_N];
+        for (d, &em) in dist.iter_mut().zip(&self.e) {
+            *d = abs_fast(x - em);
+        }
+        self.check_point_with(x, y, &dist[..n])?;
+        let raw = self.abel_raw(x, y, &dist[..n])?;
+        self.normalise_into(&raw, out);
+        Ok(())
     }
 
     /// [`Self::abel`] of `N` points into `out` (row-major `(N, g)`); rayon for
@@ -860,11 +1014,7 @@ impl HyperellipticCurve {
                 got: format!("{}, {}, {}", x.len(), y.len(), out.len()),
             });
         }
-        let one = |(i, row): (usize, &mut [C])| -> Result<()> {
-            let u = self.abel(x[i], y[i])?;
-            row.copy_from_slice(&u);
-            Ok(())
-        };
+        let one = |(i, row): (usize, &mut [C])| -> Result<()> { self.abel_into(x[i], y[i], row) };
         if x.len() >= PARALLEL_MIN_POINTS {
             use rayon::prelude::*;
             out.par_chunks_mut(g).enumerate().try_for_each(one)

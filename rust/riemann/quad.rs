@@ -138,6 +138,46 @@ pub fn nodes_for(log_rho: f64) -> f64 {
     (TARGET_LN / (2.0 * log_rho)).ceil()
 }
 
+/// `|z|` as `√(re² + im²)` where `|z|²` lies safely inside the double range
+/// (then within 1.5 ulp of the true modulus), libm's `hypot` elsewhere: the
+/// per-point Abel path takes a dozen moduli, and `hypot` costs several times
+/// a square root.
+#[inline(always)]
+pub fn abs_fast(z: C) -> f64 {
+    let s = z.norm_sqr();
+    if s > 1e-290 && s < 1e290 {
+        s.sqrt()
+    } else {
+        z.re.hypot(z.im)
+    }
+}
+
+/// [`crate::curve::sqrt_principal`] (same branch, Kahan's formulation) with
+/// the modulus from [`abs_fast`].
+#[inline(always)]
+pub fn sqrt_fast(w: C) -> C {
+    let (re, im) = (w.re, w.im + 0.0);
+    if re == 0.0 && im == 0.0 {
+        return C::new(0.0, 0.0);
+    }
+    let t = ((abs_fast(C::new(re, im)) + re.abs()) / 2.0).sqrt();
+    if re >= 0.0 {
+        C::new(t, im / (2.0 * t))
+    } else {
+        C::new(im.abs() / (2.0 * t), t.copysign(im))
+    }
+}
+
+/// The focal half sum [`focal_half_sum`] of `√w` from moduli alone:
+/// `(|√w − 1| + |√w + 1|)² = 2|w| + 2 + 2|w − 1|`, so with `abs_w = |w|` and
+/// `abs_w1 = |w − 1|` it is `√((|w| + 1 + |w − 1|)/2)` — no complex root, and
+/// for `w = (e_m − e_k)/(x − e_k)` both moduli are distances between the
+/// points `e_k, e_m, x` divided by `|x − e_k|`.
+#[inline(always)]
+pub fn focal_half_sum_sqrt(abs_w: f64, abs_w1: f64) -> f64 {
+    (0.5 * (abs_w + 1.0 + abs_w1)).sqrt().max(1.0)
+}
+
 /// Square root of `w` with `Re w > 0` (the rotated values of [`SegmentSqrt`]):
 /// `√w = (t, Im w / 2t)`, `t = √((|w| + Re w)/2)`, accurate to a few ulps
 /// because no cancellation occurs on the right half plane.
@@ -164,7 +204,18 @@ pub struct SegmentSqrt {
 }
 
 impl SegmentSqrt {
+    /// No rotation (a placeholder for fixed-size buffers).
+    pub const UNIT: SegmentSqrt = SegmentSqrt {
+        rot: C::new(1.0, 0.0),
+        unrot: C::new(1.0, 0.0),
+    };
+
     pub fn new(a: C, b: C) -> Self {
+        Self::with_distance(a, b).0
+    }
+
+    /// [`Self::new`] and the distance of the segment from 0.
+    pub fn with_distance(a: C, b: C) -> (Self, f64) {
         let bb = b.norm_sqr();
         let v = if bb > 0.0 {
             (-(b.conj() * a).re / bb).clamp(0.0, 1.0)
@@ -172,15 +223,15 @@ impl SegmentSqrt {
             0.0
         };
         let p = a + b * v;
-        let r = p.norm();
+        let r = abs_fast(p);
         let rot = if r > 0.0 {
             p.conj() / r
         } else {
             C::new(1.0, 0.0)
         };
         // c^{-1/2} = conj(√c) for |c| = 1; √c with Re c arbitrary: principal.
-        let unrot = crate::curve::sqrt_principal(rot).conj();
-        SegmentSqrt { rot, unrot }
+        let unrot = sqrt_fast(rot).conj();
+        (SegmentSqrt { rot, unrot }, r)
     }
 
     /// `√w` on the branch of the segment (`w` a point of it).
@@ -198,6 +249,171 @@ impl SegmentSqrt {
     /// The constant `c^{-1/2}`.
     pub fn unrot(&self) -> C {
         self.unrot
+    }
+}
+
+/// Most factors of a [`SqrtProduct`] (the number of finite branch points).
+pub const MAX_FACTORS: usize = 2 * crate::theta::MAX_GENUS + 2;
+
+/// `sin` of the margin kept between the argument of a grouped product and
+/// the branch cut of the principal root (0.05 rad: far above rounding).
+const SIN_CUT_MARGIN: f64 = 0.05;
+
+/// Bound on the modulus of a group's product (and of its inverse), so that
+/// `|P|²` stays inside the double range and [`inv_sqrt_principal`] takes the
+/// fast modulus.
+const GROUP_MOD_MAX: f64 = 1e140;
+
+/// A continuous branch of `Π_m √(a_m + v b_m)` for `v ∈ [0, 1]` (segments not
+/// through 0) with few complex square roots per evaluation.
+///
+/// Factor `m` is rotated by the unit `c_m` that centres its segment on the
+/// positive real axis: the ends `a_m`, `a_m + b_m` subtend an angle
+/// `2δ_m < π` at 0, so `arg(c_m w) ∈ [−δ_m, δ_m]` along the segment.
+/// Consecutive factors are grouped while `Σ δ_m < π − margin`; then the
+/// argument of a group's rotated product stays off the cut, its principal
+/// root is continuous in `v`, and one square root serves the whole group
+/// (the per-factor roots of [`SegmentSqrt`] cost one each). A segment
+/// passing too close to 0 for an accurate bisector takes the nearest-point
+/// rotation of [`SegmentSqrt`] and counts as `δ = π/2`. The constant
+/// `unrot = conj √(Π c_m)` undoes the rotations: `(unrot · rotated(v))² =
+/// Π (a_m + v b_m)`.
+#[derive(Debug, Clone, Copy)]
+pub struct SqrtProduct {
+    ra: [C; MAX_FACTORS],
+    rb: [C; MAX_FACTORS],
+    /// Exclusive end of each group.
+    ends: [usize; MAX_FACTORS],
+    groups: usize,
+    unrot: C,
+}
+
+impl SqrtProduct {
+    /// The product over `a[m] + v b[m]`, given the end moduli
+    /// `abs_a[m] = |a_m|`, `abs_e[m] = |a_m + b_m|` (callers have them as
+    /// distances between branch points and `x`). At most [`MAX_FACTORS`].
+    pub fn new(a: &[C], b: &[C], abs_a: &[f64], abs_e: &[f64]) -> Self {
+        let nf = a.len();
+        let zero = C::new(0.0, 0.0);
+        let mut sp = SqrtProduct {
+            ra: [zero; MAX_FACTORS],
+            rb: [zero; MAX_FACTORS],
+            ends: [0; MAX_FACTORS],
+            groups: 0,
+            unrot: C::new(1.0, 0.0),
+        };
+        let mut all = C::new(1.0, 0.0);
+        // e^{iΣδ} and the modulus bounds of the open group.
+        let mut dir = C::new(1.0, 0.0);
+        let (mut hi, mut lo) = (1.0f64, 1.0f64);
+        for m in 0..nf {
+            let (am, bm) = (a[m], b[m]);
+            let (r0, r1) = (abs_a[m], abs_e[m]);
+            let u0 = am / r0;
+            let u1 = (am + bm) / r1;
+            let bis = u0 + u1;
+            let lb = abs_fast(bis);
+            let (c, d, min_mod) = if r0 > 0.0 && r1 > 0.0 && lb > 1e-6 {
+                let c = bis.conj() / lb;
+                // e^{±iδ}: the rotated end; δ ∈ [0, π/2) from its imaginary part's sign
+                let d = u1 * c;
+                let d = if d.im < 0.0 { d.conj() } else { d };
+                // Re(c w) is linear along the segment: its minimum is at an end
+                (c, d, r0.min(r1) * d.re)
+            } else {
+                let (seg, near) = SegmentSqrt::with_distance(am, bm);
+                (seg.rot, C::new(0.0, 1.0), near)
+            };
+            let max_mod = r0.max(r1);
+            let nd = dir * d;
+            let fits = m > 0
+                && nd.im >= 0.0
+                && (nd.re >= 0.0 || nd.im > SIN_CUT_MARGIN)
+                && hi * max_mod <= GROUP_MOD_MAX
+                && lo * min_mod >= 1.0 / GROUP_MOD_MAX;
+            if fits {
+                dir = nd;
+                hi *= max_mod;
+                lo *= min_mod;
+            } else {
+                if m > 0 {
+                    sp.ends[sp.groups] = m;
+                    sp.groups += 1;
+                }
+                dir = d;
+                hi = max_mod;
+                lo = min_mod;
+            }
+            sp.ra[m] = c * am;
+            sp.rb[m] = c * bm;
+            all *= c;
+        }
+        if nf > 0 {
+            sp.ends[sp.groups] = nf;
+            sp.groups += 1;
+        }
+        sp.unrot = sqrt_fast(all).conj();
+        sp
+    }
+
+    /// `Π_groups √(Π_{m ∈ group} c_m (a_m + v b_m))` (principal roots).
+    #[inline]
+    pub fn rotated(&self, v: f64) -> C {
+        let mut acc = C::new(1.0, 0.0);
+        let mut start = 0;
+        for &end in &self.ends[..self.groups] {
+            let mut p = self.ra[start] + self.rb[start] * v;
+            for m in start + 1..end {
+                p *= self.ra[m] + self.rb[m] * v;
+            }
+            acc *= sqrt_fast(p);
+            start = end;
+        }
+        acc
+    }
+
+    /// `1 / rotated(v)`, one real division per group.
+    #[inline(always)]
+    pub fn inv_rotated(&self, v: f64) -> C {
+        let mut acc = C::new(1.0, 0.0);
+        let mut start = 0;
+        for &end in &self.ends[..self.groups] {
+            let mut p = self.ra[start] + self.rb[start] * v;
+            for m in start + 1..end {
+                p *= self.ra[m] + self.rb[m] * v;
+            }
+            acc *= inv_sqrt_principal(p);
+            start = end;
+        }
+        acc
+    }
+
+    /// `conj √(Π c_m)`.
+    pub fn unrot(&self) -> C {
+        self.unrot
+    }
+
+    /// Number of complex square roots per evaluation (for tests).
+    pub fn groups(&self) -> usize {
+        self.groups
+    }
+}
+
+/// `1/√p` on the principal branch: `conj(√p)/|p|` with `√p` by Kahan's
+/// formulation, `t² = (|p| + |Re p|)/2` formed without rounding `t`:
+/// one square root for `|p|`, one for `t`, one division.
+#[inline(always)]
+pub fn inv_sqrt_principal(p: C) -> C {
+    let (re, im) = (p.re, p.im + 0.0); // one cut side, as sqrt_principal
+    let r = abs_fast(p);
+    if re >= 0.0 {
+        let t2 = 0.5 * (r + re);
+        let inv = 1.0 / (t2.sqrt() * r);
+        C::new(t2 * inv, -0.5 * im * inv)
+    } else {
+        let t2 = 0.5 * (r - re);
+        let inv = 1.0 / (t2.sqrt() * r);
+        C::new(0.5 * im.abs() * inv, -t2.copysign(im) * inv)
     }
 }
 
@@ -300,6 +516,74 @@ mod tests {
             assert!((r - prev).norm() < 0.1);
             prev = r;
         }
+    }
+
+    /// The grouped roots square back to the product, are continuous along
+    /// `v ∈ [0, 1]` (no jump across the cut of a group's principal root),
+    /// and `inv_rotated` is their inverse; segments passing close to 0 on
+    /// both sides and far ones (one group) are covered.
+    #[test]
+    fn sqrt_product_is_a_continuous_root_of_the_product() {
+        let cases: [&[(C, C)]; 3] = [
+            &[
+                (C::new(-3.0, 0.5), C::new(6.0, -1.2)),
+                (C::new(1.0, 2.0), C::new(-2.0, -4.1)),
+                (C::new(-1.0, -0.01), C::new(2.0, 0.0)),
+                (C::new(0.2, 0.3), C::new(0.1, -0.9)),
+            ],
+            &[
+                (C::new(5.0, 1.0), C::new(0.5, 0.2)),
+                (C::new(4.0, -2.0), C::new(0.3, 0.1)),
+                (C::new(-6.0, 0.5), C::new(-0.2, 0.4)),
+            ],
+            &[
+                (C::new(-1.0, 1e-9), C::new(2.0, 0.0)),
+                (C::new(-1.0, -1e-9), C::new(2.0, 0.0)),
+                (C::new(1e-3, 1.0), C::new(0.0, -2.0)),
+            ],
+        ];
+        // Three segments each sweeping arg from −1.4 to 1.4: the product's
+        // argument sweeps ±4.2 and crosses the cut unless it is split.
+        let (lo, hi) = (C::from_polar(1.0, -1.4), C::from_polar(1.0, 1.4));
+        let sweep = [(lo, hi - lo); 3];
+        let cases: Vec<&[(C, C)]> = cases.iter().copied().chain([&sweep[..]]).collect();
+        for (ci, f) in cases.iter().enumerate() {
+            let a: Vec<C> = f.iter().map(|p| p.0).collect();
+            let b: Vec<C> = f.iter().map(|p| p.1).collect();
+            let abs_a: Vec<f64> = a.iter().map(|z| z.norm()).collect();
+            let abs_e: Vec<f64> = f.iter().map(|p| (p.0 + p.1).norm()).collect();
+            let sp = SqrtProduct::new(&a, &b, &abs_a, &abs_e);
+            let root = |v: f64| sp.unrot() * sp.rotated(v);
+            let mut prev = root(0.0);
+            for k in 0..=4000 {
+                let v = k as f64 / 4000.0;
+                let want: C = f.iter().map(|p| p.0 + p.1 * v).product();
+                let r = root(v);
+                assert!(
+                    (r * r - want).norm() <= 1e-14 * want.norm().max(1.0),
+                    "case {ci} v {v}"
+                );
+                let inv = sp.inv_rotated(v) * sp.rotated(v);
+                assert!((inv - 1.0).norm() < 1e-14, "case {ci} v {v}");
+                // a sign flip would jump by 2|r|; steps of 1/4000 move it far less
+                assert!(
+                    (r - prev).norm() < 0.05 * r.norm().max(prev.norm()) + 1e-3,
+                    "case {ci} v {v}"
+                );
+                prev = r;
+            }
+        }
+        // Far segments: one square root for all factors.
+        let a = [
+            C::new(9.0, 1.0),
+            C::new(-2.0, 8.0),
+            C::new(7.0, -7.0),
+            C::new(-9.0, -3.0),
+        ];
+        let b = [C::new(0.3, 0.1); 4];
+        let abs_a: Vec<f64> = a.iter().map(|z| z.norm()).collect();
+        let abs_e: Vec<f64> = a.iter().zip(&b).map(|(x, y)| (x + y).norm()).collect();
+        assert_eq!(SqrtProduct::new(&a, &b, &abs_a, &abs_e).groups(), 1);
     }
 
     #[test]

@@ -40,7 +40,7 @@ use crate::error::{Error, Result};
 use crate::kotter::{kotter_constants, kotter_with, KotterConstants, KotterState};
 use crate::riemann::HyperellipticCurve;
 use crate::so4;
-use crate::theta::{char_index, ThetaPlan};
+use crate::theta::{char_index, SelectedBlock, ThetaPlan};
 
 type C = Complex64;
 
@@ -471,32 +471,29 @@ impl Solution {
         ]
     }
 
-    fn combine(&self, vals: &[C], out: &mut [f64]) {
-        let th: [C; 8] = std::array::from_fn(|m| vals[self.idx[m]]);
-        let d: C = (0..8).map(|m| self.den[m] * th[m]).sum();
-        let dinv = d.inv();
-        for (o, w) in out.iter_mut().zip(self.num.iter()) {
-            let n: C = w.iter().zip(th.iter()).map(|(w, t)| w * t).sum();
-            *o = (n * dinv).re;
+    /// `l_q = Re(N_q/D)` for the points of one theta block (rows `m` of
+    /// `blk` are `θ_idx[m]`), written to `out` (row-major, `blk.len` rows);
+    /// only real parts are formed: `Re(N/D) = Re(N D̄)/|D|²`.
+    #[inline]
+    fn combine(&self, blk: &SelectedBlock, out: &mut [f64]) {
+        for (p, o) in out.chunks_exact_mut(6).enumerate().take(blk.len) {
+            let th: [C; 8] = std::array::from_fn(|m| C::new(blk.re[m][p], blk.im[m][p]));
+            let d: C = (0..8).map(|m| self.den[m] * th[m]).sum();
+            let inv = 1.0 / d.norm_sqr();
+            for (o, w) in o.iter_mut().zip(self.num.iter()) {
+                let n: C = w.iter().zip(th.iter()).map(|(w, t)| w * t).sum();
+                *o = (n.re * d.re + n.im * d.im) * inv;
+            }
         }
     }
 
     fn eval_serial(&self, t: &[f64], out: &mut [f64]) -> Result<()> {
-        let n = t.len();
-        let mut z = vec![C::new(0.0, 0.0); 2 * n];
-        for (i, &ti) in t.iter().enumerate() {
-            let v = self.v_reduced(ti);
-            z[2 * i] = v[0];
-            z[2 * i + 1] = v[1];
-        }
-        let mut vals = vec![C::new(0.0, 0.0); 16 * n];
-        let mut ls = vec![0.0; n];
-        self.plan
-            .eval_batch(&z, &mut vals, &mut [], &mut [], &mut ls)?;
-        for i in 0..n {
-            self.combine(&vals[16 * i..16 * i + 16], &mut out[6 * i..6 * i + 6]);
-        }
-        Ok(())
+        self.plan.eval_selected_g2(
+            t.len(),
+            |i| self.v_reduced(t[i]),
+            &self.idx,
+            |first, blk| self.combine(blk, &mut out[6 * first..6 * (first + blk.len)]),
+        )
     }
 
     /// `l(t_k)` into `out` (row-major `(N, 6)`); rayon for large batches,

@@ -45,6 +45,9 @@ impl std::ops::DerefMut for ALane {
 
 const AZERO: ALane = ALane([0.0; LANES]);
 
+/// `want` mask of [`Batch2::eval_chunk`] selecting all 16 characteristics.
+pub(super) const ALL: u16 = 0xffff;
+
 /// `i^u` as (re, im), `u = 0..4`.
 const UNIT: [(f64, f64); 4] = [(1.0, 0.0), (0.0, 1.0), (-1.0, 0.0), (0.0, -1.0)];
 
@@ -68,9 +71,6 @@ pub(super) struct BatchScratch {
     x1im: Vec<ALane>,
     x2re: Vec<ALane>,
     x2im: Vec<ALane>,
-    /// Class sums, `sre[r][p] + i sim[r][p]` for class `r` and lane `p`.
-    sre: Vec<ALane>,
-    sim: Vec<ALane>,
     /// The 16 values, `out_re[idx][p] + i out_im[idx][p]` (FLINT order).
     pub(super) out_re: Vec<ALane>,
     pub(super) out_im: Vec<ALane>,
@@ -119,7 +119,9 @@ impl Batch2 {
             return None;
         }
         let (d1, d2, l21) = (plan.ldl_d[0], plan.ldl_d[1], plan.ldl_l[2]);
-        let rq = plan.rq;
+        // Values only: the truncation radius of order 0 suffices whatever
+        // order the plan was built for.
+        let rq = plan.rq_values;
         let ext = |k: usize| 2.0 * ((rq * plan.yinv[k * 2 + k]).sqrt() + W_MARGIN);
         let j1lo = sum::floor_i64(-ext(0)) - 1;
         let j2lo = sum::floor_i64(-ext(1)) - 1;
@@ -209,8 +211,6 @@ impl Batch2 {
             x1im: vec![AZERO; self.n1],
             x2re: vec![AZERO; self.n2],
             x2im: vec![AZERO; self.n2],
-            sre: vec![AZERO; 16],
-            sim: vec![AZERO; 16],
             out_re: vec![AZERO; 16],
             out_im: vec![AZERO; 16],
         }
@@ -220,39 +220,44 @@ impl Batch2 {
     /// order): class sums from the table, then the Walsh–Hadamard combination with
     /// the reduction factors (`θ = exp(L) Ω` if `scaled`, else `Ω`). The per-point
     /// exponentials are evaluated for all lanes at once (`sincos_pi`, `exp_lanes`).
+    ///
+    /// Only the characteristics whose bit is set in `want` (bit `idx`) are
+    /// written; the class sums are shared by all of them.
     pub(super) fn eval_chunk(
         &self,
         plan: &ThetaPlan,
         inp: &ChunkIn,
         scaled: bool,
+        want: u16,
         sc: &mut BatchScratch,
     ) {
         #[cfg(target_arch = "x86_64")]
         {
-            if std::is_x86_feature_detected!("avx512f") {
-                // SAFETY: the CPU supports AVX-512F (checked just above).
-                unsafe { self.chunk_avx512(plan, inp, scaled, sc) };
+            if std::is_x86_feature_detected!("avx512f") && std::is_x86_feature_detected!("fma") {
+                // SAFETY: the CPU supports AVX-512F and FMA (checked just above).
+                unsafe { self.chunk_avx512(plan, inp, scaled, want, sc) };
                 return;
             }
             if std::is_x86_feature_detected!("avx2") && std::is_x86_feature_detected!("fma") {
                 // SAFETY: the CPU supports AVX2 and FMA (checked just above).
-                unsafe { self.chunk_avx2(plan, inp, scaled, sc) };
+                unsafe { self.chunk_avx2(plan, inp, scaled, want, sc) };
                 return;
             }
         }
-        self.chunk_body(plan, inp, scaled, sc);
+        self.chunk_body::<false>(plan, inp, scaled, want, sc);
     }
 
     #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx512f")]
+    #[target_feature(enable = "avx512f,fma")]
     unsafe fn chunk_avx512(
         &self,
         plan: &ThetaPlan,
         inp: &ChunkIn,
         scaled: bool,
+        want: u16,
         sc: &mut BatchScratch,
     ) {
-        self.chunk_body(plan, inp, scaled, sc);
+        self.chunk_body::<true>(plan, inp, scaled, want, sc);
     }
 
     #[cfg(target_arch = "x86_64")]
@@ -262,13 +267,21 @@ impl Batch2 {
         plan: &ThetaPlan,
         inp: &ChunkIn,
         scaled: bool,
+        want: u16,
         sc: &mut BatchScratch,
     ) {
-        self.chunk_body(plan, inp, scaled, sc);
+        self.chunk_body::<true>(plan, inp, scaled, want, sc);
     }
 
     #[inline(always)]
-    fn chunk_body(&self, plan: &ThetaPlan, inp: &ChunkIn, scaled: bool, sc: &mut BatchScratch) {
+    fn chunk_body<const FMA: bool>(
+        &self,
+        plan: &ThetaPlan,
+        inp: &ChunkIn,
+        scaled: bool,
+        want: u16,
+        sc: &mut BatchScratch,
+    ) {
         let pi = std::f64::consts::PI;
         let y = &plan.y;
         // u_k = exp(iπ z_k) per lane; the normalisation exp(-π w_rᵀYw_r) goes into X1
@@ -290,7 +303,11 @@ impl Batch2 {
         }
         fill_powers(&u1, self.j1lo, &norm, &mut sc.x1re, &mut sc.x1im);
         fill_powers(&u2, self.j2lo, &[1.0; LANES], &mut sc.x2re, &mut sc.x2im);
-        self.rows_body(sc);
+        // Class sums on the stack: no aliasing with the power tables, so the
+        // row loops need no runtime overlap checks.
+        let mut sre = [AZERO; 16];
+        let mut sim = [AZERO; 16];
+        self.rows_body::<FMA>(sc, &mut sre, &mut sim);
         // factor exp(iπ φ/π) (· exp(L)) common to the 16 values of a point
         let (mut fr, mut fi) = sincos_pi(&inp.phase);
         if scaled {
@@ -302,22 +319,15 @@ impl Batch2 {
         }
         // θ[a;b] = i^{u(a,b)} (-1)^{a·p + b·q} f Σ_h (-1)^{h·b} S[a + 2h]
         for a in 0..4 {
+            if (want >> (4 * a)) & 0xf == 0 {
+                continue;
+            }
             let r = &plan.class_of[4 * a..4 * a + 4];
             let mut vre = [[0.0; LANES]; 4];
             let mut vim = [[0.0; LANES]; 4];
             for p in 0..LANES {
-                let (s0r, s1r, s2r, s3r) = (
-                    sc.sre[r[0]][p],
-                    sc.sre[r[1]][p],
-                    sc.sre[r[2]][p],
-                    sc.sre[r[3]][p],
-                );
-                let (s0i, s1i, s2i, s3i) = (
-                    sc.sim[r[0]][p],
-                    sc.sim[r[1]][p],
-                    sc.sim[r[2]][p],
-                    sc.sim[r[3]][p],
-                );
+                let (s0r, s1r, s2r, s3r) = (sre[r[0]][p], sre[r[1]][p], sre[r[2]][p], sre[r[3]][p]);
+                let (s0i, s1i, s2i, s3i) = (sim[r[0]][p], sim[r[1]][p], sim[r[2]][p], sim[r[3]][p]);
                 let (p0r, p1r, p2r, p3r) = (s0r + s1r, s0r - s1r, s2r + s3r, s2r - s3r);
                 let (p0i, p1i, p2i, p3i) = (s0i + s1i, s0i - s1i, s2i + s3i, s2i - s3i);
                 vre[0][p] = p0r + p2r;
@@ -331,6 +341,9 @@ impl Batch2 {
             }
             for b in 0..4 {
                 let idx = (a << 2) | b;
+                if (want >> idx) & 1 == 0 {
+                    continue;
+                }
                 let unit = UNIT[(plan.unit_pow[idx] & 3) as usize];
                 let (sa, sb) = (&inp.sa[a], &inp.sb[b]);
                 for p in 0..LANES {
@@ -346,11 +359,17 @@ impl Batch2 {
 
     /// Row by row, class by class: `acc = Σ_{j2 ≡ c} C(j1, j2) X2(j2)` over all
     /// lanes, then `S[4 (j1 mod 4) + c] += X1(j1) acc`.
+    ///
+    /// `FMA`: fused multiply-adds (the copies compiled for CPUs with FMA);
+    /// they round once instead of twice, a difference of a few ulp of the
+    /// largest term in the sums.
     #[inline(always)]
-    fn rows_body(&self, sc: &mut BatchScratch) {
-        for v in sc.sre.iter_mut().chain(sc.sim.iter_mut()) {
-            *v = AZERO;
-        }
+    fn rows_body<const FMA: bool>(
+        &self,
+        sc: &BatchScratch,
+        sre: &mut [ALane; 16],
+        sim: &mut [ALane; 16],
+    ) {
         for (a, &(lo, hi)) in self.rows.iter().enumerate() {
             if lo > hi {
                 continue;
@@ -367,17 +386,32 @@ impl Batch2 {
                 while b <= hi {
                     let (cr, ci) = (crow_re[b], crow_im[b]);
                     let (xr, xi) = (&sc.x2re[b], &sc.x2im[b]);
-                    for p in 0..LANES {
-                        acc_re[p] += cr * xr[p] - ci * xi[p];
-                        acc_im[p] += cr * xi[p] + ci * xr[p];
+                    if FMA {
+                        for p in 0..LANES {
+                            acc_re[p] = cr.mul_add(xr[p], (-ci).mul_add(xi[p], acc_re[p]));
+                            acc_im[p] = cr.mul_add(xi[p], ci.mul_add(xr[p], acc_im[p]));
+                        }
+                    } else {
+                        for p in 0..LANES {
+                            acc_re[p] += cr * xr[p] - ci * xi[p];
+                            acc_im[p] += cr * xi[p] + ci * xr[p];
+                        }
                     }
                     b += 4;
                 }
                 let (yr, yi) = (&sc.x1re[a], &sc.x1im[a]);
                 let r = base + cls;
-                for p in 0..LANES {
-                    sc.sre[r][p] += acc_re[p] * yr[p] - acc_im[p] * yi[p];
-                    sc.sim[r][p] += acc_re[p] * yi[p] + acc_im[p] * yr[p];
+                if FMA {
+                    for p in 0..LANES {
+                        sre[r][p] =
+                            acc_re[p].mul_add(yr[p], (-acc_im[p]).mul_add(yi[p], sre[r][p]));
+                        sim[r][p] = acc_re[p].mul_add(yi[p], acc_im[p].mul_add(yr[p], sim[r][p]));
+                    }
+                } else {
+                    for p in 0..LANES {
+                        sre[r][p] += acc_re[p] * yr[p] - acc_im[p] * yi[p];
+                        sim[r][p] += acc_re[p] * yi[p] + acc_im[p] * yr[p];
+                    }
                 }
             }
         }
@@ -557,20 +591,20 @@ mod tests {
             inp.set(p, &red);
         }
         let mut base = b2.scratch();
-        b2.chunk_body(&plan, &inp, true, &mut base);
+        b2.chunk_body::<false>(&plan, &inp, true, ALL, &mut base);
         let mut variants = Vec::new();
         #[cfg(target_arch = "x86_64")]
         {
             if std::is_x86_feature_detected!("avx2") && std::is_x86_feature_detected!("fma") {
                 let mut sc = b2.scratch();
                 // SAFETY: feature checked just above.
-                unsafe { b2.chunk_avx2(&plan, &inp, true, &mut sc) };
+                unsafe { b2.chunk_avx2(&plan, &inp, true, ALL, &mut sc) };
                 variants.push(sc);
             }
-            if std::is_x86_feature_detected!("avx512f") {
+            if std::is_x86_feature_detected!("avx512f") && std::is_x86_feature_detected!("fma") {
                 let mut sc = b2.scratch();
                 // SAFETY: feature checked just above.
-                unsafe { b2.chunk_avx512(&plan, &inp, true, &mut sc) };
+                unsafe { b2.chunk_avx512(&plan, &inp, true, ALL, &mut sc) };
                 variants.push(sc);
             }
         }

@@ -133,6 +133,8 @@ pub struct ThetaPlan {
     ldl_l: Vec<f64>,
     /// Squared radius of the ellipsoid in `Q` units: `R²/π`.
     rq: f64,
+    /// The same for values only (order 0; the batch kernel's table).
+    rq_values: f64,
     radius: f64,
     rho: f64,
     rho_used: f64,
@@ -352,6 +354,19 @@ impl ThetaPlan {
             }
         }
         let rq = radius * radius / pi();
+        let rq_values = if order == 0 {
+            rq
+        } else {
+            let r0 = [1.0, 0.75, 0.5, 0.3]
+                .iter()
+                .map(|&frac| {
+                    let rp = rho * frac;
+                    radius_for(|r| output_error_bound(g, rp, r, sk, 0), 0.5 * rp, tol)
+                })
+                .fold(f64::INFINITY, f64::min);
+            // never above the plan's own radius (the bisection is to ~1e-5)
+            (r0 * r0 / pi()).min(rq)
+        };
         let qmat: Vec<Complex64> = taur
             .iter()
             .map(|t| (Complex64::i() * pi() * 0.5 * t).exp())
@@ -371,6 +386,7 @@ impl ThetaPlan {
             ldl_d,
             ldl_l,
             rq,
+            rq_values,
             radius,
             rho,
             rho_used,
@@ -996,7 +1012,7 @@ impl ThetaPlan {
                 inp.set(p, &red);
                 log_scale[k] = red.log_scale;
             }
-            b2.eval_chunk(self, &inp, scaled, &mut sc);
+            b2.eval_chunk(self, &inp, scaled, batch::ALL, &mut sc);
             for p in 0..m {
                 let k = i0 + p;
                 let out = &mut values[16 * k..16 * k + 16];
@@ -1011,6 +1027,108 @@ impl ThetaPlan {
             i0 += m;
         }
         Ok(finite)
+    }
+}
+
+/// Points per block of [`ThetaPlan::eval_selected_g2`].
+pub const BLOCK: usize = batch::LANES;
+
+/// Normalised values of selected characteristics at one block of genus-2
+/// points, structure of arrays: `Ω[chars[m]]` of point `p` is
+/// `re[m][p] + i im[m][p]`, and `θ = exp(log_scale[p]) Ω`. Lanes `p ≥ len`
+/// hold zeros; rows `m ≥ chars.len()` are unspecified.
+#[derive(Debug, Clone)]
+pub struct SelectedBlock {
+    /// Points in this block (`1 ..= BLOCK`).
+    pub len: usize,
+    pub re: [[f64; BLOCK]; 16],
+    pub im: [[f64; BLOCK]; 16],
+    pub log_scale: [f64; BLOCK],
+}
+
+impl ThetaPlan {
+    /// Genus 2, values only, for the characteristics `chars` (FLINT indices,
+    /// at most 16): the points `point(0) … point(npts − 1)` are evaluated
+    /// [`BLOCK`] at a time and each block is handed to `sink(first, block)`
+    /// while it is hot in cache. The lattice sum is shared by all
+    /// characteristics (the class sums); only the requested ones are
+    /// combined. Uses the vectorised kernel whenever the plan allows it
+    /// (building its table on first use), else the per-point sum — no
+    /// allocation per point either way.
+    ///
+    /// Errors: genus ≠ 2, an index ≥ 16, more than 16 indices, and those of
+    /// [`ThetaPlan::eval_into`] for a point.
+    pub fn eval_selected_g2(
+        &self,
+        npts: usize,
+        mut point: impl FnMut(usize) -> [Complex64; 2],
+        chars: &[usize],
+        mut sink: impl FnMut(usize, &SelectedBlock),
+    ) -> Result<()> {
+        if self.g != 2 {
+            return Err(Error::InvalidArgument {
+                what: "eval_selected_g2",
+                reason: format!("genus 2 only, the plan has genus {}", self.g),
+            });
+        }
+        if chars.len() > 16 || chars.iter().any(|&c| c >= 16) {
+            return Err(Error::InvalidArgument {
+                what: "chars",
+                reason: format!("at most 16 characteristic indices below 16, got {chars:?}"),
+            });
+        }
+        let want = chars.iter().fold(0u16, |m, &c| m | (1 << c));
+        let mut blk = SelectedBlock {
+            len: 0,
+            re: [[0.0; BLOCK]; 16],
+            im: [[0.0; BLOCK]; 16],
+            log_scale: [0.0; BLOCK],
+        };
+        let mut i0 = 0;
+        if let Some(b2) = self.batch2.get_or_init(|| batch::Batch2::build(self)) {
+            let mut sc = b2.scratch();
+            let mut inp = batch::ChunkIn::default();
+            while i0 < npts {
+                let m = (npts - i0).min(BLOCK);
+                if m < BLOCK {
+                    inp = batch::ChunkIn::default();
+                }
+                for p in 0..m {
+                    let red = self.reduce2::<false>(point(i0 + p))?;
+                    inp.set(p, &red);
+                }
+                b2.eval_chunk(self, &inp, false, want, &mut sc);
+                blk.len = m;
+                blk.log_scale = inp.logs;
+                for (k, &c) in chars.iter().enumerate() {
+                    blk.re[k] = *sc.out_re[c];
+                    blk.im[k] = *sc.out_im[c];
+                }
+                sink(i0, &blk);
+                i0 += m;
+            }
+            return Ok(());
+        }
+        let mut ws = self.workspace();
+        let mut vals = [Complex64::new(0.0, 0.0); 16];
+        while i0 < npts {
+            let m = (npts - i0).min(BLOCK);
+            blk.re = [[0.0; BLOCK]; 16];
+            blk.im = [[0.0; BLOCK]; 16];
+            blk.log_scale = [0.0; BLOCK];
+            for p in 0..m {
+                let z = point(i0 + p);
+                blk.log_scale[p] = self.eval_into(&z, &mut ws, &mut vals, &mut [], &mut [])?;
+                for (k, &c) in chars.iter().enumerate() {
+                    blk.re[k][p] = vals[c].re;
+                    blk.im[k][p] = vals[c].im;
+                }
+            }
+            blk.len = m;
+            sink(i0, &blk);
+            i0 += m;
+        }
+        Ok(())
     }
 }
 
@@ -1200,13 +1318,29 @@ fn quad_mod2(x: &[f64], q: &[f64], g: usize) -> f64 {
             if pq.abs() < 6.7e7 {
                 let (hi, lo) = split(x[i * g + k]);
                 let t = pq * hi;
-                total += (t - 2.0 * (0.5 * t).round()) + pq * lo;
+                total += rem2(t) + pq * lo;
             } else {
                 total += pq * x[i * g + k];
             }
         }
     }
     total
+}
+
+/// `x − 2 round(x/2) ∈ [−1, 1]`, exact. The nearest integer comes from the
+/// `1.5·2^52` trick (ties to even; either tie is exact here) instead of a libm
+/// call, which the baseline x86-64 target needs for `round`; beyond `2^51`
+/// the trick no longer gives the nearest integer, and libm is used.
+#[inline(always)]
+pub fn rem2(x: f64) -> f64 {
+    const MAGIC: f64 = 6_755_399_441_055_744.0;
+    let h = 0.5 * x;
+    let n = if h.abs() < 2_251_799_813_685_248.0 {
+        (h + MAGIC) - MAGIC
+    } else {
+        h.round()
+    };
+    x - 2.0 * n
 }
 
 /// In-place Walsh–Hadamard transform `v_b ← Σ_h (-1)^{popcount(h & b)} v_h`.
