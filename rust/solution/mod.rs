@@ -114,9 +114,8 @@ fn phase_mod2(x0: f64, rate: f64, t: f64) -> f64 {
     let p = rate * t;
     let e = rate.mul_add(t, -p);
     // p − 2 round(p/2) is exact (|result| ≤ 1 and both are multiples of ulp(p)).
-    let r = p - 2.0 * (0.5 * p).round();
-    let s = x0 + r + e;
-    s - 2.0 * (0.5 * s).round()
+    let r = crate::theta::rem2(p);
+    crate::theta::rem2(x0 + r + e)
 }
 
 impl Solution {
@@ -454,6 +453,21 @@ impl Solution {
         Ok([ua[0] + ub[0], ua[1] + ub[1]])
     }
 
+    /// Lattice coordinates `(x, y)` of `v(t) = x + τ y`, reduced modulo 2.
+    #[inline]
+    pub fn lattice_reduced(&self, t: f64) -> ([f64; 2], [f64; 2]) {
+        (
+            [
+                phase_mod2(self.lat0[0], self.lat_rate[0], t),
+                phase_mod2(self.lat0[1], self.lat_rate[1], t),
+            ],
+            [
+                phase_mod2(self.lat0[2], self.lat_rate[2], t),
+                phase_mod2(self.lat0[3], self.lat_rate[3], t),
+            ],
+        )
+    }
+
     /// `v(t) = v0 + U t` reduced modulo twice the lattice.
     #[inline]
     pub fn v_reduced(&self, t: f64) -> [C; 2] {
@@ -488,9 +502,9 @@ impl Solution {
     }
 
     fn eval_serial(&self, t: &[f64], out: &mut [f64]) -> Result<()> {
-        self.plan.eval_selected_g2(
+        self.plan.eval_selected_g2_lattice(
             t.len(),
-            |i| self.v_reduced(t[i]),
+            |i| self.lattice_reduced(t[i]),
             &self.idx,
             |first, blk| self.combine(blk, &mut out[6 * first..6 * (first + blk.len)]),
         )

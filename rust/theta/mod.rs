@@ -124,6 +124,9 @@ pub struct ThetaPlan {
     order: usize,
     /// `τ' = τ - 2S`, row-major, `Re τ'` in [-1, 1].
     tau: Vec<Complex64>,
+    /// `Re τ` (symmetrised, before the shift by `2S`), row-major: the points
+    /// given in lattice coordinates are `x + τ y` with this `τ`.
+    re_tau: Vec<f64>,
     /// `Re τ'`, `Im τ`, `(Im τ)^{-1}`, row-major.
     x: Vec<f64>,
     y: Vec<f64>,
@@ -314,6 +317,7 @@ impl ThetaPlan {
             }
         }
         let x: Vec<f64> = taur.iter().map(|c| c.re).collect();
+        let re_tau: Vec<f64> = (0..g * g).map(|ik| sym(ik / g, ik % g).re).collect();
         let n_out = 1usize << (2 * g);
         let nh = 1usize << g;
         let abit = |a: usize, k: usize| (a >> (g - 1 - k)) & 1;
@@ -380,6 +384,7 @@ impl ThetaPlan {
             g,
             order,
             tau: taur,
+            re_tau,
             x,
             y,
             yinv,
@@ -733,6 +738,60 @@ impl ThetaPlan {
         Ok(red)
     }
 
+    /// [`ThetaPlan::reduce2`] (without the prefactor) for a point given by real
+    /// lattice coordinates, `z = x + τ y`: `q = round(y)`, `y_r = y − q`, so
+    /// `(Im τ)^{-1} Im z_r = y_r` exactly and no solve with `Im τ` is needed.
+    /// `Re τ = Re τ' + 2S` with `S` integer, so replacing `τ'` by `τ` in
+    /// `z = z_r + p + τ'q` moves `p` by the even vector `2Sq` and `qᵀX'q` by
+    /// the even `2qᵀSq`: the parities and the phase mod 2 are unchanged.
+    fn reduce2_lattice(&self, x: [f64; 2], y: [f64; 2]) -> Result<Reduced> {
+        for (k, v) in x.iter().chain(y.iter()).enumerate() {
+            if !v.is_finite() {
+                return Err(Error::NonFinite {
+                    what: "lattice coordinates",
+                    index: k,
+                });
+            }
+        }
+        if y[0].abs().max(y[1].abs()) > MAX_REDUCTION {
+            return Err(Error::InvalidArgument {
+                what: "z",
+                reason: format!("lattice coordinate y = {y:?}: theta is not representable"),
+            });
+        }
+        let (rt, it) = (&self.re_tau, &self.y);
+        let q = [sum::round_i64(y[0]) as f64, sum::round_i64(y[1]) as f64];
+        let yr = [y[0] - q[0], y[1] - q[1]];
+        let mut red = Reduced::default();
+        let mut p = [0.0; 2];
+        for i in 0..2 {
+            let re = x[i] + rt[2 * i] * yr[0] + rt[2 * i + 1] * yr[1];
+            let im = it[2 * i] * yr[0] + it[2 * i + 1] * yr[1];
+            p[i] = integer_part(re, re)?;
+            red.zr[i] = Complex64::new(re - p[i], im);
+        }
+        red.wr[0] = yr[0];
+        red.wr[1] = yr[1];
+        red.q[0] = q[0];
+        red.q[1] = q[1];
+        let imz = [it[0] * y[0] + it[1] * y[1], it[2] * y[0] + it[3] * y[1]];
+        red.log_scale = finite_log_scale(pi() * (imz[0] * y[0] + imz[1] * y[1]))?;
+        red.prefactor = Complex64::new(1.0, 0.0);
+        if q[0] != 0.0 || q[1] != 0.0 {
+            let xq = &self.x;
+            let quad = if q[0].abs() <= 1.0 && q[1].abs() <= 1.0 {
+                // q_i q_k ∈ {−1, 0, 1}: the products are exact.
+                q[0] * q[0] * xq[0] + q[0] * q[1] * (xq[1] + xq[2]) + q[1] * q[1] * xq[3]
+            } else {
+                quad_mod2(xq, &q, 2)
+            };
+            red.phase = -quad - 2.0 * (q[0] * red.zr[0].re + q[1] * red.zr[1].re);
+        }
+        red.pbits = ((p[0] as i64 & 1) << 1 | (p[1] as i64 & 1)) as usize;
+        red.qbits = ((q[0] as i64 & 1) << 1 | (q[1] as i64 & 1)) as usize;
+        Ok(red)
+    }
+
     /// Genus 2, values only: 4 Walsh–Hadamard transforms of length 4 (the hot
     /// case written out; takes the class sums directly to avoid a copy).
     fn combine_g2_values(
@@ -1037,6 +1096,13 @@ pub const BLOCK: usize = batch::LANES;
 /// points, structure of arrays: `Ω[chars[m]]` of point `p` is
 /// `re[m][p] + i im[m][p]`, and `θ = exp(log_scale[p]) Ω`. Lanes `p ≥ len`
 /// hold zeros; rows `m ≥ chars.len()` are unspecified.
+/// A genus-2 point for [`ThetaPlan::eval_selected_g2_impl`].
+#[derive(Debug, Clone, Copy)]
+enum G2Point {
+    Z([Complex64; 2]),
+    Lattice([f64; 2], [f64; 2]),
+}
+
 #[derive(Debug, Clone)]
 pub struct SelectedBlock {
     /// Points in this block (`1 ..= BLOCK`).
@@ -1062,6 +1128,57 @@ impl ThetaPlan {
         &self,
         npts: usize,
         mut point: impl FnMut(usize) -> [Complex64; 2],
+        chars: &[usize],
+        sink: impl FnMut(usize, &SelectedBlock),
+    ) -> Result<()> {
+        self.eval_selected_g2_impl(npts, |i| G2Point::Z(point(i)), chars, sink)
+    }
+
+    /// [`ThetaPlan::eval_selected_g2`] for points given by real lattice
+    /// coordinates, `z = x + τ y` with `(x, y) = lattice(i)`: the reduction to
+    /// the fundamental cell is then read off `y` (no solve with `Im τ`), which
+    /// is most of the per-point cost outside the lattice sum.
+    pub fn eval_selected_g2_lattice(
+        &self,
+        npts: usize,
+        mut lattice: impl FnMut(usize) -> ([f64; 2], [f64; 2]),
+        chars: &[usize],
+        sink: impl FnMut(usize, &SelectedBlock),
+    ) -> Result<()> {
+        self.eval_selected_g2_impl(
+            npts,
+            |i| {
+                let (x, y) = lattice(i);
+                G2Point::Lattice(x, y)
+            },
+            chars,
+            sink,
+        )
+    }
+
+    fn g2_reduce(&self, pt: G2Point) -> Result<Reduced> {
+        match pt {
+            G2Point::Z(z) => self.reduce2::<false>(z),
+            G2Point::Lattice(x, y) => self.reduce2_lattice(x, y),
+        }
+    }
+
+    fn g2_z(&self, pt: G2Point) -> [Complex64; 2] {
+        match pt {
+            G2Point::Z(z) => z,
+            G2Point::Lattice(x, y) => std::array::from_fn(|i| {
+                Complex64::new(
+                    x[i] + self.re_tau[2 * i] * y[0] + self.re_tau[2 * i + 1] * y[1],
+                    self.y[2 * i] * y[0] + self.y[2 * i + 1] * y[1],
+                )
+            }),
+        }
+    }
+
+    fn eval_selected_g2_impl(
+        &self,
+        npts: usize,
+        mut point: impl FnMut(usize) -> G2Point,
         chars: &[usize],
         mut sink: impl FnMut(usize, &SelectedBlock),
     ) -> Result<()> {
@@ -1094,7 +1211,7 @@ impl ThetaPlan {
                     inp = batch::ChunkIn::default();
                 }
                 for p in 0..m {
-                    let red = self.reduce2::<false>(point(i0 + p))?;
+                    let red = self.g2_reduce(point(i0 + p))?;
                     inp.set(p, &red);
                 }
                 b2.eval_chunk(self, &inp, false, want, &mut sc);
@@ -1117,7 +1234,7 @@ impl ThetaPlan {
             blk.im = [[0.0; BLOCK]; 16];
             blk.log_scale = [0.0; BLOCK];
             for p in 0..m {
-                let z = point(i0 + p);
+                let z = self.g2_z(point(i0 + p));
                 blk.log_scale[p] = self.eval_into(&z, &mut ws, &mut vals, &mut [], &mut [])?;
                 for (k, &c) in chars.iter().enumerate() {
                     blk.re[k][p] = vals[c].re;

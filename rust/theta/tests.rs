@@ -542,3 +542,53 @@ fn large_genus_sums_over_the_cost_budget_are_refused() {
     let info = ThetaPlan::new(&ok, g, 1e-15, 0).unwrap().info();
     assert!(info.seconds_per_point > 0.0 && info.seconds_per_point <= MAX_SECONDS_PER_POINT);
 }
+
+/// Points given by lattice coordinates (`z = x + τ y`) give the thetas of `z`:
+/// against the brute-force sum, through the batch kernel (a full block) and the
+/// per-point path (a short tail), with `Re τ` beyond [−1, 1] (`S ≠ 0`) and
+/// `|y|` up to 3.7 (reduction shifts `q` with `|q| > 1`).
+#[test]
+fn lattice_coordinates_give_the_thetas_of_the_point() {
+    let tau = tau2(C::new(2.3, 1.1), C::new(-3.1, 0.4), C::new(-0.2, 1.3));
+    let plan = ThetaPlan::new(&tau, 2, 1e-16, 0).unwrap();
+    let n = BLOCK + 5;
+    let lat: Vec<([f64; 2], [f64; 2])> = (0..n)
+        .map(|p| {
+            let t = p as f64;
+            (
+                [(0.37 * t).sin() * 5.0, (0.53 * t).cos() * 1.5],
+                [(0.71 * t).cos() * 3.7, (0.29 * t).sin() * 1.2],
+            )
+        })
+        .collect();
+    let chars: Vec<usize> = (0..16).collect();
+    let mut got = vec![[C::new(0.0, 0.0); 16]; n];
+    plan.eval_selected_g2_lattice(
+        n,
+        |i| lat[i],
+        &chars,
+        |first, blk| {
+            for p in 0..blk.len {
+                for (k, _) in chars.iter().enumerate() {
+                    got[first + p][k] = C::new(blk.re[k][p], blk.im[k][p]) * blk.log_scale[p].exp();
+                }
+            }
+        },
+    )
+    .unwrap();
+    for (p, (x, y)) in lat.iter().enumerate() {
+        let z: Vec<C> = (0..2)
+            .map(|i| C::new(x[i], 0.0) + tau[2 * i] * y[0] + tau[2 * i + 1] * y[1])
+            .collect();
+        let refs: Vec<C> = (0..16).map(|c| brute(&z, &tau, 2, c, 14, &one)).collect();
+        let scale = max_abs(&refs);
+        for c in 0..16 {
+            assert!(
+                (got[p][c] - refs[c]).norm() <= AGREE * scale,
+                "point {p} char {c}: {} vs {}",
+                got[p][c],
+                refs[c]
+            );
+        }
+    }
+}
