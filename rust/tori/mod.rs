@@ -454,8 +454,8 @@ pub enum Status {
     Ok = 0,
     /// `h1² = 4 h0²`: `F(s)` of (19) is undefined (the level set is singular).
     SingularCasimirs = 1,
-    /// Two branch points `d_j` of (8) coincide (`h0 = 0` included): the genus drops,
-    /// a separatrix or a degenerate torus.
+    /// Two branch points `d_j` of (8) coincide (`h0 = 0` and a repeated root of
+    /// `F` (19) included): the genus drops, a separatrix or a degenerate torus.
     CoincidingBranchPoints = 2,
     /// The divisor of the initial state has a point at infinity.
     DivisorAtInfinity = 3,
@@ -471,10 +471,12 @@ pub enum Status {
     NoRealLattice = 8,
     /// Any other refusal of the solution (its message names the reason).
     Singular = 9,
+    /// The theta-quotient gradients at `v0` do not determine the velocity `U`.
+    DegenerateGradients = 10,
 }
 
 /// Short names of the status codes, indexed by code.
-pub const STATUS_NAMES: [&str; 10] = [
+pub const STATUS_NAMES: [&str; 11] = [
     "ok",
     "h1^2 = 4 h0^2",
     "coinciding branch points",
@@ -485,6 +487,7 @@ pub const STATUS_NAMES: [&str; 10] = [
     "degenerate plane",
     "no real lattice",
     "singular",
+    "degenerate gradients",
 ];
 
 impl From<TorusFailure> for Status {

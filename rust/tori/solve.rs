@@ -6,7 +6,7 @@ use num_complex::Complex64 as C;
 use super::{
     frequencies_of_state, real_torus, second_flow_b, Char, FlowData, MapEntry, RealTorus, Status,
 };
-use crate::error::{Error, Result};
+use crate::error::{Error, Result, SingularKind};
 use crate::so4;
 use crate::solution::Solution;
 use crate::theta::ThetaPlan;
@@ -39,22 +39,22 @@ pub fn flow_data(sol: &Solution, b2: &[f64; 4]) -> Result<FlowData> {
 /// The status code of an error of [`Solution::new`].
 pub fn classify(e: &Error) -> Status {
     match e {
+        Error::Singular { kind, .. } => match kind {
+            SingularKind::ZeroState => Status::ZeroState,
+            SingularKind::SelfDual => Status::SingularCasimirs,
+            // h0 = 0 is d_0 = 0 meeting another d_j; a double root of F (19)
+            // drops the genus alike (a separatrix).
+            SingularKind::VanishingH0
+            | SingularKind::CoincidingBranchPoints
+            | SingularKind::RepeatedRoot => Status::CoincidingBranchPoints,
+            SingularKind::DivisorAtInfinity => Status::DivisorAtInfinity,
+            SingularKind::DegenerateGradients => Status::DegenerateGradients,
+            // A kind added later: still a refusal, never Ok.
+            _ => Status::Singular,
+        },
         Error::RepeatedBranchPoints { .. } => Status::CoincidingBranchPoints,
         Error::NoConvergence { .. } => Status::NoConvergence,
         Error::NonFinite { .. } => Status::NonFinite,
-        Error::InvalidArgument { reason, .. } => {
-            if reason.contains("infinity") {
-                Status::DivisorAtInfinity
-            } else if reason.contains("h1^2 - 4 h0^2") {
-                Status::SingularCasimirs
-            } else if reason.contains("h0 =") || reason.contains("coincide") {
-                Status::CoincidingBranchPoints
-            } else if reason.contains("l0 = 0") {
-                Status::ZeroState
-            } else {
-                Status::Singular
-            }
-        }
         _ => Status::Singular,
     }
 }

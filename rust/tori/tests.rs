@@ -360,8 +360,11 @@ fn state_statuses_and_nan_policy() {
 }
 
 mod on_the_solution {
-    use super::super::solve::{c_pairs, flow_data, rate_for, state_frequencies, torus_of_state};
+    use super::super::solve::{
+        c_pairs, classify, flow_data, rate_for, state_frequencies, torus_of_state,
+    };
     use super::super::*;
+    use crate::error::SingularKind;
     use crate::solution::Solution;
 
     const GENERIC: ([f64; 4], [f64; 4], [f64; 6]) = (
@@ -467,5 +470,83 @@ mod on_the_solution {
         assert!(e.nu.iter().all(|v| v.is_nan()));
         let e = state_frequencies(&a, &b, &[0.3, -0.2, 0.5, 0.5, 0.2, 0.3]);
         assert_eq!(e.status, Status::SingularCasimirs);
+        // A double root of F (19) (l12, l34 only): a separatrix.
+        let e = state_frequencies(&a, &b, &[1.0, 0.0, 0.0, 0.0, 0.0, 0.5]);
+        assert_eq!(e.status, Status::CoincidingBranchPoints);
+    }
+
+    fn kind_of(e: Error) -> (&'static str, SingularKind) {
+        match e {
+            Error::Singular { what, kind, .. } => (what, kind),
+            other => panic!("not a Singular error: {other}"),
+        }
+    }
+
+    #[test]
+    fn refusals_of_the_solution_carry_their_kind() {
+        let (a, b, _) = GENERIC;
+        let new = |l0: [f64; 6]| kind_of(Solution::new(&a, &b, &l0).map(|_| ()).unwrap_err());
+        assert_eq!(new([0.0; 6]), ("state l0", SingularKind::ZeroState));
+        assert_eq!(
+            new([1.0, 0.0, 0.0, 0.0, 0.5, 0.0]),
+            ("state l0", SingularKind::VanishingH0)
+        );
+        // m = n: the solution's own check, before the reduction's.
+        assert_eq!(
+            new([0.3, -0.2, 0.5, 0.5, 0.2, 0.3]),
+            ("state l0", SingularKind::SelfDual)
+        );
+        // h0 just above the solution's threshold, within the reduction's.
+        assert_eq!(
+            new([1.0, 0.0, 0.0, 0.0, 0.0, 1e-12]),
+            ("state l", SingularKind::VanishingH0)
+        );
+        assert_eq!(
+            new([1.0, 0.0, 0.0, 0.0, 0.0, 0.5]),
+            ("state l", SingularKind::RepeatedRoot)
+        );
+    }
+
+    #[test]
+    fn every_kind_has_its_status() {
+        // Written out, so that a new kind or a changed code shows here.
+        let table = [
+            (SingularKind::ZeroState, Status::ZeroState),
+            (SingularKind::VanishingH0, Status::CoincidingBranchPoints),
+            (SingularKind::SelfDual, Status::SingularCasimirs),
+            (
+                SingularKind::CoincidingBranchPoints,
+                Status::CoincidingBranchPoints,
+            ),
+            (SingularKind::RepeatedRoot, Status::CoincidingBranchPoints),
+            (SingularKind::DivisorAtInfinity, Status::DivisorAtInfinity),
+            (
+                SingularKind::DegenerateGradients,
+                Status::DegenerateGradients,
+            ),
+        ];
+        for (kind, status) in table {
+            let e = Error::Singular {
+                what: "state l0",
+                kind,
+                reason: String::new(),
+            };
+            assert_eq!(classify(&e), status, "{kind:?}");
+        }
+        let other = Error::InvalidArgument {
+            what: "state l",
+            reason: "h0 = 0 coincide infinity".into(),
+        };
+        // The message no longer decides the code.
+        assert_eq!(classify(&other), Status::Singular);
+        assert_eq!(
+            classify(&Error::NoConvergence {
+                what: "x",
+                tol: 0.0,
+                reached: 1.0,
+                iterations: 1
+            }),
+            Status::NoConvergence
+        );
     }
 }
