@@ -12,25 +12,13 @@ import time
 
 import numpy as np
 import pytest
-from naff import naff
+from tori_naff import LINE_RTOL, check_lines
 
 import manakov
 from manakov import tori
 
 PROBLEMS = ("generic", "physical", "wide", "near_degenerate")
 
-# Every NAFF line must be k1 ν1 + k2 ν2 (|k| ≤ 20) to this, relative to
-# max(ν1, ν2): the issue's figure. NAFF itself resolves ~1e-11 on synthetic
-# signals of the same length (tests/test_naff.py).
-LINE_RTOL = 1e-8
-K_MAX = 20
-# Lines down to this fraction of the largest are checked (the issue's figure).
-LINE_FLOOR = 1e-6
-# Slow periods in the NAFF window (the issue asks ≥ 500). At 500, NAFF's own
-# error on the weakest lines (amplitude ~1e-6 beside lines 10^6 larger) reached
-# 1.8e-8 on a random state — the tool's limit, not the frequencies' (the same
-# state passes at 1000); 1000 periods keep the reference below the 1e-8 asked.
-PERIODS = 1000
 # l(u0 + λ_i) from the theta quotients vs l(u0), relative to |l0|: the sign
 # rule makes them equal up to the rounding of θ at a shifted argument.
 PERIOD_RTOL = 1e-12
@@ -66,49 +54,16 @@ def _real4(z):
     return np.r_[z.real, z.imag]
 
 
-def _match(nu, nu1, nu2):
-    k = np.arange(-K_MAX, K_MAX + 1)
-    comb = k[:, None] * nu1 + k[None, :] * nu2
-    i = np.unravel_index(np.argmin(np.abs(comb - nu)), comb.shape)
-    return (int(k[i[0]]), int(k[i[1]])), abs(comb[i] - nu) / max(nu1, nu2)
-
-
 def _naff_check(top, l0, nu, components):
-    """Integrate, NAFF each component, match every line; return the k's found."""
-    nu1, nu2 = nu
-    slow = min(nu1, nu2)
-    # Spectral extent from a short run, then the sampling step from it.
-    T0 = 40 / slow
-    dt0 = 1 / (40 * max(nu1, nu2))
-    short = top.integrate(l0, T0, sample_every=dt0, method="gauss16").l
-    fmax = 0.0
-    for c in components:
-        x = short[:, c] * np.sin(np.pi * np.arange(short.shape[0]) / (short.shape[0] - 1)) ** 4
-        F = np.abs(np.fft.rfft(x - x.mean()))
-        f = np.fft.rfftfreq(x.size, dt0)
-        fmax = max(fmax, f[np.flatnonzero(F >= 1e-8 * F.max()).max()])
-    dt = 0.4 / max(fmax, max(nu1, nu2))
-    T = PERIODS / slow
-    tr = top.integrate(l0, T, sample_every=dt, method="gauss16")
-    ks = []
-    for c in components:
-        lines, amps = naff(tr.l[:, c], dt, max_lines=150, rel_threshold=LINE_FLOOR)
-        for line, amp in zip(lines, amps):
-            if amp < LINE_FLOOR * amps[0] or line == 0.0:
-                continue
-            k, err = _match(line, nu1, nu2)
-            assert err <= LINE_RTOL, (
-                f"component {c}: line {line} (amp {amp / amps[0]:.1e}) is no k·ν, "
-                f"best {k}: {err:.1e}"
-            )
-            ks.append(k)
-    # Both generators present (up to GL(2, Z)): the k's span Z².
-    g = 0
-    for i in range(len(ks)):
-        for j in range(i + 1, len(ks)):
-            g = np.gcd(g, abs(ks[i][0] * ks[j][1] - ks[i][1] * ks[j][0]))
-    assert g == 1, f"lines {sorted(set(ks))} do not generate Z²"
-    return ks
+    """Integrate, NAFF each component, match every line (tests/tori_naff.py)."""
+    res = check_lines(top, l0, nu, components)
+    if res.worst > LINE_RTOL:
+        c, line, amp, k, err = res.worst_line
+        raise AssertionError(
+            f"component {c}: line {line} (amp {amp:.1e}) is no k·ν, best {k}: {err:.1e}"
+        )
+    assert res.generated, f"lines {sorted(set(res.ks))} do not generate Z²"
+    return res.ks
 
 
 def test_frequencies_match_naff_on_generic():
