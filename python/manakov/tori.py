@@ -75,6 +75,10 @@ SINGULAR = 9
 #: The theta-quotient gradients at the initial divisor do not determine the
 #: velocity ``U``.
 DEGENERATE_GRADIENTS = 10
+#: The solution's theta quotients reproduce the state but solve (1) for no
+#: velocity: its set-up is wrong there (one of the Theorem's outliers), so
+#: would its frequencies be.
+INCONSISTENT_QUOTIENTS = 11
 
 #: States per chunk without a client: the unit between progress updates and
 #: Ctrl-C checks of the Python loop (the Rust core also polls within a chunk).

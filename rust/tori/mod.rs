@@ -473,10 +473,14 @@ pub enum Status {
     Singular = 9,
     /// The theta-quotient gradients at `v0` do not determine the velocity `U`.
     DegenerateGradients = 10,
+    /// The solution's theta quotients reproduce `l0` but solve Frahm's
+    /// equations (1) at `v0` for no velocity: its set-up is wrong at this
+    /// state (one of the Theorem's outliers), so are its frequencies.
+    InconsistentQuotients = 11,
 }
 
 /// Short names of the status codes, indexed by code.
-pub const STATUS_NAMES: [&str; 11] = [
+pub const STATUS_NAMES: [&str; 12] = [
     "ok",
     "h1^2 = 4 h0^2",
     "coinciding branch points",
@@ -488,6 +492,7 @@ pub const STATUS_NAMES: [&str; 11] = [
     "no real lattice",
     "singular",
     "degenerate gradients",
+    "inconsistent quotients",
 ];
 
 impl From<TorusFailure> for Status {

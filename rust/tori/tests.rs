@@ -361,7 +361,8 @@ fn state_statuses_and_nan_policy() {
 
 mod on_the_solution {
     use super::super::solve::{
-        c_pairs, classify, flow_data, rate_for, state_frequencies, torus_of_state,
+        c_pairs, classify, flow_data, rate_for, state_frequencies, torus_of_state, velocities,
+        QUOTIENT_RESIDUAL_RTOL,
     };
     use super::super::*;
     use crate::error::SingularKind;
@@ -537,6 +538,11 @@ mod on_the_solution {
             what: "state l",
             reason: "h0 = 0 coincide infinity".into(),
         };
+        let inconsistent = Error::InvalidArgument {
+            what: super::super::solve::INCONSISTENT,
+            reason: String::new(),
+        };
+        assert_eq!(classify(&inconsistent), Status::InconsistentQuotients);
         // The message no longer decides the code.
         assert_eq!(classify(&other), Status::Singular);
         assert_eq!(
@@ -548,5 +554,72 @@ mod on_the_solution {
             }),
             Status::NoConvergence
         );
+    }
+
+    /// The four shared tops (/work/shared/reference/problems.json).
+    const SHARED: [([f64; 4], [f64; 4], [f64; 6]); 4] = [
+        GENERIC,
+        (
+            [1.0, 2.25, 4.84, 9.61],
+            [1.0, 1.5, 2.2, 3.1],
+            [0.4, 1.2, -0.6, 0.9, 0.3, -1.0],
+        ),
+        (
+            [0.01, 1.0, 10.0, 100.0],
+            [2.0, -1.0, 0.5, 3.0],
+            [1.0, 0.5, -0.25, 0.75, -1.5, 0.1],
+        ),
+        (
+            [1.0, 1.000001, 2.0, 3.0],
+            [0.3, 0.300002, -0.4, 1.2],
+            [0.2, -0.9, 0.4, 0.6, 1.1, -0.3],
+        ),
+    ];
+
+    #[test]
+    fn consistent_set_ups_fit_both_flows() {
+        for (a, b, l0) in SHARED {
+            let s = Solution::new(&a, &b, &l0).unwrap();
+            let c2 = c_pairs(&a, &second_flow_b(&a, &b)).unwrap();
+            let fits = velocities(&s, &[*s.c4(), c2]).unwrap();
+            for (_, res) in &fits {
+                assert!(*res <= 1e-3 * QUOTIENT_RESIDUAL_RTOL, "a = {a:?}: {res:e}");
+            }
+        }
+    }
+
+    #[test]
+    fn an_inconsistent_set_up_is_refused_not_mapped() {
+        // State 14 of tests/data/tori_naff_random100.py (seed 1313): `solve`
+        // returns l(0) = l0 (calibration 4e-14) but l'(0) off by 300 %, and
+        // the integration's spectral lines miss its ν by 2e-2. No velocity
+        // makes the quotients solve (1) at v0 (residual ~0.2).
+        let a = [
+            0.6262672408286707,
+            1.1558542100739666,
+            3.9251780045549682,
+            4.5883259242255034,
+        ];
+        let b = [
+            -0.05178024146863031,
+            -0.42179480568224204,
+            -0.1045833884785173,
+            -0.5348591116146967,
+        ];
+        let l0 = [
+            -0.7041138736314696,
+            0.538991160465901,
+            -0.27246109242831956,
+            0.26712289621603547,
+            1.7213065155493528,
+            -0.22470690403864946,
+        ];
+        let s = Solution::new(&a, &b, &l0).unwrap();
+        let fits = velocities(&s, &[*s.c4()]).unwrap();
+        assert!(fits[0].1 > 1e-2, "{:e}", fits[0].1);
+        let e = state_frequencies(&a, &b, &l0);
+        assert_eq!(e.status, Status::InconsistentQuotients);
+        assert!(e.nu.iter().all(|v| v.is_nan()));
+        assert!(torus_of_state(&a, &b, &l0).is_err());
     }
 }
