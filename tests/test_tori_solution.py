@@ -98,8 +98,8 @@ def _random_states(n, seed):
 
 @pytest.mark.slow
 def test_frequencies_match_naff_on_random_states():
-    # The issue asks for 100 random states; with this NAFF each takes ~20-100 s,
-    # so the slow run (CI) checks 3 of them (two components each).
+    # The issue's 100 random states run in tests/data/tori_naff_random100.py
+    # (minutes to an hour); the slow run (CI) checks 3 of them (two components each).
     for a, b, l0 in _random_states(3, 4242):
         top = manakov.ManakovTop(a, b)
         fm = tori.frequency_map(top, l0[None, :])
