@@ -34,6 +34,15 @@ pub enum Error {
         j: usize,
         value: Complex64,
     },
+    /// A state on which the Theorem's genus-2 solution (or the reduction
+    /// under it) does not exist: a singular level set or a degenerate divisor.
+    /// `kind` says which; the message (worded like [`Error::InvalidArgument`])
+    /// names the numbers. Python sees a `ValueError`.
+    Singular {
+        what: &'static str,
+        kind: SingularKind,
+        reason: String,
+    },
     /// Any other invalid argument, with the reason.
     InvalidArgument { what: &'static str, reason: String },
     /// An iteration did not reach its tolerance.
@@ -45,6 +54,30 @@ pub enum Error {
     },
     /// The computation was cancelled (Ctrl-C in Python; see [`crate::cancel`]).
     Interrupted,
+}
+
+/// Why a state has no genus-2 theta-function solution ([`Error::Singular`]).
+///
+/// The frequency maps (`crate::tori`) turn the kind into a status code, so a
+/// kind is part of the API; the message stays free text.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[non_exhaustive]
+pub enum SingularKind {
+    /// `l0 = 0`: the rest state, no curve (8).
+    ZeroState,
+    /// `h0 = 0`: the branch point `d_0 = 0` meets another `d_j`.
+    VanishingH0,
+    /// `h1² = 4h0²` (`m = ±n`): `F` of (19) is undefined.
+    SelfDual,
+    /// Two branch points `d_i`, `d_j` of (8) coincide, or a root of `F` (19)
+    /// meets an `a_j`: the genus drops.
+    CoincidingBranchPoints,
+    /// `F(s)` of (19) has a repeated root (a separatrix): the genus drops.
+    RepeatedRoot,
+    /// The divisor of `l0` contains the point at infinity (`θ(v0) = 0`).
+    DivisorAtInfinity,
+    /// The theta-quotient gradients at `v0` do not determine `U`.
+    DegenerateGradients,
 }
 
 /// `Result` with the crate's [`Error`].
@@ -77,7 +110,10 @@ impl fmt::Display for Error {
                 f,
                 "branch points d{i} and d{j} coincide (= {value}): the curve is singular, its genus drops"
             ),
-            Error::InvalidArgument { what, reason } => write!(f, "invalid {what}: {reason}"),
+            // The same text as the `InvalidArgument` these once were.
+            Error::Singular { what, reason, .. } | Error::InvalidArgument { what, reason } => {
+                write!(f, "invalid {what}: {reason}")
+            }
             Error::NoConvergence {
                 what,
                 tol,
@@ -126,5 +162,19 @@ mod tests {
             value: 1.5,
         };
         assert!(e.to_string().contains("a[0] == a[2] == 1.5"));
+    }
+
+    #[test]
+    fn singular_reads_like_an_invalid_state() {
+        let e = Error::Singular {
+            what: "state l0",
+            kind: SingularKind::SelfDual,
+            reason: "h1^2 - 4 h0^2 = 0e0 vanishes".into(),
+        };
+        let old = Error::InvalidArgument {
+            what: "state l0",
+            reason: "h1^2 - 4 h0^2 = 0e0 vanishes".into(),
+        };
+        assert_eq!(e.to_string(), old.to_string());
     }
 }

@@ -28,7 +28,7 @@ pub mod solution;
 pub mod theta;
 pub mod tori;
 
-pub use error::{Error, Result};
+pub use error::{Error, Result, SingularKind};
 
 #[cfg(feature = "python")]
 mod python;

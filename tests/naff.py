@@ -5,7 +5,8 @@ Independent of the package: numpy only. For samples ``x_k = x(k dt)``:
 1. window ``w_k = sin²(π k/(N−1))^p`` (Hann for ``p = 1``; ``p = 2`` is the
    Hann² window of Laskar's frequency-map papers, whose side lobes fall as
    ``1/(Δν T)⁵``, so that weak lines next to strong ones keep their place);
-2. the peak of ``|FFT(w x)|`` (4× zero padding), parabolic interpolation;
+2. the peak of ``|FFT(w x)|`` (≥ 4× zero padding, to a length the FFT
+   factors fast), parabolic interpolation;
 3. refinement: Newton's method on ``φ'(ν) = 0``, ``φ(ν) = |S(ν)|²``,
    ``S(ν) = Σ_k w_k x_k e^{−2πiν t_k}`` (first and second derivatives are
    sums of the same kind), which finds the maximum to roundoff;
@@ -22,6 +23,7 @@ For a real signal the search runs over ``ν ≥ 0`` and each line is the pair
 from __future__ import annotations
 
 import numpy as np
+from scipy.fft import next_fast_len
 
 
 def window(n: int, p: int = 1) -> np.ndarray:
@@ -29,23 +31,40 @@ def window(n: int, p: int = 1) -> np.ndarray:
     return np.sin(np.pi * k / (n - 1)) ** (2 * p)
 
 
-def _sums(y: np.ndarray, t: np.ndarray, nu: float):
-    """``S``, ``S'``, ``S''`` at ``ν`` (dot products: BLAS, one pass each)."""
-    ye = y * np.exp(-2j * np.pi * nu * t)
-    s0 = ye.sum()
-    s1 = (ye.real @ t + 1j * (ye.imag @ t)) * (-2j * np.pi)
-    t2 = t * t
-    s2 = (ye.real @ t2 + 1j * (ye.imag @ t2)) * (-4 * np.pi**2)
-    return s0, s1, s2
+def _phasor(nu: float, n: int, dt: float, block: int = 1024) -> np.ndarray:
+    """``e^{2πiν k dt}``, ``k = 0 … n−1``, as the outer product of two short
+    tables (``k = q B + r``): ``n`` complex products instead of ``n`` complex
+    exponentials, with the rounding of the direct form (each factor's phase
+    is one product ``2πν × (multiple of dt)``; the product adds an ulp)."""
+    r = np.exp(2j * np.pi * nu * (np.arange(block) * dt))
+    q = np.exp(2j * np.pi * nu * (np.arange(-(-n // block)) * (block * dt)))
+    return np.multiply.outer(q, r).ravel()[:n]
+
+
+def _sums(m: np.ndarray, nu: float, dt: float):
+    """``S``, ``S'``, ``S''`` at ``ν`` from ``m = [y, y t, y t²]``.
+
+    For a real ``y`` the three sums are one real matrix product with the
+    phasors' (cos, sin) pairs (BLAS, one pass over them)."""
+    e = _phasor(nu, m.shape[1], dt)
+    if np.isrealobj(m):
+        cs = m @ e.view(float).reshape(-1, 2)
+        r = cs[:, 0] - 1j * cs[:, 1]
+    else:
+        r = m @ np.conj(e)
+    return r[0], r[1] * (-2j * np.pi), r[2] * (-4 * np.pi**2)
 
 
 def refine(y: np.ndarray, t: np.ndarray, nu0: float, T: float, iters: int = 12) -> float:
     """Newton's method for the maximum of ``|Σ y e^{−2πiνt}|²`` near ``nu0``
-    (``y`` already windowed); steps are limited to a quarter of the main lobe."""
+    (``y`` already windowed, ``t = k dt``); steps are limited to a quarter of
+    the main lobe."""
     nu = nu0
     cap = 0.25 / T
+    dt = t[1] - t[0]
+    m = np.stack([y, y * t, y * t * t])
     for _ in range(iters):
-        s0, s1, s2 = _sums(y, t, nu)
+        s0, s1, s2 = _sums(m, nu, dt)
         d1 = 2 * np.real(np.conj(s0) * s1)
         d2 = 2 * (abs(s1) ** 2 + np.real(np.conj(s0) * s2))
         if d2 >= 0:  # not concave here: step uphill by the cap
@@ -60,16 +79,25 @@ def refine(y: np.ndarray, t: np.ndarray, nu0: float, T: float, iters: int = 12) 
     return float(nu)
 
 
-def _line(t: np.ndarray, nu: float, c: complex, real: bool) -> np.ndarray:
-    e = np.exp(2j * np.pi * nu * t)
+def _fit_line(nu: float, c: complex, n: int, dt: float, real: bool) -> np.ndarray:
+    """Samples of the line ``c e^{2πiνt}`` (with its conjugate for a real signal)."""
+    e = _phasor(nu, n, dt)
     if not real:
         return c * e
-    return (c * e).real * (1.0 if nu == 0.0 else 2.0)
+    return (c.real * e.real - c.imag * e.imag) * (1.0 if nu == 0.0 else 2.0)
 
 
-def _amplitude(y: np.ndarray, t: np.ndarray, w: np.ndarray, nu: float) -> complex:
-    """Windowed projection ``Σ w y e^{−2πiνt} / Σ w`` (the line's complex amplitude)."""
-    return complex((w * y * np.exp(-2j * np.pi * nu * t)).sum() / w.sum())
+def _fit(resid: np.ndarray, w: np.ndarray, nu: float, dt: float, real: bool):
+    """The line at ``ν``: its complex amplitude by windowed projection
+    ``Σ w y e^{−2πiνt} / Σ w`` and its samples (one table of phasors for both)."""
+    e = _phasor(nu, resid.size, dt)
+    if not real:
+        c = complex(((w * resid) @ np.conj(e)) / w.sum())
+        return c, c * e
+    cos, sin = (w * resid) @ e.view(float).reshape(-1, 2)
+    c = complex(cos, -sin) / w.sum()
+    # Re(c e) without a complex temporary.
+    return c, (c.real * e.real - c.imag * e.imag) * (1.0 if nu == 0.0 else 2.0)
 
 
 def naff(
@@ -113,17 +141,16 @@ def naff(
     t = np.arange(n) * dt
     T = t[-1]
     w = window(n, p)
-    pad = 4 * n
-    freqs = np.fft.fftfreq(pad, dt)
+    # At least 4× zero padding, to a length the FFT factors fast.
+    pad = next_fast_len(4 * n, real=real)
+    freqs = np.fft.rfftfreq(pad, dt) if real else np.fft.fftfreq(pad, dt)
     resid = x.astype(complex) if not real else x.astype(float)
     nus: list[float] = []
     cs: list[complex] = []
     first = None
     done = False
     while not done and len(nus) < max_lines:
-        F = np.abs(np.fft.fft(resid * w, pad))
-        if real:
-            F = np.where(freqs >= 0, F, 0.0)
+        F = np.abs(np.fft.rfft(resid * w, pad) if real else np.fft.fft(resid * w, pad))
         # The largest local maxima of this spectrum, a few main lobes apart
         # (the window's main lobe is 2(p+1)/T wide), are refined in one sweep.
         is_max = (F > np.roll(F, 1)) & (F >= np.roll(F, -1))
@@ -140,8 +167,9 @@ def naff(
         if not picked:
             break
         for k in picked:
-            # Parabolic interpolation of log|F| on three bins.
-            a, b, c = (np.log(max(F[(k + j) % pad], 1e-300)) for j in (-1, 0, 1))
+            # Parabolic interpolation of log|F| on three bins (a real
+            # signal's spectrum is even: bin −1 is bin 1).
+            a, b, c = (np.log(max(F[abs(k + j) % F.size], 1e-300)) for j in (-1, 0, 1))
             den = a - 2 * b + c
             off = 0.5 * (a - c) / den if den != 0 else 0.0
             nu0 = freqs[k] + off / (pad * dt)
@@ -154,20 +182,20 @@ def naff(
             if any(abs(nu - m) < 0.5 / T for m in nus):
                 done = True  # the same line again: leakage floor reached
                 break
-            amp = _amplitude(resid, t, w, nu)
+            amp, line = _fit(resid, w, nu, dt, real)
             nus.append(nu)
             cs.append(amp)
-            resid = resid - _line(t, nu, amp, real)
+            resid = resid - line
     if polish:
         # Each line again on the residual plus itself: the leakage of lines
         # found after it no longer pulls it.
         for i, nu in enumerate(nus):
-            own = resid + _line(t, nu, cs[i], real)
+            own = resid + _fit_line(nu, cs[i], n, dt, real)
             if nu != 0.0:
                 nu = abs(refine(own * w, t, nu, T)) if real else refine(own * w, t, nu, T)
-            cs[i] = _amplitude(own, t, w, nu)
+            cs[i], line = _fit(own, w, nu, dt, real)
             nus[i] = nu
-            resid = own - _line(t, nu, cs[i], real)
+            resid = own - line
     amps = np.abs(np.array(cs))
     order = np.argsort(-amps)
     return np.array(nus)[order], amps[order]

@@ -115,6 +115,9 @@ def test_status_names_match_the_constants():
     assert tori.STATUS_NAMES[tori.DEGENERATE_PLANE] == "degenerate plane"
     assert tori.STATUS_NAMES[tori.NO_REAL_LATTICE] == "no real lattice"
     assert tori.STATUS_NAMES[tori.SINGULAR] == "singular"
+    assert tori.STATUS_NAMES[tori.DEGENERATE_GRADIENTS] == "degenerate gradients"
+    assert tori.STATUS_NAMES[tori.INCONSISTENT_QUOTIENTS] == "inconsistent quotients"
+    assert len(tori.STATUS_NAMES) == 12
 
 
 def test_casimir_slice_keeps_h0_and_h1():

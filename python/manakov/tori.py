@@ -55,8 +55,8 @@ STATUS_NAMES: tuple[str, ...] = tuple(_core.tori_status_names())
 OK = 0
 #: ``h1² = 4 h0²``: ``F(s)`` of (19) is undefined; the level set is singular.
 SINGULAR_CASIMIRS = 1
-#: Two branch points of (8) coincide (``h0 = 0`` included): genus drops; a
-#: separatrix or a degenerate torus.
+#: Two branch points of (8) coincide (``h0 = 0`` and a repeated root of ``F``
+#: (19) included): genus drops; a separatrix or a degenerate torus.
 COINCIDING_BRANCH_POINTS = 2
 #: The divisor of the initial state has a point at infinity.
 DIVISOR_AT_INFINITY = 3
@@ -72,6 +72,13 @@ DEGENERATE_PLANE = 7
 NO_REAL_LATTICE = 8
 #: Any other refusal of the solution.
 SINGULAR = 9
+#: The theta-quotient gradients at the initial divisor do not determine the
+#: velocity ``U``.
+DEGENERATE_GRADIENTS = 10
+#: The solution's theta quotients reproduce the state but solve (1) for no
+#: velocity: its set-up is wrong there (one of the Theorem's outliers), so
+#: would its frequencies be.
+INCONSISTENT_QUOTIENTS = 11
 
 #: States per chunk without a client: the unit between progress updates and
 #: Ctrl-C checks of the Python loop (the Rust core also polls within a chunk).

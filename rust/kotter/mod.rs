@@ -28,7 +28,7 @@
 use num_complex::Complex64;
 
 use crate::curve::{CurvePoint, KotterCurve, WurzelPoints};
-use crate::error::{check_finite, Error, Result};
+use crate::error::{check_finite, Error, Result, SingularKind};
 
 type C = Complex64;
 
@@ -293,8 +293,9 @@ pub fn quartic_f(a: &[f64; 4], h: &[f64; 4]) -> Result<[f64; 5]> {
 fn quartic_f_den(a: &[f64; 4], h: &[f64; 4], den: f64) -> Result<[f64; 5]> {
     let [h0, h1, h2, h3] = *h;
     if den.abs() <= DEGENERATE_RTOL * h1 * h1 || h1 == 0.0 {
-        return Err(Error::InvalidArgument {
+        return Err(Error::Singular {
             what: "state l",
+            kind: SingularKind::SelfDual,
             reason: format!(
                 "h1^2 - 4 h0^2 = {den:e} vanishes (h1 = {h1}, h0 = {h0}; the state is \
                  self-dual or anti-self-dual, m = +-n): F(s) (19) is not defined"
@@ -403,8 +404,9 @@ fn check_repeated(z: &[C]) -> Result<()> {
         for j in (i + 1)..z.len() {
             let pair = z[i].norm().max(z[j].norm());
             if (z[i] - z[j]).norm() <= REPEATED_ROOT_RTOL * pair {
-                return Err(Error::InvalidArgument {
+                return Err(Error::Singular {
                     what: "state l",
+                    kind: SingularKind::RepeatedRoot,
                     reason: format!(
                         "F(s) (19) has a repeated root s = {} (|s_{} - s_{}| = {:e}): l^(p) (20) \
                          divides by sqrt(F'(s_p)) = 0",
@@ -778,8 +780,9 @@ fn constants_impl(
     };
     let f = quartic_f_den(a, h, den)?;
     if h[0] == 0.0 || h[0].abs() <= DEGENERATE_RTOL * h[1] {
-        return Err(Error::InvalidArgument {
+        return Err(Error::Singular {
             what: "state l",
+            kind: SingularKind::VanishingH0,
             reason: format!(
                 "h0 = {} vanishes: F(s) (19) = (h1 s^2 - h2 s + h3)^2 / h1^2 has double roots and \
                  the branch sigma = -(h1 s^2 - h2 s + h3)/(2 h0) is undefined",
@@ -831,8 +834,9 @@ fn constants_impl(
             // the offsets are accurate to a few ulps relative (root_offsets):
             // only a root indistinguishable from a_j in double precision is 0/0
             if diff[j].norm() <= 4.0 * f64::EPSILON * scale_a {
-                return Err(Error::InvalidArgument {
+                return Err(Error::Singular {
                     what: "state l",
+                    kind: SingularKind::CoincidingBranchPoints,
                     reason: format!(
                         "the root s_{} = {} of F (19) coincides with a_{} = {aj}: sqrt(s_kl) = \
                          sqrt(G)/sqrt(s_j4) is 0/0 there",

@@ -76,13 +76,19 @@ fn degenerate_inputs_are_errors() {
     assert_eq!(m, n);
     assert!(matches!(
         kotter_constants(&A, &sd),
-        Err(Error::InvalidArgument { .. })
+        Err(Error::Singular {
+            kind: SingularKind::SelfDual,
+            ..
+        })
     ));
     // h0 = 0
     let z = [1.0, 0.0, 0.0, 0.0, 0.0, 0.0];
     assert!(matches!(
         kotter_constants(&A, &z),
-        Err(Error::InvalidArgument { .. })
+        Err(Error::Singular {
+            kind: SingularKind::VanishingH0,
+            ..
+        })
     ));
     assert!(matches!(
         kotter_constants(&[1.0, 1.0, 2.0, 3.0], &L0),

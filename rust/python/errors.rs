@@ -26,6 +26,7 @@ impl From<Error> for PyErr {
             | Error::NotSymmetric { .. }
             | Error::ImagNotPositiveDefinite { .. }
             | Error::RepeatedBranchPoints { .. }
+            | Error::Singular { .. }
             | Error::InvalidArgument { .. } => PyValueError::new_err(msg),
         }
     }

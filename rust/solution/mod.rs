@@ -102,8 +102,26 @@ pub struct Solution {
 }
 
 fn singular(reason: String) -> Error {
-    Error::InvalidArgument {
+    // The kind from the opening words of the four messages of `new` (this
+    // file writes them all, and rust/tori/tests.rs checks each kind); anything
+    // else stays an invalid argument.
+    let kind = if reason.starts_with("l0 = 0") {
+        crate::error::SingularKind::ZeroState
+    } else if reason.starts_with("h0 = ") {
+        crate::error::SingularKind::VanishingH0
+    } else if reason.starts_with("h1^2 - 4 h0^2") {
+        crate::error::SingularKind::SelfDual
+    } else if reason.starts_with("the divisor of l0 contains the point at infinity") {
+        crate::error::SingularKind::DivisorAtInfinity
+    } else {
+        return Error::InvalidArgument {
+            what: "state l0",
+            reason,
+        };
+    };
+    Error::Singular {
         what: "state l0",
+        kind,
         reason,
     }
 }
@@ -326,8 +344,9 @@ impl Solution {
         let svd = amat.clone().svd(true, true);
         let sv = &svd.singular_values;
         if sv[1].is_nan() || sv[1] <= 1e-12 * sv[0] {
-            return Err(Error::InvalidArgument {
+            return Err(Error::Singular {
                 what: "state l0",
+                kind: crate::error::SingularKind::DegenerateGradients,
                 reason: format!(
                     "the theta-quotient gradients at v0 are degenerate (singular values {:e}, {:e}): \
                      U is not determined",
@@ -586,7 +605,7 @@ fn eps41(k: &KotterConstants) -> C {
 }
 
 fn coinciding(i: usize, j: usize, value: C) -> Error {
-    singular(format!(
+    let reason = format!(
         "branch points d{i} and d{j} of the curve (8) coincide (= {value}){}: the genus drops, \
          the motion is degenerate (the solution exists as a limit in lower-genus functions)",
         if i == 0 || j == 0 {
@@ -594,7 +613,12 @@ fn coinciding(i: usize, j: usize, value: C) -> Error {
         } else {
             ""
         }
-    ))
+    );
+    Error::Singular {
+        what: "state l0",
+        kind: crate::error::SingularKind::CoincidingBranchPoints,
+        reason,
+    }
 }
 
 /// Relative agreement of two estimates of the `C_L²` that counts as a vote

@@ -454,8 +454,8 @@ pub enum Status {
     Ok = 0,
     /// `h1² = 4 h0²`: `F(s)` of (19) is undefined (the level set is singular).
     SingularCasimirs = 1,
-    /// Two branch points `d_j` of (8) coincide (`h0 = 0` included): the genus drops,
-    /// a separatrix or a degenerate torus.
+    /// Two branch points `d_j` of (8) coincide (`h0 = 0` and a repeated root of
+    /// `F` (19) included): the genus drops, a separatrix or a degenerate torus.
     CoincidingBranchPoints = 2,
     /// The divisor of the initial state has a point at infinity.
     DivisorAtInfinity = 3,
@@ -471,10 +471,16 @@ pub enum Status {
     NoRealLattice = 8,
     /// Any other refusal of the solution (its message names the reason).
     Singular = 9,
+    /// The theta-quotient gradients at `v0` do not determine the velocity `U`.
+    DegenerateGradients = 10,
+    /// The solution's theta quotients reproduce `l0` but solve Frahm's
+    /// equations (1) at `v0` for no velocity: its set-up is wrong at this
+    /// state (one of the Theorem's outliers), so are its frequencies.
+    InconsistentQuotients = 11,
 }
 
 /// Short names of the status codes, indexed by code.
-pub const STATUS_NAMES: [&str; 10] = [
+pub const STATUS_NAMES: [&str; 12] = [
     "ok",
     "h1^2 = 4 h0^2",
     "coinciding branch points",
@@ -485,6 +491,8 @@ pub const STATUS_NAMES: [&str; 10] = [
     "degenerate plane",
     "no real lattice",
     "singular",
+    "degenerate gradients",
+    "inconsistent quotients",
 ];
 
 impl From<TorusFailure> for Status {

@@ -360,8 +360,12 @@ fn state_statuses_and_nan_policy() {
 }
 
 mod on_the_solution {
-    use super::super::solve::{c_pairs, flow_data, rate_for, state_frequencies, torus_of_state};
+    use super::super::solve::{
+        c_pairs, classify, flow_data, rate_for, state_frequencies, torus_of_state, velocities,
+        QUOTIENT_RESIDUAL_RTOL,
+    };
     use super::super::*;
+    use crate::error::SingularKind;
     use crate::solution::Solution;
 
     const GENERIC: ([f64; 4], [f64; 4], [f64; 6]) = (
@@ -467,5 +471,155 @@ mod on_the_solution {
         assert!(e.nu.iter().all(|v| v.is_nan()));
         let e = state_frequencies(&a, &b, &[0.3, -0.2, 0.5, 0.5, 0.2, 0.3]);
         assert_eq!(e.status, Status::SingularCasimirs);
+        // A double root of F (19) (l12, l34 only): a separatrix.
+        let e = state_frequencies(&a, &b, &[1.0, 0.0, 0.0, 0.0, 0.0, 0.5]);
+        assert_eq!(e.status, Status::CoincidingBranchPoints);
+    }
+
+    fn kind_of(e: Error) -> (&'static str, SingularKind) {
+        match e {
+            Error::Singular { what, kind, .. } => (what, kind),
+            other => panic!("not a Singular error: {other}"),
+        }
+    }
+
+    #[test]
+    fn refusals_of_the_solution_carry_their_kind() {
+        let (a, b, _) = GENERIC;
+        let new = |l0: [f64; 6]| kind_of(Solution::new(&a, &b, &l0).map(|_| ()).unwrap_err());
+        assert_eq!(new([0.0; 6]), ("state l0", SingularKind::ZeroState));
+        assert_eq!(
+            new([1.0, 0.0, 0.0, 0.0, 0.5, 0.0]),
+            ("state l0", SingularKind::VanishingH0)
+        );
+        // m = n: the solution's own check, before the reduction's.
+        assert_eq!(
+            new([0.3, -0.2, 0.5, 0.5, 0.2, 0.3]),
+            ("state l0", SingularKind::SelfDual)
+        );
+        // h0 just above the solution's threshold, within the reduction's.
+        assert_eq!(
+            new([1.0, 0.0, 0.0, 0.0, 0.0, 1e-12]),
+            ("state l", SingularKind::VanishingH0)
+        );
+        assert_eq!(
+            new([1.0, 0.0, 0.0, 0.0, 0.0, 0.5]),
+            ("state l", SingularKind::RepeatedRoot)
+        );
+    }
+
+    #[test]
+    fn every_kind_has_its_status() {
+        // Written out, so that a new kind or a changed code shows here.
+        let table = [
+            (SingularKind::ZeroState, Status::ZeroState),
+            (SingularKind::VanishingH0, Status::CoincidingBranchPoints),
+            (SingularKind::SelfDual, Status::SingularCasimirs),
+            (
+                SingularKind::CoincidingBranchPoints,
+                Status::CoincidingBranchPoints,
+            ),
+            (SingularKind::RepeatedRoot, Status::CoincidingBranchPoints),
+            (SingularKind::DivisorAtInfinity, Status::DivisorAtInfinity),
+            (
+                SingularKind::DegenerateGradients,
+                Status::DegenerateGradients,
+            ),
+        ];
+        for (kind, status) in table {
+            let e = Error::Singular {
+                what: "state l0",
+                kind,
+                reason: String::new(),
+            };
+            assert_eq!(classify(&e), status, "{kind:?}");
+        }
+        let other = Error::InvalidArgument {
+            what: "state l",
+            reason: "h0 = 0 coincide infinity".into(),
+        };
+        let inconsistent = Error::InvalidArgument {
+            what: super::super::solve::INCONSISTENT,
+            reason: String::new(),
+        };
+        assert_eq!(classify(&inconsistent), Status::InconsistentQuotients);
+        // The message no longer decides the code.
+        assert_eq!(classify(&other), Status::Singular);
+        assert_eq!(
+            classify(&Error::NoConvergence {
+                what: "x",
+                tol: 0.0,
+                reached: 1.0,
+                iterations: 1
+            }),
+            Status::NoConvergence
+        );
+    }
+
+    /// The four shared tops (/work/shared/reference/problems.json).
+    const SHARED: [([f64; 4], [f64; 4], [f64; 6]); 4] = [
+        GENERIC,
+        (
+            [1.0, 2.25, 4.84, 9.61],
+            [1.0, 1.5, 2.2, 3.1],
+            [0.4, 1.2, -0.6, 0.9, 0.3, -1.0],
+        ),
+        (
+            [0.01, 1.0, 10.0, 100.0],
+            [2.0, -1.0, 0.5, 3.0],
+            [1.0, 0.5, -0.25, 0.75, -1.5, 0.1],
+        ),
+        (
+            [1.0, 1.000001, 2.0, 3.0],
+            [0.3, 0.300002, -0.4, 1.2],
+            [0.2, -0.9, 0.4, 0.6, 1.1, -0.3],
+        ),
+    ];
+
+    #[test]
+    fn consistent_set_ups_fit_both_flows() {
+        for (a, b, l0) in SHARED {
+            let s = Solution::new(&a, &b, &l0).unwrap();
+            let c2 = c_pairs(&a, &second_flow_b(&a, &b)).unwrap();
+            let fits = velocities(&s, &[*s.c4(), c2]).unwrap();
+            for (_, res) in &fits {
+                assert!(*res <= 1e-3 * QUOTIENT_RESIDUAL_RTOL, "a = {a:?}: {res:e}");
+            }
+        }
+    }
+
+    #[test]
+    fn an_inconsistent_set_up_is_refused_not_mapped() {
+        // State 14 of tests/data/tori_naff_random100.py (seed 1313): `solve`
+        // returns l(0) = l0 (calibration 4e-14) but l'(0) off by 300 %, and
+        // the integration's spectral lines miss its ν by 2e-2. No velocity
+        // makes the quotients solve (1) at v0 (residual ~0.2).
+        let a = [
+            0.6262672408286707,
+            1.1558542100739666,
+            3.9251780045549682,
+            4.5883259242255034,
+        ];
+        let b = [
+            -0.05178024146863031,
+            -0.42179480568224204,
+            -0.1045833884785173,
+            -0.5348591116146967,
+        ];
+        let l0 = [
+            -0.7041138736314696,
+            0.538991160465901,
+            -0.27246109242831956,
+            0.26712289621603547,
+            1.7213065155493528,
+            -0.22470690403864946,
+        ];
+        let s = Solution::new(&a, &b, &l0).unwrap();
+        let fits = velocities(&s, &[*s.c4()]).unwrap();
+        assert!(fits[0].1 > 1e-2, "{:e}", fits[0].1);
+        let e = state_frequencies(&a, &b, &l0);
+        assert_eq!(e.status, Status::InconsistentQuotients);
+        assert!(e.nu.iter().all(|v| v.is_nan()));
+        assert!(torus_of_state(&a, &b, &l0).is_err());
     }
 }
