@@ -259,40 +259,33 @@ def test_singular_states_raise_the_same_text_and_get_their_code(l0, text, code):
     assert np.isnan(fm.nu).all()
 
 
-# Integration error of sol.l over [0, 20] (relative to |l0|) that marks the
-# Theorem's O(1) outliers (docs/theorem.md: 1.4 … 18 on the seed-7 draw) and
-# that solutions with status ok stay below (99.4 % of that draw reach 1e-6,
-# the remaining 0.6 % are the outliers).
-OUTLIER_MIN = 1e-2
+# Integration error of sol.l over [0, 20] (relative to |l0|) that solutions with
+# status ok stay below (issue 10 asks 1e-10 of 99.9 %; the seed-7 draw's worst is 1.1e-9).
 OK_MAX = 1e-6
 
 
-def test_inconsistent_quotients_flag_the_theorems_outliers():
-    # The draw of tests/data/theorem_random_stats.py (seed 7): its first 300
-    # states hold two of the six outliers listed in docs/theorem.md (39, 281).
+def test_former_outliers_map_with_status_ok():
+    # The draw of tests/data/theorem_random_stats.py (seed 7): its first 300 states
+    # hold two of the six states that were O(1) wrong (39, 281; the wrong
+    # combination of (41), docs/errata.md). The velocity-fit guard of `solve`
+    # (status INCONSISTENT_QUOTIENTS) flagged exactly those six before the fix;
+    # now every state maps with status ok and the sampled ones match integration.
     rng = np.random.default_rng(7)
-    flagged = []
     t = np.linspace(0.0, 20.0, 41)
     for i in range(300):
         a = np.sort(rng.uniform(0.0, 5.0, 4))
         b = rng.normal(size=4)
         l0 = rng.normal(size=6)
         top = manakov.ManakovTop(a, b)
-        code = int(tori.frequency_map(top, l0).status)
-        assert code in (tori.OK, tori.INCONSISTENT_QUOTIENTS), (i, code)
-        if code == tori.OK and i % 10:
+        fm = tori.frequency_map(top, l0)
+        assert int(fm.status) == tori.OK, (i, int(fm.status))
+        assert np.isfinite(fm.nu).all()
+        if i % 10 and i not in (39, 281):
             continue
         sol = top.solve(l0)
         l_int = top.integrate(l0, 20.0, t_eval=t, dt=2e-3).l
         err = np.max(np.abs(sol.l(t) - l_int)) / np.linalg.norm(l0)
-        if code == tori.OK:
-            assert err <= OK_MAX, (i, err)
-        else:
-            assert err >= OUTLIER_MIN, (i, err)
-            with pytest.raises(ValueError, match="for no velocity"):
-                sol.frequencies  # noqa: B018
-            flagged.append(i)
-    assert flagged == [39, 281]
+        assert err <= OK_MAX, (i, err)
 
 
 @pytest.fixture(scope="module")

@@ -365,6 +365,7 @@ impl Solution {
                 index: 0,
             });
         }
+        check_velocity_fit(&amat, &rhs, &rate)?;
         let (x0, y0) = curve.lattice_coordinates(&v0);
         let (xr, yr) = curve.lattice_coordinates(&rate);
         Ok(Solution {
@@ -582,6 +583,42 @@ impl Solution {
         self.l_batch(&[t], &mut out, &Cancel::never())?;
         Ok(out)
     }
+}
+
+/// Relative least-squares residual of the velocity equations
+/// `(∇N_q − l_q ∇D)·U = l̇_q D` above which the theta quotients at `v0` solve
+/// Frahm's equations (1) for no velocity: the set-up is wrong, and the
+/// solution is refused rather than returned. Consistent set-ups leave ~1e-13
+/// (≤ 1e-10 on near_degenerate); the set-ups that took the wrong combination
+/// of (41) left 1e-2 … 1.
+pub const QUOTIENT_RESIDUAL_RTOL: f64 = 1e-6;
+
+/// `what` of the error for quotients that solve (1) for no velocity.
+pub const INCONSISTENT: &str = "theta quotients at v0";
+
+/// `|A U − r| / |r|` (Euclidean norms).
+pub fn velocity_residual(amat: &DMatrix<C>, rhs: &DVector<C>, rate: &[C; 2]) -> f64 {
+    let u = DVector::from_column_slice(rate);
+    let r = amat * u - rhs;
+    r.norm() / rhs.norm().max(f64::MIN_POSITIVE)
+}
+
+/// Refuses a set-up whose quotients fit (1) for no velocity
+/// ([`QUOTIENT_RESIDUAL_RTOL`]): a guard against a wrong constant or branch,
+/// which reproduces `l0` at `t = 0` and is O(1) wrong later.
+fn check_velocity_fit(amat: &DMatrix<C>, rhs: &DVector<C>, rate: &[C; 2]) -> Result<()> {
+    let res = velocity_residual(amat, rhs, rate);
+    if res.is_nan() || res > QUOTIENT_RESIDUAL_RTOL {
+        return Err(Error::InvalidArgument {
+            what: INCONSISTENT,
+            reason: format!(
+                "the theta quotients (9)-(10) at v0 satisfy Frahm's equations (1) for no \
+                 velocity (least-squares residual {res:e} > {QUOTIENT_RESIDUAL_RTOL:e}): a \
+                 constant or branch of the set-up is wrong at this state; please report it"
+            ),
+        });
+    }
+    Ok(())
 }
 
 /// `ε` by the corrected (41), in root differences of `F`: with

@@ -86,3 +86,33 @@ fn phase_reduction_is_exact_for_large_t() {
     ex -= 2.0 * (0.5 * ex).round();
     assert!((r - ex).abs() <= 4.0 * f64::EPSILON, "{r} vs {ex}");
 }
+
+/// The guard of `Solution::new`: a velocity system with an exact solution
+/// passes, the same system with a right-hand side no velocity reaches is
+/// refused with the documented `what`.
+#[test]
+fn velocity_fit_guard_refuses_an_inconsistent_system() {
+    let amat = DMatrix::<C>::from_fn(6, 2, |i, k| {
+        C::new(
+            (1.3 * i as f64 + 0.7 * k as f64).sin(),
+            (0.4 * i as f64 - k as f64).cos(),
+        )
+    });
+    let u = [C::new(0.3, -1.2), C::new(2.0, 0.5)];
+    let rhs = &amat * DVector::from_column_slice(&u);
+    assert!(velocity_residual(&amat, &rhs, &u) <= 1e-15);
+    assert!(check_velocity_fit(&amat, &rhs, &u).is_ok());
+    let mut bad = rhs.clone();
+    let kick = 0.2 * bad.norm();
+    bad[3] += C::new(kick, 0.0);
+    let fit = amat.clone().svd(true, true).solve(&bad, 0.0).unwrap();
+    let v = [fit[0], fit[1]];
+    assert!(velocity_residual(&amat, &bad, &v) > 1e-2);
+    match check_velocity_fit(&amat, &bad, &v) {
+        Err(Error::InvalidArgument { what, reason }) => {
+            assert_eq!(what, INCONSISTENT);
+            assert!(reason.contains("for no velocity"), "{reason}");
+        }
+        other => panic!("{other:?}"),
+    }
+}

@@ -100,16 +100,7 @@ pub fn rate_for(sol: &Solution, c4: &[f64; 6]) -> Result<[C; 2]> {
     Ok(velocities(sol, &[*c4])?[0].0)
 }
 
-/// Least-squares residual of the velocity equations (relative to the
-/// right-hand side) above which the theta quotients at `v0` are not a
-/// solution of (1) for any velocity. Consistent set-ups leave ~1e-13 (the
-/// four shared tops and random states; ≤ 1e-10 on 'near_degenerate'); the
-/// Theorem's silent O(1) outliers leave 1e-2 … 1 (docs/tori.md §3).
-pub const QUOTIENT_RESIDUAL_RTOL: f64 = 1e-6;
-
-/// `what` of the error for quotients that solve (1) for no velocity (the
-/// status [`Status::InconsistentQuotients`]).
-pub const INCONSISTENT: &str = "theta quotients at v0";
+pub use crate::solution::{INCONSISTENT, QUOTIENT_RESIDUAL_RTOL};
 
 /// The velocities of the flows with coefficients `c4s` on the level set of
 /// `sol` (see [`rate_for`]), one SVD for all, each with the relative
