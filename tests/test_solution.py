@@ -24,6 +24,7 @@ AFFINE_TOL = 1e-12
 #: Slope of the unwrapped Abel image against U, relative.
 SLOPE_RTOL = 1e-12
 
+
 def _params() -> list:
     return ["generic", "physical", "wide", "near_degenerate"]
 
