@@ -16,6 +16,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from former_outliers import EPS41_OTHER_COMBINATION
 
 import manakov
 from manakov.reduction import integrals, lax_pair, quartic, schottky
@@ -1310,37 +1311,6 @@ def _eps41_miss(k):
     x = k.eps * sd4 * Z
     return min(abs(x - s * c) / abs(c) for c in (Y - W, Y + W) for s in (1, -1))
 
-
-# States (a, b, l0; random draws rounded to 8 digits) on which the principal roots put
-# (41) on the wrong combination: (Y - W)/(sqrt(d4) Z) is -1/(d4 eps), not eps. The
-# Theorem used it and missed l(t) by O(1) on them (docs/errata.md, (41)).
-EPS41_OTHER_COMBINATION = [
-    (
-        [0.67857252, 0.69018944, 2.20666098, 3.19911628],
-        [-0.42431727, -0.37360366, -0.97653947, -0.26970037],
-        [-0.5526118, 0.09168539, -1.20413609, 0.23558991, 0.14321889, -0.14156283],
-    ),
-    (
-        [0.76257605, 1.00026768, 2.65899715, 3.36925527],
-        [-0.50114247, 1.28818065, -0.97169328, -1.80144402],
-        [0.40624016, -1.14133321, -0.43946639, 0.91158338, -0.81859642, 0.87845007],
-    ),
-    (
-        [0.85359824, 1.13156652, 2.25734074, 3.36894218],
-        [-0.35938362, 1.03892905, -0.17431921, 0.62563913],
-        [0.52832656, -0.35317268, -1.55974593, 0.98540004, 0.17070737, 0.98328009],
-    ),
-    (
-        [0.16277668, 2.79800583, 4.41355577, 4.89865903],
-        [-0.08120495, -0.25076279, 1.33640278, 0.14022409],
-        [-1.72063781, 1.95472225, 0.82352591, -1.01678797, -0.33283224, -0.84466312],
-    ),
-    (
-        [2.12832325, 2.1420552, 3.7714064, 4.01105591],
-        [1.32365651, -0.99463288, -0.98129209, -1.43287496],
-        [-0.5451466, 1.76892262, -0.07498256, 0.16611991, 2.12676488, -0.62767709],
-    ),
-]
 
 #: Principal roots on the wrong combination miss eps by O(1): the two differ by the
 #: factor -d4 eps^2, here 1e-3 .. 1e3, so the miss is at least half of |eps|.
