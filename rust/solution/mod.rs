@@ -36,7 +36,7 @@ use rayon::prelude::*;
 
 use crate::cancel::Cancel;
 use crate::curve::{sqrt_principal, KotterCurve, CYCLIC};
-use crate::error::{Error, Result};
+use crate::error::{Error, Result, SingularKind};
 use crate::kotter::{kotter_constants, kotter_with, KotterConstants, KotterState};
 use crate::riemann::HyperellipticCurve;
 use crate::so4;
@@ -101,24 +101,7 @@ pub struct Solution {
     calibration: [f64; 7],
 }
 
-fn singular(reason: String) -> Error {
-    // The kind from the opening words of the four messages of `new` (this
-    // file writes them all, and rust/tori/tests.rs checks each kind); anything
-    // else stays an invalid argument.
-    let kind = if reason.starts_with("l0 = 0") {
-        crate::error::SingularKind::ZeroState
-    } else if reason.starts_with("h0 = ") {
-        crate::error::SingularKind::VanishingH0
-    } else if reason.starts_with("h1^2 - 4 h0^2") {
-        crate::error::SingularKind::SelfDual
-    } else if reason.starts_with("the divisor of l0 contains the point at infinity") {
-        crate::error::SingularKind::DivisorAtInfinity
-    } else {
-        return Error::InvalidArgument {
-            what: "state l0",
-            reason,
-        };
-    };
+fn singular(kind: SingularKind, reason: String) -> Error {
     Error::Singular {
         what: "state l0",
         kind,
@@ -150,26 +133,33 @@ impl Solution {
         let size = l0.iter().fold(0.0f64, |m, v| m.max(v.abs()));
         if size == 0.0 {
             return Err(singular(
+                SingularKind::ZeroState,
                 "l0 = 0: the rest state; the solution is l(t) = 0, there is no curve (8)".into(),
             ));
         }
         let h = so4::integrals4(a, l0);
         let s2 = size * size;
         if h[0].abs() <= DEGENERATE_RTOL * s2 {
-            return Err(singular(format!(
+            return Err(singular(
+                SingularKind::VanishingH0,
+                format!(
                 "h0 = {:e} vanishes: the branch points d_0 = 0 and d_j coincide (F (19) has double \
                  roots), the curve (8) degenerates; the solution exists in a limiting sense \
                  (genus < 2, elementary functions), not as a genus-2 theta quotient",
                 h[0]
-            )));
+            ),
+            ));
         }
         let disc = h[1] * h[1] - 4.0 * h[0] * h[0];
         if disc.abs() <= DEGENERATE_RTOL * (h[1] * h[1] + 4.0 * h[0] * h[0]) {
-            return Err(singular(format!(
-                "h1^2 - 4 h0^2 = {disc:e} vanishes (m = ±n, a self-dual state): F (19) is not \
+            return Err(singular(
+                SingularKind::SelfDual,
+                format!(
+                    "h1^2 - 4 h0^2 = {disc:e} vanishes (m = ±n, a self-dual state): F (19) is not \
                  defined; the motion reduces to an so(3) top (elliptic functions), the \
                  genus-2 solution exists only as a limit"
-            )));
+                ),
+            ));
         }
         let kotter = kotter_constants(a, l0).map_err(|e| match e {
             Error::RepeatedBranchPoints { i, j, value } => coinciding(i, j, value),
@@ -231,12 +221,15 @@ impl Solution {
         let big = jet.values.iter().fold(0.0f64, |m, v| m.max(v.norm()));
         let th0 = jet.values[idx[0]];
         if th0.norm() <= DIVISOR_AT_INFINITY_RTOL * big {
-            return Err(singular(format!(
-                "the divisor of l0 contains the point at infinity of the curve (8) \
+            return Err(singular(
+                SingularKind::DivisorAtInfinity,
+                format!(
+                    "the divisor of l0 contains the point at infinity of the curve (8) \
                  (|theta(v0)| = {:e} of max |theta[chi](v0)|): the P_L (34) have poles there; \
                  the solution exists (take l0 at another time of the same trajectory)",
-                th0.norm() / big
-            )));
+                    th0.norm() / big
+                ),
+            ));
         }
 
         // P_L at l0 in the branch of the reduction: (37) inverted, P_0 from (31b).
@@ -346,7 +339,7 @@ impl Solution {
         if sv[1].is_nan() || sv[1] <= 1e-12 * sv[0] {
             return Err(Error::Singular {
                 what: "state l0",
-                kind: crate::error::SingularKind::DegenerateGradients,
+                kind: SingularKind::DegenerateGradients,
                 reason: format!(
                     "the theta-quotient gradients at v0 are degenerate (singular values {:e}, {:e}): \
                      U is not determined",
@@ -653,7 +646,7 @@ fn coinciding(i: usize, j: usize, value: C) -> Error {
     );
     Error::Singular {
         what: "state l0",
-        kind: crate::error::SingularKind::CoincidingBranchPoints,
+        kind: SingularKind::CoincidingBranchPoints,
         reason,
     }
 }
