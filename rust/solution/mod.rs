@@ -414,6 +414,12 @@ impl Solution {
         &self.curve
     }
 
+    /// The theta plan of `τ` (first derivatives, serial), shared with
+    /// callers that evaluate the quotients themselves.
+    pub fn plan(&self) -> &ThetaPlan {
+        &self.plan
+    }
+
     /// `τ`, row-major.
     pub fn tau(&self) -> [C; 4] {
         self.tau

@@ -9,7 +9,6 @@ use super::{
 use crate::error::{Error, Result, SingularKind};
 use crate::so4;
 use crate::solution::Solution;
-use crate::theta::ThetaPlan;
 
 /// The six `c_ij` (`i < j`, state order) of `ManakovTop(a, b)` (2).
 pub fn c_pairs(a: &[f64; 4], b: &[f64; 4]) -> Result<[f64; 6]> {
@@ -85,10 +84,6 @@ pub fn state_frequencies(a: &[f64; 4], b: &[f64; 4], l0: &[f64; 6]) -> MapEntry 
     )
 }
 
-/// Truncation tolerance of the theta sums for the gradients at `v0` (the
-/// solution's own tolerance).
-const THETA_TOL: f64 = crate::solution::THETA_TOL;
-
 /// The velocity `U'` of the flow of the Manakov top with coefficients `c4'`
 /// on the level set of `sol`, without a second solution: `l_q = Re(N_q/D)`
 /// (9)–(10) and `d l_q/dt = (∇N_q − l_q ∇D)·U' / D` at `v0` with `l̇` from
@@ -107,8 +102,7 @@ pub use crate::solution::{INCONSISTENT, QUOTIENT_RESIDUAL_RTOL};
 /// residual of its least-squares fit.
 pub fn velocities(sol: &Solution, c4s: &[[f64; 6]]) -> Result<Vec<([C; 2], f64)>> {
     let (idx, num, den) = sol.quotient();
-    let t = sol.tau();
-    let plan = ThetaPlan::new(&t, 2, THETA_TOL, 1)?.with_parallel(false);
+    let plan = sol.plan();
     let (u0, rc) = (sol.u0(), sol.riemann_constant());
     let v0 = [u0[0] + rc[0], u0[1] + rc[1]];
     let jet = plan.jet(&v0, 1)?;
