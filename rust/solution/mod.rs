@@ -40,7 +40,7 @@ use crate::error::{Error, Result, SingularKind};
 use crate::kotter::{kotter_constants, kotter_with, KotterConstants, KotterState};
 use crate::riemann::HyperellipticCurve;
 use crate::so4;
-use crate::theta::{char_index, SelectedBlock, ThetaPlan};
+use crate::theta::{char_index, SelectedBlock, ThetaJet, ThetaPlan};
 
 type C = Complex64;
 
@@ -232,11 +232,9 @@ impl Solution {
             ));
         }
 
-        // P_L at l0 in the branch of the reduction: (37) inverted, P_0 from (31b).
+        // P_L at l0 in the branch of the reduction: (37) inverted with the
+        // reduction's g ((30a), sign fixed by the corrected (42)), P_0 from (31b).
         let sc = state0.curve.c().map(sqrt_principal);
-        // g from (30a) (the reduction's inverse map, sign fixed by the corrected
-        // (42)); G = g (1 − ε P_0) is the constant of the corrected (42), here
-        // without the closed form of K (which cancels by ~1/|d_j − d_k|²).
         let eps = eps41(&kotter);
         let g = state0.points.g;
         let mut p_at0 = [C::new(0.0, 0.0); 7];
@@ -245,25 +243,20 @@ impl Solution {
             p_at0[1 + j] = state0.xi[j] / (sc[j] * g);
             p_at0[4 + j] = state0.eta[j] / (sc[j] * g);
         }
-        // C_L² at a well-conditioned auxiliary divisor, sign from l0.
-        // The estimate at v0 votes too, unless a θ[χ_L](v0) is too small to divide by.
+        // C_L² by consensus of auxiliary divisors, in which the estimate at v0
+        // votes unless a θ[χ_L](v0) is too small to divide by; the sign from l0.
+        let est: [C; 7] = std::array::from_fn(|m| p_at0[m] * th0 / jet.values[idx[m + 1]]);
         let qv0 = idx
             .iter()
             .map(|&i| jet.values[i].norm() / big)
             .fold(f64::INFINITY, f64::min);
-        let est0 = (qv0 > AUX_V0_MIN).then(|| {
-            std::array::from_fn(|m| {
-                let r = p_at0[m] * th0 / jet.values[idx[m + 1]];
-                r * r
-            })
-        });
+        let est0 = (qv0 > AUX_V0_MIN).then(|| est.map(|r| r * r));
         let c2 = aux_constants_squared(&curve, &state0.curve, &plan, &idx, &rc, est0)?;
         let mut cl = [C::new(0.0, 0.0); 7];
         let mut calibration = [0.0; 7];
         for m in 0..7 {
-            let est = p_at0[m] * th0 / jet.values[idx[m + 1]];
             let root = sqrt_principal(c2[m]);
-            let (plus, minus) = ((est - root).norm(), (est + root).norm());
+            let (plus, minus) = ((est[m] - root).norm(), (est[m] + root).norm());
             cl[m] = if plus <= minus { root } else { -root };
             calibration[m] = plus.min(minus) / root.norm();
         }
@@ -308,57 +301,10 @@ impl Solution {
         // l = (m3, −m2, n1, m1, n2, n3)
         let num = [mw[2], neg(mw[1]), nw[0], mw[0], nw[1], nw[2]];
 
-        // U from (1): l_q = N_q(v)/D(v) gives (∇N_q − l_q ∇D)·U = l̇_q D at v0,
-        // six equations for the two components of U, solved by least squares.
-        // The rows are the components of l itself, unscaled (they share the
-        // scale |l|): on tops with a nearly symmetric pair a_i ≈ a_j (|U| ~ 100)
-        // this keeps U to ~1e-14, where rows in ξ, η scaled to unit size lost
-        // up to 1e-12 of U (1e-9 of l at t = 20).
-        let theta = |m: usize| jet.values[idx[m]];
-        let grad = |m: usize, k: usize| jet.gradient[idx[m] * 2 + k];
-        let dval: C = (0..8).map(|m| den[m] * theta(m)).sum();
-        let dgrad: [C; 2] = std::array::from_fn(|k| (0..8).map(|m| den[m] * grad(m, k)).sum());
-        let lq: [C; 6] =
-            std::array::from_fn(|q| (0..8).map(|m| num[q][m] * theta(m)).sum::<C>() / dval);
-        // l̇ of (1) at the quotient's own value at v0 (it differs from l0 by the
-        // rounding of the constants, ~1e-13): U is then the exact rate of the
-        // theta quotient's flow, consistent to roundoff (with l0 in its place,
-        // U missed by up to 1e-13 relative on the fast tops).
-        let ldot = so4::vector_field4(&c4, &lq.map(|z| z.re));
-        let mut amat = DMatrix::<C>::zeros(6, 2);
-        let mut rhs = DVector::<C>::zeros(6);
-        for (q, w) in num.iter().enumerate() {
-            for k in 0..2 {
-                let ng: C = (0..8).map(|m| w[m] * grad(m, k)).sum();
-                amat[(q, k)] = ng - lq[q] * dgrad[k];
-            }
-            rhs[q] = ldot[q] * dval;
-        }
-        let svd = amat.clone().svd(true, true);
-        let sv = &svd.singular_values;
-        if sv[1].is_nan() || sv[1] <= 1e-12 * sv[0] {
-            return Err(Error::Singular {
-                what: "state l0",
-                kind: SingularKind::DegenerateGradients,
-                reason: format!(
-                    "the theta-quotient gradients at v0 are degenerate (singular values {:e}, {:e}): \
-                     U is not determined",
-                    sv[0], sv[1]
-                ),
-            });
-        }
-        let sol = svd.solve(&rhs, 0.0).map_err(|e| Error::InvalidArgument {
-            what: "U",
-            reason: e.to_string(),
-        })?;
-        let rate = [sol[0], sol[1]];
-        if !(rate.iter().all(|v| v.re.is_finite() && v.im.is_finite())) {
-            return Err(Error::NonFinite {
-                what: "U",
-                index: 0,
-            });
-        }
-        check_velocity_fit(&amat, &rhs, &rate)?;
+        // U from (1) by least squares at v0 (see [`VelocitySystem`]); a set-up
+        // whose quotients fit (1) for no velocity is refused.
+        let (rate, residual) = VelocitySystem::at(&jet, &idx, &num, &den)?.rate(&c4, "U")?;
+        check_velocity_fit(residual)?;
         let (x0, y0) = curve.lattice_coordinates(&v0);
         let (xr, yr) = curve.lattice_coordinates(&rate);
         Ok(Solution {
@@ -418,6 +364,18 @@ impl Solution {
     /// callers that evaluate the quotients themselves.
     pub fn plan(&self) -> &ThetaPlan {
         &self.plan
+    }
+
+    /// The velocities on this level set of the Manakov flows with
+    /// coefficients `c4s` (state order), each with the relative residual of
+    /// its least-squares fit: the equations that give [`Solution::rate`], with
+    /// other right-hand sides (the curve, the divisor and the quotients depend
+    /// on `a` and `l0` only). For the solution's own `c4` this is `U`.
+    pub fn rates(&self, c4s: &[[f64; 6]]) -> Result<Vec<([C; 2], f64)>> {
+        let v0 = [self.u0[0] + self.rc[0], self.u0[1] + self.rc[1]];
+        let jet = self.plan.jet(&v0, 1)?;
+        let sys = VelocitySystem::at(&jet, &self.idx, &self.num, &self.den)?;
+        c4s.iter().map(|c4| sys.rate(c4, "U'")).collect()
     }
 
     /// `τ`, row-major.
@@ -490,14 +448,7 @@ impl Solution {
     /// `v(t) = v0 + U t` reduced modulo twice the lattice.
     #[inline]
     pub fn v_reduced(&self, t: f64) -> [C; 2] {
-        let x = [
-            phase_mod2(self.lat0[0], self.lat_rate[0], t),
-            phase_mod2(self.lat0[1], self.lat_rate[1], t),
-        ];
-        let y = [
-            phase_mod2(self.lat0[2], self.lat_rate[2], t),
-            phase_mod2(self.lat0[3], self.lat_rate[3], t),
-        ];
+        let (x, y) = self.lattice_reduced(t);
         [
             C::new(x[0], 0.0) + self.tau[0] * y[0] + self.tau[1] * y[1],
             C::new(x[1], 0.0) + self.tau[2] * y[0] + self.tau[3] * y[1],
@@ -595,18 +546,85 @@ pub const QUOTIENT_RESIDUAL_RTOL: f64 = 1e-6;
 /// `what` of the error for quotients that solve (1) for no velocity.
 pub const INCONSISTENT: &str = "theta quotients at v0";
 
-/// `|A U − r| / |r|` (Euclidean norms).
-pub fn velocity_residual(amat: &DMatrix<C>, rhs: &DVector<C>, rate: &[C; 2]) -> f64 {
-    let u = DVector::from_column_slice(rate);
-    let r = amat * u - rhs;
-    r.norm() / rhs.norm().max(f64::MIN_POSITIVE)
+/// The velocity equations at `v0`: `l_q = N_q(v)/D(v)` gives
+/// `(∇N_q − l_q ∇D)·U = l̇_q D`, six complex equations for `U ∈ C²`, with the
+/// gradients from the theta jet at `v0`. The rows are the components of `l`
+/// themselves, unscaled (they share the scale `|l|`), and `l̇` is (1) at the
+/// quotient's own value `l_q(v0)` (it differs from `l0` by the rounding of the
+/// constants, ~1e-13): `U` is then the rate of the theta quotient's own flow.
+/// On tops with a nearly symmetric pair `a_i ≈ a_j` (`|U|` ~ 100) this keeps
+/// `U` to ~1e-14, where rows in `ξ, η` scaled to unit size lost up to 1e-12 of
+/// `U` (1e-9 of `l` at `t = 20`).
+struct VelocitySystem {
+    amat: DMatrix<C>,
+    svd: nalgebra::SVD<C, nalgebra::Dyn, nalgebra::Dyn>,
+    lq: [f64; 6],
+    dval: C,
 }
 
-/// Refuses a set-up whose quotients fit (1) for no velocity
-/// ([`QUOTIENT_RESIDUAL_RTOL`]): a guard against a wrong constant or branch,
-/// which reproduces `l0` at `t = 0` and is O(1) wrong later.
-fn check_velocity_fit(amat: &DMatrix<C>, rhs: &DVector<C>, rate: &[C; 2]) -> Result<()> {
-    let res = velocity_residual(amat, rhs, rate);
+impl VelocitySystem {
+    /// Errors: [`SingularKind::DegenerateGradients`] when the two singular
+    /// values differ by more than 1e12 (`U` is not determined).
+    fn at(jet: &ThetaJet, idx: &[usize; 8], num: &[[C; 8]; 6], den: &[C; 8]) -> Result<Self> {
+        let theta = |m: usize| jet.values[idx[m]];
+        let grad = |m: usize, k: usize| jet.gradient[idx[m] * 2 + k];
+        let dval: C = (0..8).map(|m| den[m] * theta(m)).sum();
+        let dgrad: [C; 2] = std::array::from_fn(|k| (0..8).map(|m| den[m] * grad(m, k)).sum());
+        let lq: [C; 6] =
+            std::array::from_fn(|q| (0..8).map(|m| num[q][m] * theta(m)).sum::<C>() / dval);
+        let mut amat = DMatrix::<C>::zeros(6, 2);
+        for (q, w) in num.iter().enumerate() {
+            for k in 0..2 {
+                let ng: C = (0..8).map(|m| w[m] * grad(m, k)).sum();
+                amat[(q, k)] = ng - lq[q] * dgrad[k];
+            }
+        }
+        let svd = amat.clone().svd(true, true);
+        let sv = &svd.singular_values;
+        if sv[1].is_nan() || sv[1] <= 1e-12 * sv[0] {
+            return Err(Error::Singular {
+                what: "state l0",
+                kind: SingularKind::DegenerateGradients,
+                reason: format!(
+                    "the theta-quotient gradients at v0 are degenerate (singular values {:e}, {:e}): \
+                     U is not determined",
+                    sv[0], sv[1]
+                ),
+            });
+        }
+        Ok(VelocitySystem {
+            amat,
+            svd,
+            lq: lq.map(|z| z.re),
+            dval,
+        })
+    }
+
+    /// The velocity of the flow with coefficients `c4` and the relative
+    /// residual `|A U − r| / |r|` of its fit.
+    fn rate(&self, c4: &[f64; 6], what: &'static str) -> Result<([C; 2], f64)> {
+        let ldot = so4::vector_field4(c4, &self.lq);
+        let rhs = DVector::<C>::from_fn(6, |q, _| ldot[q] * self.dval);
+        let x = self
+            .svd
+            .solve(&rhs, 0.0)
+            .map_err(|e| Error::InvalidArgument {
+                what,
+                reason: e.to_string(),
+            })?;
+        let u = [x[0], x[1]];
+        if !u.iter().all(|v| v.re.is_finite() && v.im.is_finite()) {
+            return Err(Error::NonFinite { what, index: 0 });
+        }
+        let res = (&self.amat * &x - &rhs).norm() / rhs.norm().max(f64::MIN_POSITIVE);
+        Ok((u, res))
+    }
+}
+
+/// Refuses a set-up whose quotients fit (1) for no velocity (least-squares
+/// residual above [`QUOTIENT_RESIDUAL_RTOL`]): a guard against a wrong
+/// constant or branch, which reproduces `l0` at `t = 0` and is O(1) wrong later.
+fn check_velocity_fit(res: f64) -> Result<()> {
     if res.is_nan() || res > QUOTIENT_RESIDUAL_RTOL {
         return Err(Error::InvalidArgument {
             what: INCONSISTENT,
