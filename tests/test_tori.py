@@ -172,22 +172,6 @@ def test_no_client_does_not_import_dask():
     assert out.stdout.split() == ["False", "False"]
 
 
-@pytest.fixture(scope="module")
-def client():
-    distributed = pytest.importorskip("distributed")
-    with (
-        distributed.LocalCluster(
-            n_workers=2,
-            processes=True,
-            threads_per_worker=1,
-            dashboard_address=None,
-            silence_logs=50,
-        ) as cluster,
-        distributed.Client(cluster) as c,
-    ):
-        yield c
-
-
 def test_dask_chunks_equal_the_local_run_bit_for_bit(client):
     states = np.random.default_rng(2).normal(size=(10_000, 6))
     local = _local(states, 10_000)

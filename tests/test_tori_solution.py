@@ -288,22 +288,6 @@ def test_former_outliers_map_with_status_ok():
         assert err <= OK_MAX, (i, err)
 
 
-@pytest.fixture(scope="module")
-def client():
-    distributed = pytest.importorskip("distributed")
-    with (
-        distributed.LocalCluster(
-            n_workers=2,
-            processes=True,
-            threads_per_worker=1,
-            dashboard_address=None,
-            silence_logs=50,
-        ) as cluster,
-        distributed.Client(cluster) as c,
-    ):
-        yield c
-
-
 def _slice(n):
     p = manakov.problem("generic")
     _, _, states = tori.casimir_slice(p.l0, n)
