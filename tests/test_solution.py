@@ -58,23 +58,7 @@ def test_theorem_matches_integration_at_1e4(name: str) -> None:
     assert err <= T1E4_RTOL, err
 
 
-@pytest.mark.parametrize(
-    "name",
-    [
-        "generic",
-        "physical",
-        "wide",
-        pytest.param(
-            "near_degenerate",
-            marks=pytest.mark.xfail(
-                strict=True,
-                reason="the Abel image of states 4e-10 from a branch point of a pair 3.8e-5 "
-                "apart scatters by 1.5e-12 in lattice coordinates (reduction's points); "
-                "the drift from u0 + U t is 4e-14 over [0, 2]",
-            ),
-        ),
-    ],
-)
+@pytest.mark.parametrize("name", ["generic", "physical", "wide", "near_degenerate"])
 def test_abel_image_is_affine_with_slope_U(name: str) -> None:
     p = manakov.problem(name)
     top = manakov.ManakovTop(p.a, p.b)

@@ -31,6 +31,13 @@ PERIOD_RTOL = 1e-12
 FLOW_PERIOD_RTOL = {"near_degenerate": 1e-9}
 # l after a proper fraction λ_i/m must differ from l0 by far more than that.
 FRACTION_MIN = 1e-6
+# The frequency map's route (level set: U, U' by the chain rule at auxiliary
+# divisors) and the solution's (U from the theta quotients at v0) agree to the
+# accuracy of the reduction's constants: ~1e-15 measured on generic, physical
+# and wide; 1e-11 on near_degenerate, whose d_1, d_2 are 3.8e-5 apart (the
+# constants are conditioned like u/|d_1 - d_2|², docs/kotter.md).
+ROUTES_RTOL = {"near_degenerate": 1e-10}
+ROUTES_RTOL_DEFAULT = 1e-13
 
 
 def _top(name):
@@ -164,7 +171,7 @@ def test_solution_torus_api(name):
     np.testing.assert_allclose(sol.angles([0.0, 3.0]), [[0, 0], np.mod(3 * nu, 1)], atol=1e-14)
     fm = tori.frequency_map(top, l0)
     assert fm.status == tori.OK
-    np.testing.assert_allclose(fm.nu, nu, rtol=1e-12)
+    np.testing.assert_allclose(fm.nu, nu, rtol=ROUTES_RTOL.get(name, ROUTES_RTOL_DEFAULT))
 
 
 def test_frequency_map_shapes_and_status_codes():

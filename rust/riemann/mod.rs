@@ -488,9 +488,23 @@ impl HyperellipticCurve {
     /// `fhs`: the route's focal half sum ([`Self::branch_quality`]) if the
     /// caller has it.
     fn path_from_branch(&self, k: usize, x: C, y: C, known: Option<(&[f64], f64)>) -> Result<Row> {
+        self.path_from_branch_dx(k, x - self.e[k], y, known)
+    }
+
+    /// [`Self::path_from_branch`] with the offset `dx = x − e_k` given: near
+    /// `e_k` a double `x` fixes `dx` only to `u |x|` absolute, and the
+    /// integral (in the local parameter `√dx`) inherits `u |x| / |dx|`
+    /// relative; an offset carried separately keeps it to roundoff.
+    fn path_from_branch_dx(
+        &self,
+        k: usize,
+        dx: C,
+        y: C,
+        known: Option<(&[f64], f64)>,
+    ) -> Result<Row> {
         let n = self.e.len();
         let ek = self.e[k];
-        let dx = x - ek;
+        let x = ek + dx;
         let mut out = ZERO_ROW;
         if dx == C::new(0.0, 0.0) {
             return Ok(out);
@@ -983,6 +997,34 @@ impl HyperellipticCurve {
         let mut out = ZERO_ROW;
         self.abel_into(x, y, &mut out[..self.g])?;
         Ok(out[..self.g].to_vec())
+    }
+
+    /// The Abel map of the point `(x, y)` close to the branch point `e_k`,
+    /// given its offset `dx = x − e_k` to full relative accuracy: the
+    /// integral runs from `e_k` in the local parameter `√dx`, so the result
+    /// keeps roundoff where [`Self::abel`] of the double `x` loses
+    /// `u |x| / |x − e_k|` (u the unit roundoff). `y` picks the sheet.
+    ///
+    /// Errors: `k` out of range, non-finite input, `(e_k + dx, y)` not on the
+    /// curve.
+    pub fn abel_near_branch(&self, k: usize, dx: C, y: C) -> Result<Vec<C>> {
+        if k >= self.e.len() {
+            return Err(Error::InvalidArgument {
+                what: "branch point index",
+                reason: format!("{k} is out of range (0..{})", self.e.len()),
+            });
+        }
+        let x = self.e[k] + dx;
+        self.check_point(x, y)?;
+        let v = self.path_from_branch_dx(k, dx, y, None)?;
+        let raw: Row = std::array::from_fn(|i| {
+            if i < self.g {
+                self.u_branch[k][i] + v[i]
+            } else {
+                v[i]
+            }
+        });
+        Ok(self.normalise(&raw))
     }
 
     /// [`Self::abel`] into `out` (length `g`), without allocating: the

@@ -190,3 +190,61 @@ mod prop {
         }
     }
 }
+
+/// Near a branch point `e_k` the Abel map from `e_k` is, in the local
+/// parameter `w = √(x − e_k)`, `A⁻¹ · 2 w (1, e_k)ᵀ / ρ + O(w³)` with
+/// `ρ² = Π_{m≠k} (e_k − e_m)` (the sheet fixing the sign of `w ρ = y / w`).
+/// At `|dx| = 1e-14` the cubic term is 1e-14 of the linear one (~1e-22
+/// absolute), so `u(e_k) + linear term` is a reference to the rounding of
+/// the O(1) result. Given the offset, [`HyperellipticCurve::abel_near_branch`]
+/// meets it; the Abel map of the double `x = e_k + dx` sees `dx` only to
+/// `u |x|` absolute and misses the increment by ~`u |x| / |dx|` of itself.
+#[test]
+fn abel_near_a_branch_point_keeps_the_local_parameter() {
+    let e = [
+        c(0.0, 0.0),
+        c(1.3, 0.2),
+        c(-0.7, 1.1),
+        c(2.1, -0.6),
+        c(-1.4, -0.9),
+    ];
+    let h = HyperellipticCurve::new(&e).unwrap();
+    let ainv = h.periods().0.clone().try_inverse().unwrap();
+    for k in 1..5 {
+        let dx = c(0.6e-14, 0.8e-14);
+        let w = sqrt_principal(dx);
+        let rho2: C = (0..5).filter(|&m| m != k).map(|m| e[k] - e[m]).product();
+        let rho = sqrt_principal(rho2);
+        let y = w * rho; // one sheet; y² = R(e_k + dx) to O(dx²)
+        let base = h.abel_branch_point(k).unwrap();
+        let lin = [2.0 * w / rho, 2.0 * w * e[k] / rho];
+        let want: Vec<C> = (0..2)
+            .map(|i| base[i] + ainv[(i, 0)] * lin[0] + ainv[(i, 1)] * lin[1])
+            .collect();
+        let size = want[0].norm().max(want[1].norm());
+        let got = h.abel_near_branch(k, dx, y).unwrap();
+        for i in 0..2 {
+            assert!(
+                (got[i] - want[i]).norm() <= 8.0 * f64::EPSILON * size,
+                "k={k} i={i}: {} vs {}",
+                got[i],
+                want[i]
+            );
+        }
+        // The plain Abel map of the rounded x, on the same sheet.
+        let x = e[k] + dx;
+        let yx = h.y(x, 1);
+        let yx = if (yx * y.conj()).re < 0.0 { -yx } else { yx };
+        let plain = h.abel(x, yx).unwrap();
+        let miss = (0..2)
+            .map(|i| {
+                let d = h.reduce(&[plain[0] - want[0], plain[1] - want[1]]);
+                d[i].norm()
+            })
+            .fold(0.0f64, f64::max);
+        assert!(
+            miss > 1e3 * f64::EPSILON * size,
+            "k={k}: plain misses by {miss:e} only"
+        );
+    }
+}

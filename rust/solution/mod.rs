@@ -42,6 +42,8 @@ use crate::riemann::HyperellipticCurve;
 use crate::so4;
 use crate::theta::{char_index, SelectedBlock, ThetaJet, ThetaPlan};
 
+pub mod velocity;
+
 type C = Complex64;
 
 /// Truncation tolerance of the theta sums (absolute, on normalised values):
@@ -130,81 +132,19 @@ impl Solution {
         let c = so4::manakov_c(a, b)?;
         // State order (12, 13, 14, 23, 24, 34) from the row-major 4 × 4 matrix.
         let c4 = [c[1], c[2], c[3], c[6], c[7], c[11]];
-        let size = l0.iter().fold(0.0f64, |m, v| m.max(v.abs()));
-        if size == 0.0 {
-            return Err(singular(
-                SingularKind::ZeroState,
-                "l0 = 0: the rest state; the solution is l(t) = 0, there is no curve (8)".into(),
-            ));
-        }
-        let h = so4::integrals4(a, l0);
-        let s2 = size * size;
-        if h[0].abs() <= DEGENERATE_RTOL * s2 {
-            return Err(singular(
-                SingularKind::VanishingH0,
-                format!(
-                "h0 = {:e} vanishes: the branch points d_0 = 0 and d_j coincide (F (19) has double \
-                 roots), the curve (8) degenerates; the solution exists in a limiting sense \
-                 (genus < 2, elementary functions), not as a genus-2 theta quotient",
-                h[0]
-            ),
-            ));
-        }
-        let disc = h[1] * h[1] - 4.0 * h[0] * h[0];
-        if disc.abs() <= DEGENERATE_RTOL * (h[1] * h[1] + 4.0 * h[0] * h[0]) {
-            return Err(singular(
-                SingularKind::SelfDual,
-                format!(
-                    "h1^2 - 4 h0^2 = {disc:e} vanishes (m = ±n, a self-dual state): F (19) is not \
-                 defined; the motion reduces to an so(3) top (elliptic functions), the \
-                 genus-2 solution exists only as a limit"
-                ),
-            ));
-        }
-        let kotter = kotter_constants(a, l0).map_err(|e| match e {
-            Error::RepeatedBranchPoints { i, j, value } => coinciding(i, j, value),
-            other => other,
-        })?;
-        let state0 = kotter_with(kotter.clone(), l0).map_err(|e| match e {
-            Error::RepeatedBranchPoints { i, j, value } => coinciding(i, j, value),
-            other => other,
-        })?;
-        let bp = state0.curve.branch_points();
-        let curve = HyperellipticCurve::new(&bp).map_err(|e| match e {
-            Error::RepeatedBranchPoints { i, j, value } => coinciding(i, j, value),
-            other => other,
-        })?;
+        let LevelSetCurve {
+            kotter,
+            kcurve: _,
+            curve,
+            chars,
+        } = level_set_curve(a, l0)?;
+        let state0 = kotter_with(kotter.clone(), l0).map_err(map_coinciding)?;
         let tau_rm = curve.tau_row_major();
         let tau: [C; 4] = [tau_rm[0], tau_rm[1], tau_rm[2], tau_rm[3]];
         let plan = ThetaPlan::new(&tau, 2, THETA_TOL, 1)?.with_parallel(false);
         let rcv = curve.try_riemann_constant()?;
         let rc = [rcv[0], rcv[1]];
 
-        // Characteristics: χ_j = η(d_j) (index j of the branch points passed),
-        // χ_jk = χ_j + χ_k mod 2.
-        let mut eta = [([0u8; 2], [0u8; 2]); 5];
-        for (j, e) in eta.iter_mut().enumerate() {
-            let (ca, cb) = curve.try_branch_char(j)?;
-            *e = ([ca[0], ca[1]], [cb[0], cb[1]]);
-        }
-        let sum = |p: usize, q: usize| {
-            (
-                [
-                    (eta[p].0[0] + eta[q].0[0]) % 2,
-                    (eta[p].0[1] + eta[q].0[1]) % 2,
-                ],
-                [
-                    (eta[p].1[0] + eta[q].1[0]) % 2,
-                    (eta[p].1[1] + eta[q].1[1]) % 2,
-                ],
-            )
-        };
-        let mut chars = [([0u8; 2], [0u8; 2]); 7];
-        chars[0] = eta[0];
-        for (j, &(_, k, l)) in CYCLIC.iter().enumerate() {
-            chars[1 + j] = sum(k, l);
-            chars[4 + j] = sum(j + 1, 4);
-        }
         let mut idx = [0usize; 8];
         idx[0] = char_index(&[0, 0], &[0, 0])?;
         for (m, ch) in chars.iter().enumerate() {
@@ -213,8 +153,8 @@ impl Solution {
 
         // The divisor of l0 and v0 = u(P1) + u(P2) + K.
         let pts = &state0.points;
-        let ua = curve.abel(pts.z1, pts.y1)?;
-        let ub = curve.abel(pts.z2, pts.y2)?;
+        let ua = abel_of_point(&curve, pts.z1, pts.y1, &pts.zd1)?;
+        let ub = abel_of_point(&curve, pts.z2, pts.y2, &pts.zd2)?;
         let u0 = [ua[0] + ub[0], ua[1] + ub[1]];
         let v0 = [u0[0] + rc[0], u0[1] + rc[1]];
         let jet = plan.jet(&v0, 1)?;
@@ -398,6 +338,32 @@ impl Solution {
         self.rate
     }
 
+    /// The velocities of the flows with coefficients `c4s` on this level set
+    /// from the chain rule at auxiliary divisors ([`velocity::algebraic_rates`]),
+    /// with the sign of `G` of this solution (the one that makes the first
+    /// flow's velocity point along [`Solution::rate`] when `c4s[0]` is the
+    /// top's own `c4`; in general the sign that matches the theta-side fit of
+    /// the first flow).
+    pub fn algebraic_rates(&self, c4s: &[[f64; 6]]) -> Result<velocity::AlgebraicRates> {
+        let mut alg = velocity::algebraic_rates(
+            &self.kotter,
+            &self.state0.curve,
+            &a_periods_of(&self.curve),
+            c4s,
+        )?;
+        let Some(first) = c4s.first() else {
+            return Ok(alg);
+        };
+        let reference = self.rates(&[*first])?[0].0;
+        let u = alg.rates[0];
+        if (u[0] * reference[0].conj() + u[1] * reference[1].conj()).re < 0.0 {
+            for r in alg.rates.iter_mut().chain(alg.v.iter_mut()) {
+                *r = r.map(|z| -z);
+            }
+        }
+        Ok(alg)
+    }
+
     /// Characteristics `(a, b)` of [`LABELS`].
     pub fn characteristics(&self) -> [([u8; 2], [u8; 2]); 7] {
         self.chars
@@ -425,8 +391,8 @@ impl Solution {
     pub fn abel(&self, l: &[f64; 6]) -> Result<[C; 2]> {
         let st = kotter_with(self.kotter.clone(), l)?;
         let p = &st.points;
-        let ua = self.curve.abel(p.z1, p.y1)?;
-        let ub = self.curve.abel(p.z2, p.y2)?;
+        let ua = abel_of_point(&self.curve, p.z1, p.y1, &p.zd1)?;
+        let ub = abel_of_point(&self.curve, p.z2, p.y2, &p.zd2)?;
         Ok([ua[0] + ub[0], ua[1] + ub[1]])
     }
 
@@ -656,6 +622,130 @@ fn eps41(k: &KotterConstants) -> C {
         .flat_map(|e| [e, -e])
         .min_by(|p, q| (p - k.eps).norm().total_cmp(&(q - k.eps).norm()))
         .unwrap_or(k.eps)
+}
+
+/// The Abel map takes the route from the nearest branch point `d_b` with the
+/// reduction's offset `z − d_b` when that offset is below this fraction of
+/// `|z|`: the double `z` fixes `z − d_b` only to `u |z|` absolute (u the unit
+/// roundoff), so below it the local parameter `√(z − d_b)` would lose
+/// `u |z| / |z − d_b|` of its digits; the offset keeps them.
+const NEAR_BRANCH_FRACTION: f64 = 0.1;
+
+/// The Abel map of a point of the divisor: from its offsets `zd[j] = z − d_j`
+/// (full relative accuracy, [`crate::curve::WurzelPoints`]) when it is near a
+/// branch point ([`HyperellipticCurve::abel_near_branch`]), else of `z`.
+fn abel_of_point(curve: &HyperellipticCurve, z: C, y: C, zd: &[C; 5]) -> Result<Vec<C>> {
+    let b = (0..5)
+        .min_by(|&i, &j| zd[i].norm().total_cmp(&zd[j].norm()))
+        .unwrap_or(0);
+    if zd[b].norm() < NEAR_BRANCH_FRACTION * z.norm() {
+        curve.abel_near_branch(b, zd[b], y)
+    } else {
+        curve.abel(z, y)
+    }
+}
+
+/// The a-period matrix `A_ij = ∮_{a_j} x^i dx/y` of the curve, row-major.
+pub fn a_periods_of(curve: &HyperellipticCurve) -> [C; 4] {
+    let (a, _) = curve.periods();
+    [a[(0, 0)], a[(0, 1)], a[(1, 0)], a[(1, 1)]]
+}
+
+/// The level set of a state as the reduction and the Riemann-surface layer
+/// see it: Kötter's constants, the curve (8) in both forms, and the
+/// characteristics `χ_L` of [`LABELS`] in the curve's homology basis.
+#[derive(Debug, Clone)]
+pub struct LevelSetCurve {
+    /// Kötter's constants of the level set ([`kotter_constants`]).
+    pub kotter: KotterConstants,
+    /// The curve (8) with the Wurzelfunktionen.
+    pub kcurve: KotterCurve,
+    /// The same curve with periods, Abel map and theta characteristics
+    /// (branch points passed as `(d_0, …, d_4)`).
+    pub curve: HyperellipticCurve,
+    /// `χ_0 = η(d_0)`, `χ_kl = η(d_k) + η(d_l)`, `χ_j4 = η(d_j) + η(d_4)` for
+    /// the labels `P0, P23, P31, P12, P14, P24, P34`.
+    pub chars: [([u8; 2], [u8; 2]); 7],
+}
+
+/// The checks of `l0` that precede the reduction, and the reduction's
+/// level-set objects: refuses `l0 = 0`, `h0 = 0`, `h1² = 4h0²` (relative to
+/// [`DEGENERATE_RTOL`]) and coinciding branch points with a
+/// [`Error::Singular`] that names the reason.
+pub fn level_set_curve(a: &[f64; 4], l0: &[f64; 6]) -> Result<LevelSetCurve> {
+    crate::error::check_finite("l0", l0)?;
+    let size = l0.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    if size == 0.0 {
+        return Err(singular(
+            SingularKind::ZeroState,
+            "l0 = 0: the rest state; the solution is l(t) = 0, there is no curve (8)".into(),
+        ));
+    }
+    let h = so4::integrals4(a, l0);
+    let s2 = size * size;
+    if h[0].abs() <= DEGENERATE_RTOL * s2 {
+        return Err(singular(
+            SingularKind::VanishingH0,
+            format!(
+                "h0 = {:e} vanishes: the branch points d_0 = 0 and d_j coincide (F (19) has double \
+                 roots), the curve (8) degenerates; the solution exists in a limiting sense \
+                 (genus < 2, elementary functions), not as a genus-2 theta quotient",
+                h[0]
+            ),
+        ));
+    }
+    let disc = h[1] * h[1] - 4.0 * h[0] * h[0];
+    if disc.abs() <= DEGENERATE_RTOL * (h[1] * h[1] + 4.0 * h[0] * h[0]) {
+        return Err(singular(
+            SingularKind::SelfDual,
+            format!(
+                "h1^2 - 4 h0^2 = {disc:e} vanishes (m = ±n, a self-dual state): F (19) is not \
+                 defined; the motion reduces to an so(3) top (elliptic functions), the \
+                 genus-2 solution exists only as a limit"
+            ),
+        ));
+    }
+    let kotter = kotter_constants(a, l0).map_err(map_coinciding)?;
+    let [d1, d2, d3] = kotter.d;
+    let kcurve = KotterCurve::new(d1, d2, d3).map_err(map_coinciding)?;
+    let curve = HyperellipticCurve::new(&kcurve.branch_points()).map_err(map_coinciding)?;
+    // χ_j = η(d_j) (index j of the branch points passed), χ_jk = χ_j + χ_k mod 2.
+    let mut eta = [([0u8; 2], [0u8; 2]); 5];
+    for (j, e) in eta.iter_mut().enumerate() {
+        let (ca, cb) = curve.try_branch_char(j)?;
+        *e = ([ca[0], ca[1]], [cb[0], cb[1]]);
+    }
+    let sum = |p: usize, q: usize| {
+        (
+            [
+                (eta[p].0[0] + eta[q].0[0]) % 2,
+                (eta[p].0[1] + eta[q].0[1]) % 2,
+            ],
+            [
+                (eta[p].1[0] + eta[q].1[0]) % 2,
+                (eta[p].1[1] + eta[q].1[1]) % 2,
+            ],
+        )
+    };
+    let mut chars = [([0u8; 2], [0u8; 2]); 7];
+    chars[0] = eta[0];
+    for (j, &(_, k, l)) in CYCLIC.iter().enumerate() {
+        chars[1 + j] = sum(k, l);
+        chars[4 + j] = sum(j + 1, 4);
+    }
+    Ok(LevelSetCurve {
+        kotter,
+        kcurve,
+        curve,
+        chars,
+    })
+}
+
+fn map_coinciding(e: Error) -> Error {
+    match e {
+        Error::RepeatedBranchPoints { i, j, value } => coinciding(i, j, value),
+        other => other,
+    }
 }
 
 fn coinciding(i: usize, j: usize, value: C) -> Error {

@@ -1,4 +1,19 @@
-//! The frequency map on the Theorem's solution ([`crate::solution`]).
+//! The frequency map on the Theorem's level set ([`crate::solution`]).
+//!
+//! Two routes to the data of [`real_torus`] (`τ`, `U`, `U'`, the
+//! characteristics):
+//!
+//! * [`level_set_flow_data`] (the frequency map): the reduction's constants,
+//!   the curve (8) and its periods, and the velocities of both flows by the
+//!   chain rule at auxiliary divisors ([`crate::solution::velocity`]). No
+//!   theta function, no divisor of `l0`, no Abel map: the frequencies are a
+//!   property of the level set, so a state whose divisor contains the point at
+//!   infinity has them too.
+//! * [`flow_data`] on a [`Solution`] (`sol.torus`): `U` from the solution's
+//!   theta-side fit at `v0`, `U'` from the same equations.
+//!
+//! They agree to the accuracy of the level-set constants (~1e-13 relative on
+//! the shared tops; `tests/test_tori.py`).
 
 use num_complex::Complex64 as C;
 
@@ -7,7 +22,8 @@ use super::{
 };
 use crate::error::{Error, Result, SingularKind};
 use crate::so4;
-use crate::solution::Solution;
+use crate::solution::velocity::algebraic_rates;
+use crate::solution::{a_periods_of, level_set_curve, Solution};
 
 /// The six `c_ij` (`i < j`, state order) of `ManakovTop(a, b)` (2).
 pub fn c_pairs(a: &[f64; 4], b: &[f64; 4]) -> Result<[f64; 6]> {
@@ -72,8 +88,45 @@ pub fn classify(e: &Error) -> Status {
     }
 }
 
-/// Status and `(ν1, ν2)` of the state `l0` of the top `(a, b)`.
+/// `τ`, `U`, `U'` and the characteristics from the level set of `l0` alone:
+/// the reduction's constants, the curve and its periods, and the velocities
+/// of the top `(a, b)` and of the second flow `(a, b2)` by the chain rule at
+/// auxiliary divisors. `U` and `U'` share one sign convention (that of
+/// [`algebraic_rates`]); the frequencies do not depend on it (the basis is
+/// oriented so that `ν ≥ 0`).
+pub fn level_set_flow_data(
+    a: &[f64; 4],
+    b: &[f64; 4],
+    b2: &[f64; 4],
+    l0: &[f64; 6],
+) -> Result<FlowData> {
+    let c4 = c_pairs(a, b)?;
+    let c2 = c_pairs(a, b2)?;
+    let ls = level_set_curve(a, l0)?;
+    let alg = algebraic_rates(&ls.kotter, &ls.kcurve, &a_periods_of(&ls.curve), &[c4, c2])?;
+    let t = ls.curve.tau_row_major();
+    Ok(FlowData {
+        tau: [[t[0], t[1]], [t[2], t[3]]],
+        u: alg.rates[0],
+        u2: alg.rates[1],
+        chars: ls
+            .chars
+            .iter()
+            .map(|(a, b)| [a[0], a[1], b[0], b[1]])
+            .collect(),
+    })
+}
+
+/// Status and `(ν1, ν2)` of the state `l0` of the top `(a, b)`, from the
+/// level set ([`level_set_flow_data`]).
 pub fn state_frequencies(a: &[f64; 4], b: &[f64; 4], l0: &[f64; 6]) -> MapEntry {
+    let b2 = second_flow_b(a, b);
+    frequencies_of_state(l0, |l| level_set_flow_data(a, b, &b2, l), classify)
+}
+
+/// [`state_frequencies`] through the Theorem's solution ([`flow_data`]):
+/// the frequencies of `sol.torus`.
+pub fn state_frequencies_theta(a: &[f64; 4], b: &[f64; 4], l0: &[f64; 6]) -> MapEntry {
     let b2 = second_flow_b(a, b);
     frequencies_of_state(
         l0,

@@ -457,10 +457,23 @@ mod on_the_solution {
         for x in &t.coords {
             assert!(is_period(&d.chars, x));
         }
+        // The map's level-set route against the solution's theta route:
+        // the same frequencies up to the accuracy of the constants.
         let e = state_frequencies(&a, &b, &l0);
         assert_eq!(e.status, Status::Ok);
-        assert_eq!(e.nu, t.nu);
+        for k in 0..2 {
+            assert!(
+                (e.nu[k] - t.nu[k]).abs() <= ROUTES_RTOL * t.nu[k],
+                "{:?} vs {:?}",
+                e.nu,
+                t.nu
+            );
+        }
     }
+
+    /// The two routes to the frequencies (level set vs theta fit) agree to
+    /// the accuracy of the reduction's constants: 3e-15 measured on 'generic'.
+    const ROUTES_RTOL: f64 = 1e-12;
 
     #[test]
     fn singular_states_get_their_codes() {

@@ -1,0 +1,506 @@
+//! `U` from the equations of motion on the algebraic side: the chain rule at
+//! auxiliary divisors.
+//!
+//! The reduction gives the state as a function on the symmetric square of
+//! the curve (8): for a divisor `D = (z1, y1) + (z2, y2)`,
+//!
+//! ```text
+//!   P_j, P_jk  (27)–(28),   g = G/(1 − ε P_0)  (42, corrected),   G = √(h0/K),
+//!   ξ_j = √c_j g P_kl,  η_j = √c_j g P_j4  (37),
+//!   m_j = α_j ξ_j + β_j η_j,  n_j = γ_j ξ_j + δ_j η_j  (23), (24) corrected,
+//!   l(D) = (m3, −m2, n1, m1, n2, n3).
+//! ```
+//!
+//! Along the flow the divisor moves so that its Abel image moves on a
+//! straight line: `Σ_i (1, z_i) ż_i / y_i = V` (unnormalised differentials
+//! `(1, x) dx/y`), a constant of the level set, and `U = A⁻¹ V` with `A` the
+//! a-periods. The chain rule `l̇ = Σ_i ∂l/∂z_i ż_i` with `l̇` from (1) at
+//! `l(D)` gives `ż_i` (six equations, two unknowns, least squares) and so `V`
+//! — at *any* divisor of the level set, since `V` is constant there. At the
+//! divisor of the initial state this is ill-conditioned when a point is near
+//! a branch point (`ż_i` and `y_i` both vanish there) or the two points are
+//! close; at a divisor of our choosing, generic and away from the branch
+//! points, it keeps the digits of the level-set constants. Several such
+//! divisors are used and must agree (a consensus, like the constants `C_L`).
+//!
+//! The state `l(D)` at an auxiliary divisor is complex (the divisor is not
+//! on the real torus); (1) and the integrals are polynomial identities and hold
+//! on the complexified level set. Whether `l(D)` lies on the level set of the
+//! solution (`H_k(l(D)) = h_k`) checks the branch of the `P_j` and of `y2`
+//! relative to `y1`; the sign of `G` is a genuine choice
+//! (`G → −G` is `l → −l`, i.e. the hyperelliptic involution, and flips `V`),
+//! fixed by the caller.
+//!
+//! A second result, used only as a test: `V ∥ (1, M(μ_b))` with `M` the
+//! Möbius map of the `s`-line sending the roots of `F` (19) to `±1/ε`,
+//! `∓d_4 ε` (docs/theorem.md, "U in closed form").
+
+use nalgebra::{Matrix2, Vector2};
+use num_complex::Complex64;
+
+use crate::curve::{sqrt_principal, KotterCurve, CYCLIC};
+use crate::error::{Error, Result};
+use crate::kotter::KotterConstants;
+use crate::so4::PAIRS4;
+
+type C = Complex64;
+
+const ZERO: C = C::new(0.0, 0.0);
+const ONE: C = C::new(1.0, 0.0);
+
+/// A combination of branches places `l(D)` on the level set when its
+/// integrals match to this relative accuracy (of `|l(D)|²`, times `max|a|` for
+/// `H2`, `max|a|²` for `H3`): consistent branches leave rounding (~1e-15 when
+/// the level-set constants are accurate), inconsistent ones O(1).
+pub const LEVEL_SET_RTOL: f64 = 1e-8;
+
+/// Two divisors' velocities agree (a vote in the consensus) within this
+/// relative distance: well-conditioned divisors agree to ~1e-14.
+pub const AGREE_RTOL: f64 = 1e-11;
+
+/// The factor `1 − ε P_0` of `g` (42) below this size puts the divisor near a
+/// pole of the state; such a divisor is not used.
+const POLE_MARGIN: f64 = 1e-2;
+
+/// Fixed generic positions of the two points of an auxiliary divisor, in
+/// units of the curve's scale (off the real and imaginary axes, apart).
+const OFFSETS: [(f64, f64, f64, f64); 6] = [
+    (0.43, 0.57, -0.61, 0.32),
+    (-0.52, -0.38, 0.29, -0.71),
+    (0.66, -0.24, -0.17, 0.83),
+    (-0.31, 0.74, 0.77, 0.41),
+    (0.21, -0.62, -0.73, -0.26),
+    (0.81, 0.36, 0.12, -0.58),
+];
+
+/// The velocities of several flows on one level set, from the chain rule at
+/// auxiliary divisors.
+#[derive(Debug, Clone, PartialEq)]
+pub struct AlgebraicRates {
+    /// `U` of each flow (normalised: `v = u + U t`), in the order of the
+    /// coefficient sets passed, for `G = √(h0/K)` principal.
+    pub rates: Vec<[C; 2]>,
+    /// The unnormalised velocities `V = A U`.
+    pub v: Vec<[C; 2]>,
+    /// Number of divisors that agreed with the result.
+    pub support: usize,
+    /// Largest relative distance between the agreeing divisors' `U` (first flow).
+    pub spread: f64,
+    /// Largest relative level-set residual `|H(l(D)) − h|` of the agreeing divisors.
+    pub level_residual: f64,
+}
+
+/// One auxiliary divisor's result: `U` and `V` of each flow, and the
+/// level-set residual of its state.
+struct Candidate {
+    u: Vec<[C; 2]>,
+    v: Vec<[C; 2]>,
+    level: f64,
+}
+
+/// `(1)` for a complex state: `l̇ = [l, ω]`, `ω_ij = c_ij l_ij`, written as
+/// the matrix commutator (not the expanded form of [`crate::so4::vector_field4`]).
+pub fn vector_field_complex(c4: &[f64; 6], l: &[C; 6]) -> [C; 6] {
+    let mut lm = [[ZERO; 4]; 4];
+    let mut om = [[ZERO; 4]; 4];
+    for (q, &(i, j)) in PAIRS4.iter().enumerate() {
+        lm[i][j] = l[q];
+        lm[j][i] = -l[q];
+        om[i][j] = l[q] * c4[q];
+        om[j][i] = -l[q] * c4[q];
+    }
+    std::array::from_fn(|q| {
+        let (i, j) = PAIRS4[q];
+        (0..4).fold(ZERO, |acc, k| {
+            acc + lm[i][k] * om[k][j] - om[i][k] * lm[k][j]
+        })
+    })
+}
+
+/// `(H0, H1, H2, H3)` of (6)–(7) (corrected: complementary pairs) for a
+/// complex state.
+pub fn integrals_complex(a: &[f64; 4], l: &[C; 6]) -> [C; 4] {
+    let [l12, l13, l14, l23, l24, l34] = *l;
+    let h0 = l12 * l34 + l23 * l14 - l13 * l24;
+    let (mut h1, mut h2, mut h3) = (ZERO, ZERO, ZERO);
+    for (p, _) in PAIRS4.iter().enumerate() {
+        let (u, v) = PAIRS4[5 - p];
+        let x2 = l[p] * l[p];
+        h1 += x2;
+        h2 += x2 * (a[u] + a[v]);
+        h3 += x2 * (a[u] * a[v]);
+    }
+    [h0, h1, h2, h3]
+}
+
+/// The state at a divisor and its derivatives along the curve.
+struct StateJet {
+    l: [C; 6],
+    /// `dl[i][q] = ∂l_q/∂z_i` (`y_i` continued along its sheet).
+    dl: [[C; 6]; 2],
+}
+
+/// `l(D)` and `∂l/∂z_i` at the divisor with roots `r[i][m] = √(z_i − d_m)`
+/// (signs carrying the sheet: `Π_m r[i][m] = y_i`) and branch `eps` of the
+/// `P_j`. With `A = r2_j r2_k Π_{m≠j,k} r1_m`, `B = r1_j r1_k Π_{m≠j,k} r2_m`,
+/// (28) reads `P_jk = (A − B)/(z1 − z2)`, and `∂r_im/∂z_i = r_im/(2(z_i − d_m))`.
+#[allow(clippy::too_many_arguments)]
+fn state_jet(
+    k: &KotterConstants,
+    sc: &[C; 3],
+    big_g: C,
+    d: &[C; 5],
+    z: [C; 2],
+    r: &[[C; 5]; 2],
+    eps: &[f64; 5],
+) -> Option<StateJet> {
+    let dz = z[0] - z[1];
+    // h[i][m] = 1/(2(z_i − d_m)): the logarithmic derivative of r[i][m].
+    let h: [[C; 5]; 2] = std::array::from_fn(|i| std::array::from_fn(|m| 0.5 / (z[i] - d[m])));
+    let p: [C; 5] = std::array::from_fn(|m| eps[m] * r[0][m] * r[1][m]);
+    let dp: [[C; 5]; 2] = std::array::from_fn(|i| std::array::from_fn(|m| p[m] * h[i][m]));
+    // P_jk and its derivatives for the six pairs that enter (37).
+    let pjk = |j: usize, kk: usize| -> (C, [C; 2]) {
+        let (mut a, mut b) = (r[1][j] * r[1][kk], r[0][j] * r[0][kk]);
+        let (mut sa1, mut sb2) = (ZERO, ZERO);
+        for m in (0..5).filter(|&m| m != j && m != kk) {
+            a *= r[0][m];
+            b *= r[1][m];
+            sa1 += h[0][m];
+            sb2 += h[1][m];
+        }
+        let s = eps[j] * eps[kk];
+        let v = s * (a - b) / dz;
+        let da1 = a * sa1;
+        let db1 = b * (h[0][j] + h[0][kk]);
+        let da2 = a * (h[1][j] + h[1][kk]);
+        let db2 = b * sb2;
+        let d1 = s * (da1 - db1) / dz - v / dz;
+        let d2 = s * (da2 - db2) / dz + v / dz;
+        (v, [d1, d2])
+    };
+    let den = ONE - k.eps * p[0];
+    if den.norm() < POLE_MARGIN {
+        return None;
+    }
+    let g = big_g / den;
+    // ∂g/∂z_i = g ε ∂P_0/∂z_i / (1 − ε P_0)
+    let dg: [C; 2] = std::array::from_fn(|i| g * k.eps * dp[i][0] / den);
+    let mut m = [ZERO; 3];
+    let mut n = [ZERO; 3];
+    let mut dm = [[ZERO; 3]; 2];
+    let mut dn = [[ZERO; 3]; 2];
+    for (jj, &(j, kk, ll)) in CYCLIC.iter().enumerate() {
+        let (pkl, dpkl) = pjk(kk, ll);
+        let (pj4, dpj4) = pjk(j, 4);
+        let xi = sc[jj] * g * pkl;
+        let eta = sc[jj] * g * pj4;
+        m[jj] = k.alpha[jj] * xi + k.beta[jj] * eta;
+        n[jj] = k.gamma[jj] * xi + k.delta[jj] * eta;
+        for i in 0..2 {
+            let dxi = sc[jj] * (dg[i] * pkl + g * dpkl[i]);
+            let deta = sc[jj] * (dg[i] * pj4 + g * dpj4[i]);
+            dm[i][jj] = k.alpha[jj] * dxi + k.beta[jj] * deta;
+            dn[i][jj] = k.gamma[jj] * dxi + k.delta[jj] * deta;
+        }
+    }
+    let lay = |m: &[C; 3], n: &[C; 3]| [m[2], -m[1], n[0], m[0], n[1], n[2]];
+    let l = lay(&m, &n);
+    let dl = [lay(&dm[0], &dn[0]), lay(&dm[1], &dn[1])];
+    let finite = |v: &C| v.re.is_finite() && v.im.is_finite();
+    (l.iter().all(finite) && dl.iter().flatten().all(finite)).then_some(StateJet { l, dl })
+}
+
+/// Relative distance of the integrals of `l` from `h`.
+fn level_residual(a: &[f64; 4], h: &[f64; 4], l: &[C; 6]) -> f64 {
+    let hl = integrals_complex(a, l);
+    let size = l.iter().map(|v| v.norm_sqr()).sum::<f64>();
+    let am = a.iter().fold(0.0f64, |m, x| m.max(x.abs())).max(1.0);
+    let w = [1.0, 1.0, 2.0 * am, am * am];
+    (0..4)
+        .map(|q| (hl[q] - h[q]).norm() / (size * w[q]))
+        .fold(0.0f64, f64::max)
+}
+
+/// Least squares `J x = b` for a 6 × 2 complex `J` (normal equations with one
+/// step of refinement: the divisors are chosen so that `J` is well conditioned).
+fn lstsq_6x2(j: &[[C; 6]; 2], b: &[C; 6]) -> Option<[C; 2]> {
+    let dot = |u: &[C; 6], v: &[C; 6]| (0..6).fold(ZERO, |s, q| s + u[q].conj() * v[q]);
+    let g = Matrix2::new(
+        dot(&j[0], &j[0]),
+        dot(&j[0], &j[1]),
+        dot(&j[1], &j[0]),
+        dot(&j[1], &j[1]),
+    );
+    let inv = g.try_inverse()?;
+    let solve = |rhs: &[C; 6]| inv * Vector2::new(dot(&j[0], rhs), dot(&j[1], rhs));
+    let x = solve(b);
+    let res: [C; 6] = std::array::from_fn(|q| b[q] - j[0][q] * x[0] - j[1][q] * x[1]);
+    let dx = solve(&res);
+    let out = [x[0] + dx[0], x[1] + dx[1]];
+    out.iter()
+        .all(|v| v.re.is_finite() && v.im.is_finite())
+        .then_some(out)
+}
+
+/// The velocities `U` of the flows with coefficients `c4s` (the six `c_ij`,
+/// `i < j`, of (1)) on the level set of the constants `k`, by the chain rule
+/// at auxiliary divisors, for the sign `G = +√(h0/K)` (principal).
+///
+/// `curve` is the curve (8) of `k`; `a_periods` the a-period matrix
+/// `A_ij = ∮_{a_j} x^{i} dx/y` (row-major, 2 × 2) of the homology basis in
+/// which `U` is wanted.
+///
+/// Errors: no auxiliary divisor gives a state on the level set (the constants
+/// are inconsistent), or the divisors disagree.
+pub fn algebraic_rates(
+    k: &KotterConstants,
+    curve: &KotterCurve,
+    a_periods: &[C; 4],
+    c4s: &[[f64; 6]],
+) -> Result<AlgebraicRates> {
+    let d = curve.branch_points();
+    let sc = curve.c().map(sqrt_principal);
+    let big_g = sqrt_principal(C::new(k.h[0], 0.0) / k.k);
+    let amat = Matrix2::new(a_periods[0], a_periods[1], a_periods[2], a_periods[3]);
+    let ainv = amat.try_inverse().ok_or(Error::InvalidArgument {
+        what: "a-periods",
+        reason: "the a-period matrix is singular".into(),
+    })?;
+    // Scales: the geometric mean of the non-zero |d_j| (in ratio far from
+    // every branch point however widely they spread), then the outer radius.
+    let (log_sum, count) = d
+        .iter()
+        .filter(|x| x.norm() > 0.0)
+        .fold((0.0f64, 0u32), |(s, n), x| (s + x.norm().ln(), n + 1));
+    let center: C = d.iter().sum::<C>() / 5.0;
+    let radius = d.iter().fold(0.0f64, |m, x| m.max((x - center).norm()));
+    let geo = if count > 0 {
+        (log_sum / f64::from(count)).exp()
+    } else {
+        radius
+    };
+    let mut cands: Vec<Candidate> = Vec::new();
+    let eps_default = [1.0; 5];
+    let agree = |x: &[C; 2], y: &[C; 2]| {
+        let s = x[0]
+            .norm()
+            .max(x[1].norm())
+            .max(y[0].norm().max(y[1].norm()));
+        (x[0] - y[0]).norm().max((x[1] - y[1]).norm()) <= AGREE_RTOL * s
+    };
+    let best = |cands: &[Candidate]| {
+        cands
+            .iter()
+            .enumerate()
+            .map(|(i, c)| {
+                let votes = cands.iter().filter(|o| agree(&c.u[0], &o.u[0])).count();
+                (votes, -c.level, i)
+            })
+            .max_by(|a, b| a.0.cmp(&b.0).then(a.1.total_cmp(&b.1)))
+    };
+    // Divisors one at a time until three agree (on a well-conditioned curve
+    // the first three do).
+    'scales: for (origin, scale) in [(ZERO, geo), (center, 1.3 * radius)] {
+        for &(a1, b1, a2, b2) in &OFFSETS {
+            if best(&cands).is_some_and(|(votes, _, _)| votes >= 3) {
+                break 'scales;
+            }
+            let z = [
+                origin + C::new(a1, b1) * scale,
+                origin + C::new(a2, b2) * scale,
+            ];
+            let r0: [[C; 5]; 2] =
+                std::array::from_fn(|i| std::array::from_fn(|m| sqrt_principal(z[i] - d[m])));
+            // Sheets: y1 canonical, y2 on either sheet (the pair on the other
+            // sheets is the involution image, with the same velocity). The
+            // level set holds for one of the two; the other is off by O(1).
+            let mut pick: Option<(f64, StateJet, [[C; 5]; 2])> = None;
+            for s2 in [1.0, -1.0] {
+                let mut r = r0;
+                r[1][0] *= s2;
+                let Some(jet) = state_jet(k, &sc, big_g, &d, z, &r, &eps_default) else {
+                    continue;
+                };
+                let res = level_residual(&k.a, &k.h, &jet.l);
+                if res <= LEVEL_SET_RTOL {
+                    pick = Some((res, jet, r));
+                    break;
+                }
+            }
+            let Some((res, jet, r)) = pick else {
+                continue;
+            };
+            let y: [C; 2] = std::array::from_fn(|i| r[i].iter().product::<C>());
+            let mut us = Vec::with_capacity(c4s.len());
+            let mut vs = Vec::with_capacity(c4s.len());
+            for c4 in c4s {
+                let ldot = vector_field_complex(c4, &jet.l);
+                let Some(zdot) = lstsq_6x2(&jet.dl, &ldot) else {
+                    break;
+                };
+                let w = [zdot[0] / y[0], zdot[1] / y[1]];
+                let v = [w[0] + w[1], z[0] * w[0] + z[1] * w[1]];
+                let u = ainv * Vector2::new(v[0], v[1]);
+                vs.push(v);
+                us.push([u[0], u[1]]);
+            }
+            let finite = |p: &[C; 2]| p.iter().all(|v| v.re.is_finite() && v.im.is_finite());
+            if us.len() == c4s.len() && us.iter().all(finite) {
+                cands.push(Candidate {
+                    u: us,
+                    v: vs,
+                    level: res,
+                });
+            }
+        }
+    }
+    let (votes, _, i) = best(&cands).ok_or(Error::InvalidArgument {
+        what: "level set",
+        reason: "no auxiliary divisor gives a state on the level set: the reduction's \
+                 constants are inconsistent"
+            .into(),
+    })?;
+    // The mean over the divisors that agree with the best-supported one.
+    let sup: Vec<&Candidate> = cands
+        .iter()
+        .filter(|o| agree(&cands[i].u[0], &o.u[0]))
+        .collect();
+    let nf = sup.len() as f64;
+    let mean = |pick: &dyn Fn(&Candidate) -> [C; 2]| -> [C; 2] {
+        let s = sup.iter().fold([ZERO; 2], |acc, c| {
+            let x = pick(c);
+            [acc[0] + x[0], acc[1] + x[1]]
+        });
+        [s[0] / nf, s[1] / nf]
+    };
+    let rates: Vec<[C; 2]> = (0..c4s.len()).map(|f| mean(&|c| c.u[f])).collect();
+    let v: Vec<[C; 2]> = (0..c4s.len()).map(|f| mean(&|c| c.v[f])).collect();
+    let scale_u = rates[0][0].norm().max(rates[0][1].norm());
+    let spread = sup
+        .iter()
+        .map(|c| {
+            (c.u[0][0] - rates[0][0])
+                .norm()
+                .max((c.u[0][1] - rates[0][1]).norm())
+        })
+        .fold(0.0f64, f64::max)
+        / scale_u;
+    let level_residual = sup.iter().map(|c| c.level).fold(0.0f64, f64::max);
+    Ok(AlgebraicRates {
+        rates,
+        v,
+        support: votes,
+        spread,
+        level_residual,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::kotter::kotter_constants;
+    use crate::so4::{integrals4, vector_field4};
+
+    const GENERIC: ([f64; 4], [f64; 4], [f64; 6]) = (
+        [0.3, 1.1, 2.0, 3.7],
+        [0.5, -0.2, 1.4, 0.9],
+        [0.8, -0.3, 0.5, 1.1, -0.7, 0.2],
+    );
+
+    #[test]
+    fn complex_field_and_integrals_match_the_real_ones() {
+        let c4 = [0.7, -1.3, 2.1, 0.4, -0.2, 1.9];
+        let (a, _, l) = GENERIC;
+        let lc = l.map(|x| C::new(x, 0.0));
+        let f = vector_field_complex(&c4, &lc);
+        let fr = vector_field4(&c4, &l);
+        let h = integrals_complex(&a, &lc);
+        let hr = integrals4(&a, &l);
+        for q in 0..6 {
+            assert!((f[q] - fr[q]).norm() <= 1e-14, "{q}: {} {}", f[q], fr[q]);
+        }
+        for q in 0..4 {
+            assert!((h[q] - hr[q]).norm() <= 1e-14 * hr[q].abs().max(1.0));
+        }
+    }
+
+    /// `∂l/∂z_i` of [`state_jet`] against the Cauchy integral
+    /// `f'(z) = (1/N r) Σ_k f(z + r ω^k) ω^{−k}` (32 nodes on a circle of
+    /// radius 0.2 of the distance to the nearest singularity: the trapezoid
+    /// rule on the circle converges like 0.2^32, rounding stays at 1e-15/0.2).
+    #[test]
+    fn state_derivatives_match_a_cauchy_integral() {
+        let (a, _, l0) = GENERIC;
+        let k = kotter_constants(&a, &l0).unwrap();
+        let curve = KotterCurve::new(k.d[0], k.d[1], k.d[2]).unwrap();
+        let d = curve.branch_points();
+        let sc = curve.c().map(sqrt_principal);
+        let big_g = sqrt_principal(C::new(k.h[0], 0.0) / k.k);
+        let z = [C::new(1.1, 0.9), C::new(-2.3, 1.7)];
+        // roots continued from the centre of the circle (no cut crossed)
+        let roots = |zz: [C; 2], r0: &[[C; 5]; 2]| -> [[C; 5]; 2] {
+            std::array::from_fn(|i| {
+                std::array::from_fn(|m| {
+                    let v = sqrt_principal(zz[i] - d[m]);
+                    if (v - r0[i][m]).norm() <= (v + r0[i][m]).norm() {
+                        v
+                    } else {
+                        -v
+                    }
+                })
+            })
+        };
+        let r0: [[C; 5]; 2] =
+            std::array::from_fn(|i| std::array::from_fn(|m| sqrt_principal(z[i] - d[m])));
+        let e = [1.0; 5];
+        let jet = state_jet(&k, &sc, big_g, &d, z, &r0, &e).unwrap();
+        let near = (0..2)
+            .map(|i| {
+                d.iter()
+                    .fold((z[0] - z[1]).norm(), |m, x| m.min((z[i] - x).norm()))
+            })
+            .fold(f64::INFINITY, f64::min);
+        let rad = 0.2 * near;
+        let n = 32;
+        for i in 0..2 {
+            let mut acc = [ZERO; 6];
+            for kk in 0..n {
+                let w = C::from_polar(1.0, 2.0 * std::f64::consts::PI * kk as f64 / n as f64);
+                let mut zz = z;
+                zz[i] += w * rad;
+                let r = roots(zz, &r0);
+                let lj = state_jet(&k, &sc, big_g, &d, zz, &r, &e).unwrap();
+                for (a, lq) in acc.iter_mut().zip(lj.l) {
+                    *a += lq / w;
+                }
+            }
+            let scale = jet.dl[i].iter().fold(0.0f64, |m, v| m.max(v.norm()));
+            for (q, (a, exact)) in acc.iter().zip(jet.dl[i]).enumerate() {
+                let fd = a / (n as f64 * rad);
+                assert!(
+                    (fd - exact).norm() <= 1e-12 * scale,
+                    "z{i}, l{q}: {exact} vs {fd}"
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn auxiliary_states_lie_on_the_level_set_and_agree() {
+        let (a, b, l0) = GENERIC;
+        let k = kotter_constants(&a, &l0).unwrap();
+        let curve = KotterCurve::new(k.d[0], k.d[1], k.d[2]).unwrap();
+        let hc = crate::riemann::HyperellipticCurve::new(&curve.branch_points()).unwrap();
+        let c = crate::so4::manakov_c(&a, &b).unwrap();
+        let c4 = [c[1], c[2], c[3], c[6], c[7], c[11]];
+        let r = algebraic_rates(&k, &curve, &super::super::a_periods_of(&hc), &[c4]).unwrap();
+        assert!(r.support >= 3, "support {}", r.support);
+        assert!(r.spread <= 1e-13, "spread {:e}", r.spread);
+        assert!(
+            r.level_residual <= 1e-13,
+            "level residual {:e}",
+            r.level_residual
+        );
+    }
+}
