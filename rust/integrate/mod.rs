@@ -28,8 +28,8 @@
 //! size `Δt / n ≤ dt`, so a sample lands exactly on its time and memory is
 //! `O(samples)`: a step allocates nothing (see `tests/alloc.rs`).
 //!
-//! **Batches.** [`integrate_many`] runs so(4) batches with gauss16 and dop853 on
-//! the lane kernels of `batch.rs` (each vector lane a different trajectory,
+//! **Batches.** [`integrate_many`] runs so(4) batches with gauss16, dop853 and Taylor on
+//! the lane kernels of `batch.rs` and `taylor.rs` (each vector lane a different trajectory,
 //! [`LANES`] at a time), bit-for-bit equal to [`integrate`] state by state, in
 //! parallel over lane groups with rayon.
 //!
