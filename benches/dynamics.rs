@@ -112,7 +112,8 @@ fn steps(c: &mut Criterion) {
 }
 
 /// The trajectory-lane batch kernels (integrate_many, one thread): 64 states
-/// of the norm of 'generic''s l0 to t = 10; time per element = per trajectory-step.
+/// of the norm of 'generic''s l0 to t = 10; time per element = per trajectory-step
+/// (Taylor's method at rtol = eps: order 20, ~2.3x gauss16's steps at dt = 1/3).
 fn batch(c: &mut Criterion) {
     let top = FrahmTop::manakov(&A, &B).unwrap();
     let n0: f64 = L0.iter().map(|x| x * x).sum::<f64>().sqrt();
@@ -127,6 +128,7 @@ fn batch(c: &mut Criterion) {
     for (method, dt, rtol) in [
         (Method::Gauss16, 1.0 / 3.0, 0.0),
         (Method::Dop853, 0.0, 1e-12),
+        (Method::Taylor, 0.0, f64::EPSILON),
     ] {
         let opts = Options {
             method,

@@ -69,7 +69,7 @@ PROGRESS_MIN_STEPS = 200_000
 SEGMENT_STEPS = 30_000
 #: Explicit (adaptive) methods: their step is not known before the run; the
 #: first sample interval is integrated alone to measure it.
-EXPLICIT_METHODS = ("dopri5", "dop853")
+EXPLICIT_METHODS = ("dopri5", "dop853", "taylor")
 #: Exit status after Ctrl-C (128 + SIGINT, as a shell reports it).
 EXIT_INTERRUPTED = 130
 #: Exit status when the reader of standard output went away (128 + SIGPIPE).

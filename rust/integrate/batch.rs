@@ -109,7 +109,7 @@ unsafe fn gauss16_group_avx2(
 }
 
 /// One vector of `W` lanes.
-type V = [f64; W];
+pub(super) type V = [f64; W];
 
 /// The state of a gauss16 lane group.
 struct Gauss16Lanes {
@@ -363,8 +363,10 @@ fn gauss16_step<L: Lanes>(c: &[f64; 6], g: &mut Gauss16Lanes, h: f64) -> Result<
 /// plain arrays (the baseline build; LLVM vectorises them as it can) and AVX2
 /// registers (`avx::F64x4`, explicit instructions, so that the stage sums and
 /// the field stay in registers). Both are IEEE operations lane by lane, with
-/// no FMA, so they give the same bits.
-trait Lanes: Copy {
+/// no FMA in the gauss16 kernel, so they give the same bits. The Taylor kernel
+/// (`taylor.rs`) uses [`Lanes::fma`]: one rounding in both copies (the baseline
+/// calls `f64::mul_add`, correctly rounded), so again the same bits.
+pub(super) trait Lanes: Copy {
     fn splat(x: f64) -> Self;
     fn load(a: &V) -> Self;
     fn store(self, a: &mut V);
@@ -379,6 +381,8 @@ trait Lanes: Copy {
     fn max_of(self, d: Self) -> Self;
     /// `a` where `mask`'s sign bit is set, else `b`, lane by lane.
     fn select(mask: Self, a: Self, b: Self) -> Self;
+    /// `self · b + c` with one rounding.
+    fn fma(self, b: Self, c: Self) -> Self;
 }
 
 impl Lanes for V {
@@ -428,18 +432,22 @@ impl Lanes for V {
             }
         })
     }
+    #[inline(always)]
+    fn fma(self, b: Self, c: Self) -> Self {
+        std::array::from_fn(|w| self[w].mul_add(b[w], c[w]))
+    }
 }
 
 /// AVX2 registers for [`Lanes`]. The methods are `#[inline(always)]` and only
 /// ever run inlined into `gauss16_group_avx2`, which is entered only on a CPU
 /// with AVX2 (checked at run time), so the AVX instructions are always available.
 #[cfg(target_arch = "x86_64")]
-mod avx {
+pub(super) mod avx {
     use super::{Lanes, V};
     use std::arch::x86_64::*;
 
     #[derive(Clone, Copy)]
-    pub(super) struct F64x4(__m256d);
+    pub(in crate::integrate) struct F64x4(__m256d);
 
     // SAFETY (every unsafe block below): AVX is available, see the module docs;
     // loads and stores go through references to `[f64; 4]`, valid for 32 bytes
@@ -486,6 +494,11 @@ mod avx {
         #[inline(always)]
         fn select(mask: Self, a: Self, b: Self) -> Self {
             F64x4(unsafe { _mm256_blendv_pd(b.0, a.0, mask.0) })
+        }
+        #[inline(always)]
+        fn fma(self, b: Self, c: Self) -> Self {
+            // FMA is available wherever AVX2 is used here (both are checked).
+            F64x4(unsafe { _mm256_fmadd_pd(self.0, b.0, c.0) })
         }
     }
 }
