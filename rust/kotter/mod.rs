@@ -14,8 +14,12 @@
 //! * `√s_j4` is the principal root of `s_j4 = (s − a_j)(s − a_4)`, and
 //!   `√s_kl := √G / √s_j4` for a chosen branch `√G` of `G(s) = Π (s − a_j)`,
 //!   so that `√s_j4 √s_kl = √G` for every `j` (the cross term of (15)).
-//! * At a root `s_p` of `F` (19), the branch of `√G` is
-//!   `σ_p = −(h1 s_p² − h2 s_p + h3)/(2 h0)`, the one on which `f(s_p) = 0`.
+//! * At a root `s_p` of `F` (19), the branch of `√G` is `σ_p`, the one on
+//!   which `f(s_p) = 0` (`σ_p = −(h1 s_p² − h2 s_p + h3)/(2 h0)`; computed as
+//!   `√G(s_p)` on that branch).
+//! * The level-set constants (`s_p`, `σ_p`, `F'(s_p)`, `u`, `v`, `Δ`, `d_j`,
+//!   `α_j … δ_j`) are computed in double-double (`rust/kotter/dd.rs`) and rounded once; the
+//!   low parts of `u`, `v` are kept for `l^(p)`, `ξ`, `η` (docs/kotter.md §3).
 //! * `√F'(s_p)` principal. Order of the roots: `s1` the non-real root of
 //!   largest imaginary part, `s2` the root nearest `conj(s1)`, `s3` the
 //!   remaining root of larger imaginary part (then larger real part), `s4`
@@ -30,11 +34,13 @@ use num_complex::Complex64;
 use crate::curve::{CurvePoint, KotterCurve, WurzelPoints};
 use crate::error::{check_finite, Error, Result, SingularKind};
 
+mod dd;
+use dd::{Cdd, Dd};
+
 type C = Complex64;
 
 const ZERO: C = C::new(0.0, 0.0);
 const ONE: C = C::new(1.0, 0.0);
-const I: C = C::new(0.0, 1.0);
 
 /// `(j, k, l)` cyclic permutations of `(1, 2, 3)`, 0-based, in the order `j = 1, 2, 3`.
 pub const CYCLIC: [(usize, usize, usize); 3] = [(0, 1, 2), (1, 2, 0), (2, 0, 1)];
@@ -492,6 +498,13 @@ pub struct KotterConstants {
     pub u: [[C; 3]; 4],
     /// `v[p][j] = √s_kl(s_p) / √F'(s_p)` (coefficient of `n_j`).
     pub v: [[C; 3]; 4],
+    /// The rounding errors of `u`: `u + u_lo` is `u` to double-double
+    /// accuracy. [`l_p`] and [`xi_eta`] sum `(u + u_lo) m + (v + v_lo) n` in DD:
+    /// near the singular set `h1² = 4h0²` the two terms cancel by about the
+    /// inverse relative distance to it (docs/kotter.md §3).
+    pub u_lo: [[C; 3]; 4],
+    /// The rounding errors of `v` (see [`KotterConstants::u_lo`]).
+    pub v_lo: [[C; 3]; 4],
     /// `delta_det[p][j] = Δ_j^(p)` (25) (corrected: a 2×2 determinant), `p = 1, 2, 3`.
     pub delta_det: [[C; 3]; 3],
     /// `√d_j = (Δ_j^(1) − i Δ_j^(2)) / Δ_j^(3)` (26).
@@ -629,6 +642,47 @@ impl Level<'_> {
             }
         }
     }
+
+    /// `f'(s)` on the branch `√G = sigma`. From the state, `f' = 2 Σ_j l_j l_j'`
+    /// with `l_j` as in [`Level::f`] and, with `w_a = 1/x_j + 1/x_4`,
+    /// `w_b = 1/x_k + 1/x_l`, `w_b − w_a = (a_k − a_j)/(x_j x_k) + (a_l − a_4)/(x_l x_4)`,
+    /// `l_j' = ½ [w_a l_j + √s_kl n_j (w_b − w_a)]` or `½ [w_b l_j − √s_j4 m_j (w_b − w_a)]`
+    /// (the derivative `½ (w_a √s_j4 m_j + w_b √s_kl n_j)` regrouped so that the
+    /// two terms that cancel near `m = ∓n` at large `|s|` enter only through
+    /// `l_j`; of the two, the one whose `w` has no pole at a nearby `a_i`). The
+    /// closed form `P'(s) + h0 σ Σ_m 1/x_m` cancels there by about the relative
+    /// distance `(h1² − 4h0²)/h1²` to the singular set (docs/kotter.md §3).
+    fn df(&self, s: C, x: &[C; 4], sigma: C) -> C {
+        match self.mn {
+            Some((m, n)) => {
+                let a = self.a;
+                let mut df = ZERO;
+                for (j, &(_, k, l)) in CYCLIC.iter().enumerate() {
+                    let r = sqrt_principal(x[j] * x[3]);
+                    let q = sigma / r;
+                    let tau = if (q * r.conj()).re >= 0.0 { 1.0 } else { -1.0 };
+                    let lj = r * (m[j] + tau * n[j])
+                        + n[j] * (x[k] * x[l] - x[j] * x[3]) / (q + tau * r);
+                    // w_a = 1/x_j + 1/x_4, w_b = 1/x_k + 1/x_l; w_b − w_a from the
+                    // differences of the a's (no cancellation)
+                    let wa = ONE / x[j] + ONE / x[3];
+                    let wb = ONE / x[k] + ONE / x[l];
+                    let wba = (a[k] - a[j]) / (x[j] * x[k]) + (a[l] - a[3]) / (x[l] * x[3]);
+                    let dlj = if wa.norm() <= wb.norm() {
+                        0.5 * (wa * lj + q * n[j] * wba)
+                    } else {
+                        0.5 * (wb * lj - r * m[j] * wba)
+                    };
+                    df += 2.0 * lj * dlj;
+                }
+                df
+            }
+            None => {
+                let (_, dp) = self.p_dp(s, x);
+                dp + self.h[0] * sigma * x.iter().map(|&xm| ONE / xm).sum::<C>()
+            }
+        }
+    }
 }
 
 /// The offsets `x_m = s − a_m` with `s = a_i + t` (`i` the nearest `a`):
@@ -650,12 +704,35 @@ fn sqrt_g_near(x: &[C; 4], prev: C) -> C {
 /// A root of `F` (19) polished on its own branch, with what (20) needs there.
 struct PolishedRoot {
     s: C,
-    /// `s − a_m`, full relative accuracy.
-    x: [C; 4],
+    /// `s − a_m` in DD (exact sums from the root's offset to its nearest `a_i`).
+    x: [Cdd; 4],
     /// `σ = √G(s)` on the branch where `f(s) = 0`.
-    sigma: C,
+    sigma: Cdd,
     /// `F'(s) = f'(s) f̃(s) / (h1² − 4h0²)` with `f̃(s) = −4 h0 σ` (docs/kotter.md §3).
     fprime: C,
+    /// `√F'(s)`, principal.
+    sqrt_fprime: Cdd,
+}
+
+impl PolishedRoot {
+    /// The root of the conjugate pair's partner: every quantity conjugated,
+    /// `√F'` kept principal (`conj(√F')` is the principal root of `conj(F')`
+    /// except on the cut `F' < 0`, where both are `+i√|F'|`).
+    fn conj(&self) -> PolishedRoot {
+        let c = self.sqrt_fprime.conj();
+        let sqrt_fprime = if c.re.hi == 0.0 && c.im.hi < 0.0 {
+            c.neg()
+        } else {
+            c
+        };
+        PolishedRoot {
+            s: self.s.conj(),
+            x: self.x.map(Cdd::conj),
+            sigma: self.sigma.conj(),
+            fprime: self.fprime.conj(),
+            sqrt_fprime,
+        }
+    }
 }
 
 /// Newton's method on `f(s) = P(s) + 2 h0 √G(s)` (15) itself, on the branch
@@ -722,9 +799,7 @@ fn polish_root(lv: &Level, p_at_a: &[f64; 4], s0: C) -> PolishedRoot {
         let (t, x, sg) = cur;
         let s = ai + t;
         let (f, _) = lv.f(s, &x, sg);
-        let (_, dp) = lv.p_dp(s, &x);
-        // f' = P' + h0 G'/√G = P' + h0 σ Σ_m 1/(s − a_m)
-        let df = dp + h0 * sg * x.iter().map(|&xm| ONE / xm).sum::<C>();
+        let df = lv.df(s, &x, sg);
         let step = f / df;
         if !(step.re.is_finite() && step.im.is_finite()) {
             break;
@@ -745,14 +820,152 @@ fn polish_root(lv: &Level, p_at_a: &[f64; 4], s0: C) -> PolishedRoot {
     }
     let (t, x, sigma) = best_state;
     let s = ai + t;
-    let (_, dp) = lv.p_dp(s, &x);
-    let df = dp + h0 * sigma * x.iter().map(|&xm| ONE / xm).sum::<C>();
-    PolishedRoot {
+    let df = lv.df(s, &x, sigma);
+    let fprime = df * (-4.0 * h0 * sigma) / lv.den;
+    let plain = PolishedRoot {
         s,
-        x,
-        sigma,
-        fprime: df * (-4.0 * h0 * sigma) / lv.den,
+        x: x.map(Cdd::new),
+        sigma: Cdd::new(sigma),
+        fprime,
+        sqrt_fprime: Cdd::new(sqrt_principal(fprime)),
+    };
+    refine_dd(lv, best, t, sigma, df).unwrap_or(plain)
+}
+
+/// The root, `σ`, the offsets `s − a_m` and `√F'(s)` to double-double
+/// accuracy: one Newton step on `f` evaluated in DD from the double root
+/// (`t = s − a_i`), then `σ`, `f'` and `F' = −4h0 σ f'/(h1² − 4h0²)` in DD at
+/// the new root.
+///
+/// Why: `l^(p)`, `Δ`, `d_j` and `α_j … δ_j` are all built from `(s_p, σ_p, F'(s_p))`,
+/// and the third quadric (11) of the rounded constants holds only as well as
+/// these are consistent with each other, amplified by about `√|d_j|` for a
+/// large branch point: `F'` in double (a few ulps off) left a round trip of
+/// 3.5e-12 at `|d_1| = 1.2e7`, DD constants 5e-16 (docs/kotter.md §3). `None`
+/// when a DD value is not finite (then the double values stand).
+fn refine_dd(lv: &Level, i: usize, t: C, sigma: C, df: C) -> Option<PolishedRoot> {
+    let (h0, den) = match lv.mn {
+        Some((m, n)) => {
+            let mut h0 = Dd::ZERO;
+            let (mut dm, mut dp) = (Dd::ZERO, Dd::ZERO);
+            for j in 0..3 {
+                h0 = h0.add(Dd::prod(m[j], n[j]));
+                let (mi, pl) = (Dd::sum(m[j], -n[j]), Dd::sum(m[j], n[j]));
+                dm = dm.add(mi.mul(mi));
+                dp = dp.add(pl.mul(pl));
+            }
+            (h0, dm.mul(dp))
+        }
+        None => {
+            let [h0, h1, _, _] = *lv.h;
+            (
+                Dd::new(h0),
+                Dd::prod(h1, h1).sub(Dd::prod(h0, h0).mul_f64(4.0)),
+            )
+        }
+    };
+    let (x, sg) = offsets_dd(lv.a, i, Cdd::new(t), sigma);
+    let f = f_dd(lv, h0, &x, sg);
+    let step = f.to_c() / df;
+    if !(step.re.is_finite() && step.im.is_finite()) {
+        return None;
     }
+    let t_dd = Cdd::new(t).sub(Cdd::new(step));
+    let (x, sg) = offsets_dd(lv.a, i, t_dd, sigma);
+    let dfd = df_dd(lv, h0, &x, sg);
+    let fp = dfd.mul(sg).mul_dd(h0).mul_f64(-4.0).div_dd(den);
+    let sq = fp.sqrt();
+    let s = t_dd.add_f64(lv.a[i]);
+    let out = PolishedRoot {
+        s: s.to_c(),
+        x,
+        sigma: sg,
+        fprime: fp.to_c(),
+        sqrt_fprime: sq,
+    };
+    let finite = |z: Cdd| {
+        let (hi, lo) = (z.to_c(), Complex64::new(z.re.lo, z.im.lo));
+        hi.re.is_finite() && hi.im.is_finite() && lo.re.is_finite() && lo.im.is_finite()
+    };
+    let ok = finite(s)
+        && out.x.iter().all(|&v| finite(v))
+        && finite(sg)
+        && finite(sq)
+        && sq.to_c() != ZERO;
+    ok.then_some(out)
+}
+
+/// The offsets `x_m = s − a_m` at `s = a_i + t` (exact sums) and `√G(s)` on
+/// the branch nearest `sigma`, in DD.
+fn offsets_dd(a: &[f64; 4], i: usize, t: Cdd, sigma: C) -> ([Cdd; 4], Cdd) {
+    let x: [Cdd; 4] = std::array::from_fn(|m| {
+        if m == i {
+            t
+        } else {
+            t.add(Cdd::real(Dd::sum(a[i], -a[m])))
+        }
+    });
+    let sg = x[0].mul(x[1]).mul(x[2]).mul(x[3]).sqrt();
+    if (sg.to_c() * sigma.conj()).re < 0.0 {
+        (x, sg.neg())
+    } else {
+        (x, sg)
+    }
+}
+
+/// `P(s) = h1 s² − h2 s + h3` in DD from the offsets: from the state,
+/// `P = Σ_j (x_j x_4 m_j² + x_k x_l n_j²)` (no cancellation near a root of
+/// `G`), else from `h`.
+fn p_dd(lv: &Level, x: &[Cdd; 4]) -> Cdd {
+    match lv.mn {
+        Some((m, n)) => CYCLIC
+            .iter()
+            .enumerate()
+            .fold(Cdd::ZERO, |p, (j, &(_, k, l))| {
+                p.add(x[j].mul(x[3]).mul_dd(Dd::prod(m[j], m[j])))
+                    .add(x[k].mul(x[l]).mul_dd(Dd::prod(n[j], n[j])))
+            }),
+        None => {
+            let [_, h1, h2, h3] = *lv.h;
+            let s = x[0].add_f64(lv.a[0]);
+            s.mul_f64(h1).add_f64(-h2).mul(s).add_f64(h3)
+        }
+    }
+}
+
+/// `P'(s)` in DD (the derivative of the forms of [`p_dd`]).
+fn dp_dd(lv: &Level, x: &[Cdd; 4]) -> Cdd {
+    match lv.mn {
+        Some((m, n)) => CYCLIC
+            .iter()
+            .enumerate()
+            .fold(Cdd::ZERO, |p, (j, &(_, k, l))| {
+                p.add(x[j].add(x[3]).mul_dd(Dd::prod(m[j], m[j])))
+                    .add(x[k].add(x[l]).mul_dd(Dd::prod(n[j], n[j])))
+            }),
+        None => {
+            let [_, h1, h2, _] = *lv.h;
+            x[0].add_f64(lv.a[0]).mul_f64(2.0 * h1).add_f64(-h2)
+        }
+    }
+}
+
+/// `f = P + 2h0 σ` (15) in DD.
+///
+/// The closed forms here and in [`df_dd`] cancel near the singular set by
+/// about the relative distance `(h1² − 4h0²)/h1²` to it ([`Level::f`]), which
+/// DD absorbs: its `u²` leaves `u² h1²/(h1² − 4h0²)`, far below double
+/// precision for every state not refused by [`DEGENERATE_RTOL`].
+fn f_dd(lv: &Level, h0: Dd, x: &[Cdd; 4], sg: Cdd) -> Cdd {
+    p_dd(lv, x).add(sg.mul_dd(h0).mul_f64(2.0))
+}
+
+/// `f' = P' + h0 G'/σ` in DD (`G'/√G = σ Σ_m 1/x_m`), with
+/// `G' = (x_1 + x_2) x_3 x_4 + x_1 x_2 (x_3 + x_4)`.
+fn df_dd(lv: &Level, h0: Dd, x: &[Cdd; 4], sg: Cdd) -> Cdd {
+    let (a, b) = (x[0].mul(x[1]), x[2].mul(x[3]));
+    let dg = x[0].add(x[1]).mul(b).add(a.mul(x[2].add(x[3])));
+    dp_dd(lv, x).add(dg.mul_dd(h0).div(sg))
 }
 
 /// `h1² − 4h0² = |m − n|² |m + n|²` from the state: the difference of squares
@@ -796,13 +1009,8 @@ fn constants_impl(
     for p in 0..4 {
         // the partner of a conjugate pair is polished as the exact conjugate
         if p % 2 == 1 && s0[p] == s0[p - 1].conj() && s0[p].im != 0.0 {
-            let r = &roots[p - 1];
-            roots.push(PolishedRoot {
-                s: r.s.conj(),
-                x: r.x.map(|v| v.conj()),
-                sigma: r.sigma.conj(),
-                fprime: r.fprime.conj(),
-            });
+            let partner = roots[p - 1].conj();
+            roots.push(partner);
         } else {
             roots.push(polish_root(&lv, p_at_a, s0[p]));
         }
@@ -810,15 +1018,18 @@ fn constants_impl(
     check_repeated(&roots.iter().map(|r| r.s).collect::<Vec<_>>())?;
     let s: [C; 4] = std::array::from_fn(|p| roots[p].s);
     let scale_a = a.iter().fold(1.0f64, |m, v| m.max(v.abs()));
-    let mut sigma = [ZERO; 4];
-    let mut sqrt_fp = [ZERO; 4];
-    let mut u = [[ZERO; 3]; 4];
-    let mut v = [[ZERO; 3]; 4];
+    // Everything below is a function of (s_p, σ_p, F'(s_p)) and is carried in
+    // DD, rounded to double once at the end: the third quadric (11) of the
+    // rounded constants holds only as well as they are consistent with each
+    // other, and near the singular set Δ_j^(3) and the forms u m + v n cancel
+    // by about the inverse relative distance to it (docs/kotter.md §3).
+    let mut u = [[Cdd::ZERO; 3]; 4];
+    let mut v = [[Cdd::ZERO; 3]; 4];
+    // √(x_j x_4) of the previous root (for its conjugate partner)
+    let mut root_jd = [Cdd::ZERO; 3];
     for p in 0..4 {
-        let diff = roots[p].x;
-        sigma[p] = roots[p].sigma;
-        sqrt_fp[p] = sqrt_principal(roots[p].fprime);
-        if !(sqrt_fp[p].norm().is_finite() && sqrt_fp[p].norm() > 0.0) {
+        let sqrt_fp = roots[p].sqrt_fprime.to_c();
+        if !(sqrt_fp.norm().is_finite() && sqrt_fp.norm() > 0.0) {
             return Err(Error::InvalidArgument {
                 what: "state l",
                 reason: format!(
@@ -833,7 +1044,7 @@ fn constants_impl(
         for (j, &aj) in a.iter().enumerate() {
             // the offsets are accurate to a few ulps relative (root_offsets):
             // only a root indistinguishable from a_j in double precision is 0/0
-            if diff[j].norm() <= 4.0 * f64::EPSILON * scale_a {
+            if roots[p].x[j].to_c().norm() <= 4.0 * f64::EPSILON * scale_a {
                 return Err(Error::Singular {
                     what: "state l",
                     kind: SingularKind::CoincidingBranchPoints,
@@ -847,16 +1058,32 @@ fn constants_impl(
                 });
             }
         }
+        // The partner of a conjugate pair has the conjugate u, v, unless a
+        // principal root (of x_j x_4 or of F') lies on its cut, where both
+        // members take +i√|·|.
+        let partner = p % 2 == 1
+            && s[p].im != 0.0
+            && s[p] == s[p - 1].conj()
+            && roots[p].sqrt_fprime == roots[p - 1].sqrt_fprime.conj();
+        let x = &roots[p].x;
+        let inv_sfp = roots[p].sqrt_fprime.recip();
+        let sg_sfp = roots[p].sigma.mul(inv_sfp);
         for j in 0..3 {
-            let r = sqrt_principal(diff[j] * diff[3]);
-            u[p][j] = r / sqrt_fp[p];
-            v[p][j] = sigma[p] / r / sqrt_fp[p];
+            if partner && root_jd[j].re.hi > 0.0 {
+                u[p][j] = u[p - 1][j].conj();
+                v[p][j] = v[p - 1][j].conj();
+                continue;
+            }
+            let r = x[j].mul(x[3]).sqrt();
+            root_jd[j] = r;
+            u[p][j] = r.mul(inv_sfp);
+            v[p][j] = sg_sfp.div(r);
         }
     }
-    let mut dd = [[ZERO; 3]; 3];
+    let mut dd = [[Cdd::ZERO; 3]; 3];
     for (p, q, r) in [(0, 1, 2), (1, 2, 0), (2, 0, 1)] {
         for j in 0..3 {
-            dd[p][j] = u[q][j] * v[r][j] - u[r][j] * v[q][j];
+            dd[p][j] = u[q][j].mul(v[r][j]).sub(u[r][j].mul(v[q][j]));
         }
     }
     let mut sqrt_d = [ZERO; 3];
@@ -867,8 +1094,9 @@ fn constants_impl(
     let mut delta = [ZERO; 3];
     for j in 0..3 {
         let d3 = dd[2][j];
-        let size = (u[0][j].norm() + v[0][j].norm()) * (u[1][j].norm() + v[1][j].norm());
-        if d3.norm() <= 1e-12 * size {
+        let size = (u[0][j].to_c().norm() + v[0][j].to_c().norm())
+            * (u[1][j].to_c().norm() + v[1][j].to_c().norm());
+        if d3.to_c().norm() <= 1e-12 * size {
             return Err(Error::InvalidArgument {
                 what: "state l",
                 reason: format!(
@@ -880,18 +1108,21 @@ fn constants_impl(
         // (26) both halves: √d_j = (Δ1 − iΔ2)/Δ3 = −Δ3/(Δ1 + iΔ2), since
         // (Δ1 − iΔ2)(Δ1 + iΔ2) = −Δ3². A small (or large) d_j is a cancellation
         // in one of Δ1 ∓ iΔ2; the other, larger one keeps full accuracy.
-        let (minus, plus) = (dd[0][j] - I * dd[1][j], dd[0][j] + I * dd[1][j]);
-        sqrt_d[j] = if minus.norm() >= plus.norm() {
-            minus / d3
+        let i_d2 = dd[1][j].mul_i();
+        let (minus, plus) = (dd[0][j].sub(i_d2), dd[0][j].add(i_d2));
+        let sd = if minus.to_c().norm() >= plus.to_c().norm() {
+            minus.div(d3)
         } else {
-            -d3 / plus
+            d3.div(plus).neg()
         };
-        d[j] = sqrt_d[j] * sqrt_d[j];
+        sqrt_d[j] = sd.to_c();
+        d[j] = sd.mul(sd).to_c();
         let (u1, v1, u2, v2) = (u[0][j], v[0][j], u[1][j], v[1][j]);
-        alpha[j] = (v2 + I * v1) / (2.0 * d3);
-        beta[j] = (v2 - I * v1) / (2.0 * d3);
-        gamma[j] = -(u2 + I * u1) / (2.0 * d3);
-        delta[j] = -(u2 - I * u1) / (2.0 * d3);
+        let two_d3 = d3.mul_f64(2.0);
+        alpha[j] = v2.add(v1.mul_i()).div(two_d3).to_c();
+        beta[j] = v2.sub(v1.mul_i()).div(two_d3).to_c();
+        gamma[j] = u2.add(u1.mul_i()).div(two_d3).neg().to_c();
+        delta[j] = u2.sub(u1.mul_i()).div(two_d3).neg().to_c();
         if d[j].norm() == 0.0 || !d[j].norm().is_finite() {
             return Err(Error::InvalidArgument {
                 what: "state l",
@@ -899,6 +1130,13 @@ fn constants_impl(
             });
         }
     }
+    let round2 = |x: &[[Cdd; 3]; 4]| x.map(|row| row.map(Cdd::to_c));
+    let lo2 = |x: &[[Cdd; 3]; 4]| x.map(|row| row.map(|z| z.sub(Cdd::new(z.to_c())).to_c()));
+    let (u_lo, v_lo) = (lo2(&u), lo2(&v));
+    let (u, v) = (round2(&u), round2(&v));
+    let dd = dd.map(|row| row.map(Cdd::to_c));
+    let sigma: [C; 4] = std::array::from_fn(|p| roots[p].sigma.to_c());
+    let sqrt_fp: [C; 4] = std::array::from_fn(|p| roots[p].sqrt_fprime.to_c());
     let (a_coef, b_coef, abgd39, eps, k) = h0_structure(&alpha, &beta, &gamma, &delta, &d)?;
     Ok(KotterConstants {
         a: *a,
@@ -908,6 +1146,8 @@ fn constants_impl(
         sqrt_fprime: sqrt_fp,
         u,
         v,
+        u_lo,
+        v_lo,
         delta_det: dd,
         sqrt_d,
         d,
@@ -1068,16 +1308,30 @@ fn h0_structure(
 }
 
 /// `l^(p) = l(s_p)/√F'(s_p)` (20) for `p = 1 … 4`, on the documented branches.
+///
+/// Summed in DD from `u + u_lo`, `v + v_lo` ([`KotterConstants::u_lo`]) and
+/// rounded once: near the singular set the two terms cancel.
 pub fn l_p(k: &KotterConstants, l: &[f64; 6]) -> [[C; 3]; 4] {
-    let (m, n) = m_n(l);
-    std::array::from_fn(|p| std::array::from_fn(|j| k.u[p][j] * m[j] + k.v[p][j] * n[j]))
+    l_p_dd(k, l).map(|row| row.map(Cdd::to_c))
 }
 
-/// Kötter's vectors (22): `ξ = l^(1) + i l^(2)`, `η = l^(1) − i l^(2)`.
+fn l_p_dd(k: &KotterConstants, l: &[f64; 6]) -> [[Cdd; 3]; 4] {
+    let (m, n) = m_n(l);
+    std::array::from_fn(|p| {
+        std::array::from_fn(|j| {
+            let u = Cdd::from_parts(k.u[p][j], k.u_lo[p][j]);
+            let v = Cdd::from_parts(k.v[p][j], k.v_lo[p][j]);
+            u.mul_f64(m[j]).add(v.mul_f64(n[j]))
+        })
+    })
+}
+
+/// Kötter's vectors (22): `ξ = l^(1) + i l^(2)`, `η = l^(1) − i l^(2)` (from
+/// the DD sums of [`l_p`], rounded once).
 pub fn xi_eta(k: &KotterConstants, l: &[f64; 6]) -> ([C; 3], [C; 3]) {
-    let lp = l_p(k, l);
-    let xi = std::array::from_fn(|j| lp[0][j] + I * lp[1][j]);
-    let eta = std::array::from_fn(|j| lp[0][j] - I * lp[1][j]);
+    let lp = l_p_dd(k, l);
+    let xi = std::array::from_fn(|j| lp[0][j].add(lp[1][j].mul_i()).to_c());
+    let eta = std::array::from_fn(|j| lp[0][j].sub(lp[1][j].mul_i()).to_c());
     (xi, eta)
 }
 

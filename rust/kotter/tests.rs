@@ -449,6 +449,75 @@ fn fprime_identity_19prime() {
     }
 }
 
+/// The constants are carried in double-double (`u + u_lo`, `v + v_lo`): the
+/// identities (21) hold to DD precision, `Σ_p u_j^(p)² = Σ_p u_j^(p) v_j^(p) =
+/// Σ_p v_j^(p)² = 0` (partial fractions of the quadratics `s_j4`, `σ = −P/(2h0)`,
+/// `s_kl` over the monic quartic F) and `(l^(p))² = 0` at the state, far below
+/// the ~1e-16 that double-precision constants can reach. States: the reference
+/// top, and one of |d_1| = 1.2e7 (the round trip in double precision lost
+/// 2.5e-12 there).
+#[test]
+fn identities_21_hold_in_double_double() {
+    use super::dd::Cdd;
+    const DD_RTOL: f64 = 1e-26;
+    let cases = [
+        (A, L0),
+        (
+            [
+                -1.585310933410371,
+                -1.0457401246649016,
+                -0.133361592904932,
+                1.0419437783331729,
+            ],
+            [
+                0.8399234568268651,
+                0.9994274853880986,
+                0.14975644527013487,
+                0.4971976793654091,
+                -0.8884535144343967,
+                -1.3770246476765315,
+            ],
+        ),
+    ];
+    for (a, l) in cases {
+        let k = kotter_constants(&a, &l).unwrap();
+        let (m, n) = m_n(&l);
+        let uu = |p: usize, j: usize| Cdd::from_parts(k.u[p][j], k.u_lo[p][j]);
+        let vv = |p: usize, j: usize| Cdd::from_parts(k.v[p][j], k.v_lo[p][j]);
+        for j in 0..3 {
+            let (mut s1, mut s2, mut s3) = (Cdd::ZERO, Cdd::ZERO, Cdd::ZERO);
+            let mut size = 0.0;
+            for p in 0..4 {
+                s1 = s1.add(uu(p, j).mul(uu(p, j)));
+                s2 = s2.add(uu(p, j).mul(vv(p, j)));
+                s3 = s3.add(vv(p, j).mul(vv(p, j)));
+                size += (k.u[p][j].norm() + k.v[p][j].norm()).powi(2);
+            }
+            for s in [s1, s2, s3] {
+                assert!(
+                    s.to_c().norm() <= DD_RTOL * size,
+                    "{:e}",
+                    s.to_c().norm() / size
+                );
+            }
+        }
+        for p in 0..4 {
+            let mut sq = Cdd::ZERO;
+            let mut size = 0.0;
+            for j in 0..3 {
+                let lj = uu(p, j).mul_f64(m[j]).add(vv(p, j).mul_f64(n[j]));
+                sq = sq.add(lj.mul(lj));
+                size += (k.u[p][j].norm() * m[j].abs() + k.v[p][j].norm() * n[j].abs()).powi(2);
+            }
+            assert!(
+                sq.to_c().norm() <= DD_RTOL * size,
+                "{:e}",
+                sq.to_c().norm() / size
+            );
+        }
+    }
+}
+
 /// One branch per level set: `kotter_along` keeps the constants of `l0`,
 /// refuses a state of another level set, and `follow_order` swaps a pair back.
 #[test]

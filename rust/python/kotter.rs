@@ -102,6 +102,8 @@ fn nan_state() -> PyResult<kotter::KotterState> {
         sqrt_fprime: [n; 4],
         u: [[n; 3]; 4],
         v: [[n; 3]; 4],
+        u_lo: [[n; 3]; 4],
+        v_lo: [[n; 3]; 4],
         delta_det: [[n; 3]; 3],
         sqrt_d: [n; 3],
         d: [n; 3],

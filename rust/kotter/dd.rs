@@ -1,0 +1,338 @@
+//! Double-double ("DD") arithmetic for the level-set constants.
+//!
+//! A DD number is an unevaluated sum `hi + lo` with `|lo| ≤ ulp(hi)/2`,
+//! carrying about 106 bits. The error-free transformations are Knuth's
+//! `two_sum`, the `fast_two_sum` of Dekker (for `|a| ≥ |b|`) and the product
+//! through a fused multiply-add; the operations are the "accurate" sum and
+//! the product of Joldes, Muller and Popescu, *Tight and rigorous error bounds
+//! for basic building blocks of double-word arithmetic*, ACM TOMS 44 (2017),
+//! Algorithms 6 and 12 (relative errors ≤ 3u² and ≤ 5u²), and divisions by one
+//! correction step of the double quotient.
+//!
+//! Why: the reduction's round trip needs the roots `s_p`, `σ_p` and `F'(s_p)`
+//! consistent with each other to better than double precision when a branch
+//! point `d_j` is large (`docs/kotter.md`, "Accuracy"); they are computed in DD
+//! once per level set and rounded to double at the end.
+
+use num_complex::Complex64;
+
+/// `a + b = s + e` exactly (Knuth).
+#[inline]
+fn two_sum(a: f64, b: f64) -> (f64, f64) {
+    let s = a + b;
+    let bb = s - a;
+    (s, (a - (s - bb)) + (b - bb))
+}
+
+/// `a + b = s + e` exactly, for `|a| ≥ |b|` (or `a = 0`) (Dekker).
+#[inline]
+fn fast_two_sum(a: f64, b: f64) -> (f64, f64) {
+    let s = a + b;
+    (s, b - (s - a))
+}
+
+/// Veltkamp's splitting `a = hi + lo` into two 26-bit halves (valid for
+/// `|a| < 2^995`, far beyond the magnitudes met here).
+#[inline]
+fn split(a: f64) -> (f64, f64) {
+    let c = 134_217_729.0 * a; // 2^27 + 1
+    let hi = c - (c - a);
+    (hi, a - hi)
+}
+
+/// `a b = p + e` exactly (Dekker's product). Not `f64::mul_add`: without the
+/// `fma` target feature (the default x86-64 target) that is a library call
+/// of ~9 ns, several times the cost of these seventeen flops.
+#[inline]
+fn two_prod(a: f64, b: f64) -> (f64, f64) {
+    let p = a * b;
+    let (ah, al) = split(a);
+    let (bh, bl) = split(b);
+    (p, ((ah * bh - p) + ah * bl + al * bh) + al * bl)
+}
+
+/// A real double-double number `hi + lo`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct Dd {
+    pub hi: f64,
+    pub lo: f64,
+}
+
+impl Dd {
+    pub const ZERO: Dd = Dd { hi: 0.0, lo: 0.0 };
+
+    pub fn new(x: f64) -> Dd {
+        Dd { hi: x, lo: 0.0 }
+    }
+
+    /// `a + b` of two doubles, exactly.
+    pub fn sum(a: f64, b: f64) -> Dd {
+        let (hi, lo) = two_sum(a, b);
+        Dd { hi, lo }
+    }
+
+    /// `a b` of two doubles, exactly.
+    pub fn prod(a: f64, b: f64) -> Dd {
+        let (hi, lo) = two_prod(a, b);
+        Dd { hi, lo }
+    }
+
+    pub fn to_f64(self) -> f64 {
+        self.hi + self.lo
+    }
+
+    pub fn neg(self) -> Dd {
+        Dd {
+            hi: -self.hi,
+            lo: -self.lo,
+        }
+    }
+
+    pub fn add(self, b: Dd) -> Dd {
+        let (s, e) = two_sum(self.hi, b.hi);
+        let (t, f) = two_sum(self.lo, b.lo);
+        let (s, e) = fast_two_sum(s, e + t);
+        let (hi, lo) = fast_two_sum(s, e + f);
+        Dd { hi, lo }
+    }
+
+    pub fn sub(self, b: Dd) -> Dd {
+        self.add(b.neg())
+    }
+
+    pub fn mul(self, b: Dd) -> Dd {
+        let (p, e) = two_prod(self.hi, b.hi);
+        let e = e + (self.hi * b.lo + self.lo * b.hi);
+        let (hi, lo) = fast_two_sum(p, e);
+        Dd { hi, lo }
+    }
+
+    pub fn mul_f64(self, b: f64) -> Dd {
+        let (p, e) = two_prod(self.hi, b);
+        let (hi, lo) = fast_two_sum(p, e + self.lo * b);
+        Dd { hi, lo }
+    }
+
+    /// `self / b`: the double quotient, corrected once by the DD residual.
+    pub fn div(self, b: Dd) -> Dd {
+        let q1 = self.hi / b.hi;
+        let r = self.sub(b.mul_f64(q1));
+        let q2 = r.hi / b.hi;
+        let r = r.sub(b.mul_f64(q2));
+        let q3 = r.hi / b.hi;
+        let (hi, lo) = fast_two_sum(q1, q2);
+        Dd { hi, lo }.add(Dd::new(q3))
+    }
+}
+
+/// A complex double-double number.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct Cdd {
+    pub re: Dd,
+    pub im: Dd,
+}
+
+impl Cdd {
+    pub const ZERO: Cdd = Cdd {
+        re: Dd::ZERO,
+        im: Dd::ZERO,
+    };
+
+    pub fn new(z: Complex64) -> Cdd {
+        Cdd {
+            re: Dd::new(z.re),
+            im: Dd::new(z.im),
+        }
+    }
+
+    /// `hi + lo` from a double and its low part (as stored by the constants).
+    pub fn from_parts(hi: Complex64, lo: Complex64) -> Cdd {
+        Cdd {
+            re: Dd::sum(hi.re, lo.re),
+            im: Dd::sum(hi.im, lo.im),
+        }
+    }
+
+    pub fn conj(self) -> Cdd {
+        Cdd {
+            re: self.re,
+            im: self.im.neg(),
+        }
+    }
+
+    /// `i · self`, exactly.
+    pub fn mul_i(self) -> Cdd {
+        Cdd {
+            re: self.im.neg(),
+            im: self.re,
+        }
+    }
+
+    pub fn real(x: Dd) -> Cdd {
+        Cdd {
+            re: x,
+            im: Dd::ZERO,
+        }
+    }
+
+    /// The double nearest (to within an ulp) to the DD value.
+    pub fn to_c(self) -> Complex64 {
+        Complex64::new(self.re.to_f64(), self.im.to_f64())
+    }
+
+    pub fn neg(self) -> Cdd {
+        Cdd {
+            re: self.re.neg(),
+            im: self.im.neg(),
+        }
+    }
+
+    pub fn add(self, b: Cdd) -> Cdd {
+        Cdd {
+            re: self.re.add(b.re),
+            im: self.im.add(b.im),
+        }
+    }
+
+    pub fn sub(self, b: Cdd) -> Cdd {
+        Cdd {
+            re: self.re.sub(b.re),
+            im: self.im.sub(b.im),
+        }
+    }
+
+    /// `self + x` for a real double `x`.
+    pub fn add_f64(self, x: f64) -> Cdd {
+        Cdd {
+            re: self.re.add(Dd::new(x)),
+            im: self.im,
+        }
+    }
+
+    pub fn mul(self, b: Cdd) -> Cdd {
+        Cdd {
+            re: self.re.mul(b.re).sub(self.im.mul(b.im)),
+            im: self.re.mul(b.im).add(self.im.mul(b.re)),
+        }
+    }
+
+    pub fn mul_dd(self, x: Dd) -> Cdd {
+        Cdd {
+            re: self.re.mul(x),
+            im: self.im.mul(x),
+        }
+    }
+
+    pub fn mul_f64(self, x: f64) -> Cdd {
+        Cdd {
+            re: self.re.mul_f64(x),
+            im: self.im.mul_f64(x),
+        }
+    }
+
+    pub fn div_dd(self, x: Dd) -> Cdd {
+        Cdd {
+            re: self.re.div(x),
+            im: self.im.div(x),
+        }
+    }
+
+    /// `self · z` for a double `z`.
+    pub fn mul_c(self, z: Complex64) -> Cdd {
+        Cdd {
+            re: self.re.mul_f64(z.re).sub(self.im.mul_f64(z.im)),
+            im: self.re.mul_f64(z.im).add(self.im.mul_f64(z.re)),
+        }
+    }
+
+    /// `self / b`: the double quotient `q0` corrected by the DD residual,
+    /// `q0 + (self − b q0)/b` (the correction, ~u of `q0`, needs only double
+    /// precision).
+    pub fn div(self, b: Cdd) -> Cdd {
+        let bc = b.to_c();
+        let q0 = self.to_c() / bc;
+        let corr = self.sub(b.mul_c(q0)).to_c() / bc;
+        Cdd {
+            re: Dd::sum(q0.re, corr.re),
+            im: Dd::sum(q0.im, corr.im),
+        }
+    }
+
+    /// `1 / self`.
+    pub fn recip(self) -> Cdd {
+        Cdd::new(Complex64::new(1.0, 0.0)).div(self)
+    }
+
+    /// The principal square root (the branch of
+    /// [`crate::curve::sqrt_principal`] applied to the leading double, which
+    /// decides the side of the cut): one Newton step
+    /// `r = r0 + (z − r0²)/(2 r0)` from the double root `r0`, with `r0²`
+    /// formed exactly, doubles the number of correct digits.
+    pub fn sqrt(self) -> Cdd {
+        let r0 = crate::curve::sqrt_principal(self.to_c());
+        if r0 == Complex64::new(0.0, 0.0) {
+            return Cdd::ZERO;
+        }
+        let sq = Cdd {
+            re: Dd::prod(r0.re, r0.re).sub(Dd::prod(r0.im, r0.im)),
+            im: Dd::prod(r0.re, r0.im).mul_f64(2.0),
+        };
+        let corr = self.sub(sq).to_c() / (2.0 * r0);
+        Cdd {
+            re: Dd::sum(r0.re, corr.re),
+            im: Dd::sum(r0.im, corr.im),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Exact references: products and quotients of small integers scaled by
+    /// powers of two, and identities whose DD residual must be ~u² of the terms.
+    #[test]
+    fn dd_operations_are_double_double_accurate() {
+        let u2 = f64::EPSILON * f64::EPSILON;
+        let third = Dd::new(1.0).div(Dd::new(3.0));
+        // 3 * (1/3) - 1 to ~u²
+        let r = third.mul_f64(3.0).sub(Dd::new(1.0));
+        assert!(r.to_f64().abs() < 4.0 * u2, "{r:?}");
+        // (1 + 2^-60)² = 1 + 2^-59 + 2^-120: the 2^-59 survives, which a double loses
+        let x = Dd::sum(1.0, 2f64.powi(-60));
+        let x2 = x.mul(x).sub(Dd::new(1.0));
+        assert_eq!(x2.hi, 2f64.powi(-59));
+        // complex: (1 + i 2^-40)(1 - i 2^-40) = 1 + 2^-80
+        let z = Cdd {
+            re: Dd::new(1.0),
+            im: Dd::new(2f64.powi(-40)),
+        };
+        let zc = Cdd {
+            re: Dd::new(1.0),
+            im: Dd::new(-(2f64.powi(-40))),
+        };
+        let p = z.mul(zc);
+        assert_eq!(p.re.sub(Dd::new(1.0)).hi, 2f64.powi(-80));
+        assert_eq!(p.im.to_f64(), 0.0);
+        // sqrt: (sqrt z)² − z ~ u² |z|, principal branch
+        for w in [
+            Complex64::new(2.0, 0.0),
+            Complex64::new(-3.0, 1e-3),
+            Complex64::new(-3.0, -1e-3),
+            Complex64::new(1e-5, 7.0),
+        ] {
+            let zz = Cdd::new(w);
+            let r = zz.sqrt();
+            let back = r.mul(r).sub(zz).to_c();
+            assert!(back.norm() < 8.0 * u2 * w.norm(), "{w} {back}");
+            assert!(r.re.hi >= 0.0);
+        }
+        // division: (7 + 5i)/(3 - 2i) = (11 + 29i)/13
+        let q = Cdd::new(Complex64::new(7.0, 5.0)).div(Cdd::new(Complex64::new(3.0, -2.0)));
+        let e = q
+            .mul(Cdd::new(Complex64::new(13.0, 0.0)))
+            .sub(Cdd::new(Complex64::new(11.0, 29.0)))
+            .to_c();
+        assert!(e.norm() < 64.0 * u2, "{e}");
+    }
+}
