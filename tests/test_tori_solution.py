@@ -275,8 +275,9 @@ def test_former_outliers_map_with_status_ok():
     # The draw of tests/data/theorem_random_stats.py (seed 7): its first 300 states
     # hold two of the six states that were O(1) wrong (39, 281; the wrong
     # combination of (41), docs/errata.md). The velocity-fit guard of `solve`
-    # (status INCONSISTENT_QUOTIENTS) flagged exactly those six before the fix;
-    # now every state maps with status ok and the sampled ones match integration.
+    # (status INCONSISTENT_QUOTIENTS) flagged exactly those six before the fix.
+    # The map now takes the level-set route (no theta quotients): every state
+    # maps with status ok, and the sampled solutions match integration.
     rng = np.random.default_rng(7)
     t = np.linspace(0.0, 20.0, 41)
     for i in range(300):

@@ -197,8 +197,8 @@ mod prop {
 /// At `|dx| = 1e-14` the cubic term is 1e-14 of the linear one (~1e-22
 /// absolute), so `u(e_k) + linear term` is a reference to the rounding of
 /// the O(1) result. Given the offset, [`HyperellipticCurve::abel_near_branch`]
-/// meets it; the Abel map of the double `x = e_k + dx` sees `dx` only to
-/// `u |x|` absolute and misses the increment by ~`u |x| / |dx|` of itself.
+/// meets it. (The Abel map of the double `x = e_k + dx` sees `dx` only to
+/// `u |x|` absolute: ~`u |x| / |dx|` ≈ 1e-2 of the increment here.)
 #[test]
 fn abel_near_a_branch_point_keeps_the_local_parameter() {
     let e = [
@@ -231,20 +231,5 @@ fn abel_near_a_branch_point_keeps_the_local_parameter() {
                 want[i]
             );
         }
-        // The plain Abel map of the rounded x, on the same sheet.
-        let x = e[k] + dx;
-        let yx = h.y(x, 1);
-        let yx = if (yx * y.conj()).re < 0.0 { -yx } else { yx };
-        let plain = h.abel(x, yx).unwrap();
-        let miss = (0..2)
-            .map(|i| {
-                let d = h.reduce(&[plain[0] - want[0], plain[1] - want[1]]);
-                d[i].norm()
-            })
-            .fold(0.0f64, f64::max);
-        assert!(
-            miss > 1e3 * f64::EPSILON * size,
-            "k={k}: plain misses by {miss:e} only"
-        );
     }
 }

@@ -340,26 +340,35 @@ impl Solution {
 
     /// The velocities of the flows with coefficients `c4s` on this level set
     /// from the chain rule at auxiliary divisors ([`velocity::algebraic_rates`]),
-    /// with the sign of `G` of this solution (the one that makes the first
-    /// flow's velocity point along [`Solution::rate`] when `c4s[0]` is the
-    /// top's own `c4`; in general the sign that matches the theta-side fit of
-    /// the first flow).
+    /// in the sign convention of this solution: the first flow's velocity is
+    /// compared with the theta-side fit of the same flow at `v0`
+    /// ([`Solution::rates`]).
+    ///
+    /// Errors: those of [`velocity::algebraic_rates`], and the two routes
+    /// disagreeing on the first flow by more than [`QUOTIENT_RESIDUAL_RTOL`]
+    /// relative ([`INCONSISTENT`]). Both use the principal `G` of (42), so no
+    /// sign is flipped here: a flipped sign would be such a disagreement.
     pub fn algebraic_rates(&self, c4s: &[[f64; 6]]) -> Result<velocity::AlgebraicRates> {
-        let mut alg = velocity::algebraic_rates(
+        let alg = velocity::algebraic_rates(
             &self.kotter,
             &self.state0.curve,
             &a_periods_of(&self.curve),
             c4s,
         )?;
-        let Some(first) = c4s.first() else {
-            return Ok(alg);
-        };
-        let reference = self.rates(&[*first])?[0].0;
+        let reference = self.rates(&c4s[..1])?[0].0;
         let u = alg.rates[0];
-        if (u[0] * reference[0].conj() + u[1] * reference[1].conj()).re < 0.0 {
-            for r in alg.rates.iter_mut().chain(alg.v.iter_mut()) {
-                *r = r.map(|z| -z);
-            }
+        let dev = (u[0] - reference[0])
+            .norm()
+            .max((u[1] - reference[1]).norm());
+        let scale = reference[0].norm().max(reference[1].norm());
+        if dev.is_nan() || dev > QUOTIENT_RESIDUAL_RTOL * scale {
+            return Err(Error::InvalidArgument {
+                what: INCONSISTENT,
+                reason: format!(
+                    "the velocity by the chain rule at auxiliary divisors differs from the \
+                     theta quotients' at v0 by {dev:e} (|U| = {scale:e})"
+                ),
+            });
         }
         Ok(alg)
     }
@@ -633,7 +642,10 @@ const NEAR_BRANCH_FRACTION: f64 = 0.1;
 
 /// The Abel map of a point of the divisor: from its offsets `zd[j] = z − d_j`
 /// (full relative accuracy, [`crate::curve::WurzelPoints`]) when it is near a
-/// branch point ([`HyperellipticCurve::abel_near_branch`]), else of `z`.
+/// branch point ([`HyperellipticCurve::abel_near_branch`]), else of `z`. The
+/// two routes give the Abel map modulo the lattice, so a state moving across
+/// the threshold may see its image jump by a lattice vector (the solution's
+/// `u0` is computed once; `sol.abel` is documented modulo the lattice).
 fn abel_of_point(curve: &HyperellipticCurve, z: C, y: C, zd: &[C; 5]) -> Result<Vec<C>> {
     let b = (0..5)
         .min_by(|&i, &j| zd[i].norm().total_cmp(&zd[j].norm()))

@@ -7,8 +7,8 @@
 //!   the curve (8) and its periods, and the velocities of both flows by the
 //!   chain rule at auxiliary divisors ([`crate::solution::velocity`]). No
 //!   theta function, no divisor of `l0`, no Abel map: the frequencies are a
-//!   property of the level set, so a state whose divisor contains the point at
-//!   infinity has them too.
+//!   property of the level set. Where the divisors do not agree on the
+//!   velocities (none known), the state takes the second route.
 //! * [`flow_data`] on a [`Solution`] (`sol.torus`): `U` from the solution's
 //!   theta-side fit at `v0`, `U'` from the same equations.
 //!
@@ -22,7 +22,7 @@ use super::{
 };
 use crate::error::{Error, Result, SingularKind};
 use crate::so4;
-use crate::solution::velocity::algebraic_rates;
+use crate::solution::velocity::{algebraic_rates, NO_CONSENSUS};
 use crate::solution::{a_periods_of, level_set_curve, Solution};
 
 /// The six `c_ij` (`i < j`, state order) of `ManakovTop(a, b)` (2).
@@ -118,14 +118,25 @@ pub fn level_set_flow_data(
 }
 
 /// Status and `(ν1, ν2)` of the state `l0` of the top `(a, b)`, from the
-/// level set ([`level_set_flow_data`]).
+/// level set ([`level_set_flow_data`]); where the auxiliary divisors do not
+/// reach a consensus on the velocities (none is known), through the
+/// Theorem's solution ([`state_frequencies_theta`]).
 pub fn state_frequencies(a: &[f64; 4], b: &[f64; 4], l0: &[f64; 6]) -> MapEntry {
     let b2 = second_flow_b(a, b);
-    frequencies_of_state(l0, |l| level_set_flow_data(a, b, &b2, l), classify)
+    frequencies_of_state(
+        l0,
+        |l| match level_set_flow_data(a, b, &b2, l) {
+            Err(Error::InvalidArgument {
+                what: NO_CONSENSUS, ..
+            }) => Solution::new(a, b, l).and_then(|s| flow_data(&s, &b2)),
+            other => other,
+        },
+        classify,
+    )
 }
 
 /// [`state_frequencies`] through the Theorem's solution ([`flow_data`]):
-/// the frequencies of `sol.torus`.
+/// the frequencies of `sol.torus` (the route of `torus_of_state`).
 pub fn state_frequencies_theta(a: &[f64; 4], b: &[f64; 4], l0: &[f64; 6]) -> MapEntry {
     let b2 = second_flow_b(a, b);
     frequencies_of_state(

@@ -361,8 +361,8 @@ fn state_statuses_and_nan_policy() {
 
 mod on_the_solution {
     use super::super::solve::{
-        c_pairs, classify, flow_data, rate_for, state_frequencies, torus_of_state,
-        QUOTIENT_RESIDUAL_RTOL,
+        c_pairs, classify, flow_data, rate_for, state_frequencies, state_frequencies_theta,
+        torus_of_state, QUOTIENT_RESIDUAL_RTOL,
     };
     use super::super::*;
     use crate::error::SingularKind;
@@ -474,6 +474,23 @@ mod on_the_solution {
     /// The two routes to the frequencies (level set vs theta fit) agree to
     /// the accuracy of the reduction's constants: 3e-15 measured on 'generic'.
     const ROUTES_RTOL: f64 = 1e-12;
+
+    #[test]
+    fn the_two_routes_agree_on_the_shared_tops() {
+        // near_degenerate: its constants carry ~1e-12 (d_1 − d_2 = 3.8e-5).
+        for (n, (a, b, l0)) in SHARED.into_iter().enumerate() {
+            let tol = if n == 3 { 1e-10 } else { ROUTES_RTOL };
+            let e = state_frequencies(&a, &b, &l0);
+            let t = state_frequencies_theta(&a, &b, &l0);
+            assert_eq!((e.status, t.status), (Status::Ok, Status::Ok));
+            for k in 0..2 {
+                assert!(
+                    (e.nu[k] - t.nu[k]).abs() <= tol * t.nu[k],
+                    "{n}: {e:?} {t:?}"
+                );
+            }
+        }
+    }
 
     #[test]
     fn singular_states_get_their_codes() {
