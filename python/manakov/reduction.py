@@ -294,7 +294,8 @@ class Kotter:
         ``2 K eps = kappa sum_j c~_j (alpha_j delta_j + beta_j gamma_j)``,
         ``kappa = prod_{m=1}^3 (d_m - d4)``, ``c~_j`` of (33).
     P0 : complex
-        ``P_0 = sqrt(z1 z2)`` (27) in the curve's branch.
+        ``P_0 = sqrt(z1 z2)`` (27) in the curve's branch, ``eps_0 sqrt(z1) sqrt(z2)``
+        of the points.
     g : complex
         The factor of (37); (42) corrected: ``g = sqrt(h0/K) / (1 - eps P_0)``.
     z1, y1, z2, y2 : complex
@@ -485,9 +486,13 @@ def kotter(a: Any, b: Any, l: Any, *, errors: str = "raise") -> Kotter:
     ValueError
         Non-finite input; ``max |l_ij|`` outside :data:`STATE_RANGE` (rescale
         l); repeated ``a_i``; ``h0 = 0`` or ``h1^2 = 4 h0^2``
-        (``F`` (19) undefined or with double roots); repeated roots of ``F``;
+        (``F`` (19) undefined or with double roots), which includes every
+        state with ``(h1^2 - 4 h0^2)/h1^2 <= 1e-12``; repeated roots of ``F``;
         a root of ``F`` at some ``a_j``; coinciding branch points ``d_j`` of
-        the curve (its genus drops); ``z1 = z2``; ``1 - eps P_0 = 0``.
+        the curve (its genus drops); ``z1 = z2``; ``1 - eps P_0 = 0``. States
+        with ``1e-12 < (h1^2 - 4 h0^2)/h1^2 < 1e-10`` usually reduce but may
+        raise, naming that distance; every state farther from the singular
+        set reduces (docs/kotter.md, "Near the singular set").
     """
     a = _check_a(a)
     b = _check_b(b)

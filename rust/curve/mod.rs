@@ -54,6 +54,12 @@ use crate::error::{Error, Result};
 /// fitted absolutely.
 const REL_FLOOR: f64 = 1e-8;
 
+/// Relative residual (2-norm of the relative residuals of the six data) at
+/// which the Levenberg–Marquardt phase of the inverse map's polish hands over
+/// to Gauss–Newton, whose quadratic convergence then reaches rounding in one
+/// or two steps.
+const LM_HANDOVER: f64 = 1e-12;
+
 /// Relative residual `|y² − R(z)| / Π_j (|z| + |d_j|)` above which a point is
 /// rejected as not lying on the curve. `Π_j (|z| + |d_j|)` bounds the size of
 /// the terms of `R(z)`, so rounding in any reasonable computation of `y`
@@ -96,12 +102,21 @@ pub const CYCLIC: [(usize, usize, usize); 3] = [(1, 2, 3), (2, 3, 1), (3, 1, 2)]
 ///
 /// Computed as `t = √((|w| + |Re w|)/2)` (Kahan's formulation), which is
 /// accurate to a few ulps in both components, unlike the polar form.
+/// `|w| = √(Re w² + Im w²)` directly while the sum of squares is a normal
+/// double (error ≤ 1 ulp, as `hypot`'s), else `hypot`: libm's `hypot` costs
+/// ~250 instructions and was 40 % of the reduction's per-state time.
 pub fn sqrt_principal(w: Complex64) -> Complex64 {
     let (re, im) = (w.re, w.im + 0.0); // + 0.0 maps −0.0 to +0.0: one cut side
     if re == 0.0 && im == 0.0 {
         return Complex64::new(0.0, 0.0);
     }
-    let t = ((re.hypot(im) + re.abs()) / 2.0).sqrt();
+    let s = re * re + im * im;
+    let modulus = if s.is_normal() && s < f64::MAX {
+        s.sqrt()
+    } else {
+        re.hypot(im)
+    };
+    let t = ((modulus + re.abs()) / 2.0).sqrt();
     if re >= 0.0 {
         Complex64::new(t, im / (2.0 * t))
     } else {
@@ -170,6 +185,16 @@ pub struct WurzelPoints {
     pub zd1: [Complex64; 5],
     /// `zd2[j] = z2 − d_j`.
     pub zd2: [Complex64; 5],
+}
+
+/// A start for the inverse map of (37) ([`KotterCurve::points_from_xi_eta_fit`]):
+/// the abscissas, their offsets `z_i − d_j` from this curve's branch points and
+/// `g²`, in the units of the data (not scaled).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct InverseStart {
+    pub z: [Complex64; 2],
+    pub zd: [[Complex64; 5]; 2],
+    pub g2: Complex64,
 }
 
 /// A point `(z, y)` of the curve together with its offsets
@@ -537,6 +562,27 @@ impl KotterCurve {
         rtol: f64,
         lmap: Option<&[[Complex64; 3]; 4]>,
     ) -> Result<WurzelPoints> {
+        self.points_from_xi_eta_start(xi, eta, sqrt_c, g_ref, rtol, lmap, None)
+    }
+
+    /// [`KotterCurve::points_from_xi_eta_fit`] from a given start instead of
+    /// the closed form (30) (the polish, the branch search and the checks are
+    /// the same). The reduction passes the closed form evaluated in
+    /// double-double on its unrounded curve: near the singular set
+    /// `h1² = 4h0²` the double-precision closed form cancels by `|d_4|/|z|`
+    /// (1e13 and more) and puts a point thousands of units off, across a pair of
+    /// branch points a few units apart (docs/kotter.md, "Near the singular set").
+    #[allow(clippy::too_many_arguments)]
+    pub(crate) fn points_from_xi_eta_start(
+        &self,
+        xi: [Complex64; 3],
+        eta: [Complex64; 3],
+        sqrt_c: Option<[Complex64; 3]>,
+        g_ref: Option<Complex64>,
+        rtol: f64,
+        lmap: Option<&[[Complex64; 3]; 4]>,
+        start: Option<&InverseStart>,
+    ) -> Result<WurzelPoints> {
         check_finite_c("xi", &xi)?;
         check_finite_c("eta", &eta)?;
         if let Some(gr) = g_ref {
@@ -561,7 +607,10 @@ impl KotterCurve {
         let x: [Complex64; 3] = std::array::from_fn(|i| xi[i] / scale / sc[i]);
         let yv: [Complex64; 3] = std::array::from_fn(|i| eta[i] / scale / sc[i]);
 
-        let g2 = (0..3).map(|i| ct[i] * yv[i] * yv[i]).sum::<Complex64>() / d[4];
+        let g2 = match start {
+            Some(s) => s.g2 / (scale * scale),
+            None => (0..3).map(|i| ct[i] * yv[i] * yv[i]).sum::<Complex64>() / d[4],
+        };
         if scale == 0.0
             || g2 == Complex64::new(0.0, 0.0)
             || !(g2.re.is_finite() && g2.im.is_finite())
@@ -580,7 +629,13 @@ impl KotterCurve {
             .map(|(i, &(j, _, _))| ct[i] * d[j] * x[i] * x[i])
             .sum::<Complex64>()
             / g2;
-        let (z1, z2) = quadratic_roots(sum1, sum2)?;
+        let ((z1, z2), (zd1, zd2)) = match start {
+            Some(s) => ((s.z[0], s.z[1]), (s.zd[0], s.zd[1])),
+            None => {
+                let (z1, z2) = quadratic_roots(sum1, sum2)?;
+                ((z1, z2), (self.offsets(z1), self.offsets(z2)))
+            }
+        };
 
         let mut g = sqrt_principal(g2);
         if let Some(gr) = g_ref {
@@ -589,8 +644,12 @@ impl KotterCurve {
             }
         }
         let target: [Complex64; 6] = [x[0], x[1], x[2], yv[0], yv[1], yv[2]];
-        let yc1 = self.y(z1);
-        let yc2 = self.y(z2);
+        let canonical_y = |zd: &[Complex64; 5]| {
+            zd.iter()
+                .fold(Complex64::new(1.0, 0.0), |acc, &v| acc * sqrt_principal(v))
+        };
+        let yc1 = canonical_y(&zd1);
+        let yc2 = canonical_y(&zd2);
         let mut best = WurzelPoints {
             z1,
             y1: yc1,
@@ -599,14 +658,14 @@ impl KotterCurve {
             g,
             eps: [1; 5],
             residual: f64::INFINITY,
-            zd1: self.offsets(z1),
-            zd2: self.offsets(z2),
+            zd1,
+            zd2,
         };
         for s1 in [1.0, -1.0] {
             for s2 in [1.0, -1.0] {
                 let (y1, y2) = (yc1 * s1, yc2 * s2);
-                let r1 = self.roots(z1, y1);
-                let r2 = self.roots(z2, y2);
+                let r1 = self.roots_from_offsets(&zd1, y1);
+                let r2 = self.roots_from_offsets(&zd2, y2);
                 let w = wurzel_from_roots(&r1, &r2, z1 - z2, &[1.0; 5]);
                 for bits in 0..8u8 {
                     let e = |b: u8| if bits & (1 << b) == 0 { 1.0 } else { -1.0 };
@@ -627,8 +686,8 @@ impl KotterCurve {
                             g,
                             eps: eps.map(|v| v as i8),
                             residual: resid,
-                            zd1: self.offsets(z1),
-                            zd2: self.offsets(z2),
+                            zd1,
+                            zd2,
                         };
                     }
                 }
@@ -637,6 +696,16 @@ impl KotterCurve {
         let mut b = self.refine(best, &target, &sc, lmap);
         b.g *= scale;
         b.residual *= scale;
+        // A polish from a far start may end on the involution image of the
+        // start's sheet, (−g, −y1, −y2), which has the same (ξ, η): the
+        // documented sign of g (nearer g_ref) is restored.
+        if let Some(gr) = g_ref {
+            if (gr.conj() * b.g).re < 0.0 {
+                b.g = -b.g;
+                b.y1 = -b.y1;
+                b.y2 = -b.y2;
+            }
+        }
         if (b.z1 - b.z2).norm() <= NEAR_DOUBLE_ROOT * b.z1.norm().max(b.z2.norm()) {
             // A discriminant that vanishes in exact arithmetic is ~1e-16 after
             // rounding, so z1 - z2 ~ 1e-8: the data sit at z1 == z2, and no
@@ -740,9 +809,9 @@ impl KotterCurve {
         // The rows the polish minimises: a residual (or Jacobian column) in the
         // P-space of the six targets, mapped to l-space by `lmap` (through
         // ξ = √c P), else weighted relatively.
-        let rows = |v: &[Complex64; 6]| -> [Complex64; 6] {
+        let rows = |v: &[Complex64; 6], in_l: bool| -> [Complex64; 6] {
             match lmap {
-                Some([al, be, ga, de]) => std::array::from_fn(|q| {
+                Some([al, be, ga, de]) if in_l => std::array::from_fn(|q| {
                     let j = q % 3;
                     let (x, y) = (sc[j] * v[j], sc[j] * v[j + 3]);
                     if q < 3 {
@@ -751,12 +820,12 @@ impl KotterCurve {
                         ga[j] * x + de[j] * y
                     }
                 }),
-                None => std::array::from_fn(|i| v[i] * wt[i]),
+                _ => std::array::from_fn(|i| v[i] * wt[i]),
             }
         };
-        let obj_of = |f: &[Complex64; 6]| -> f64 {
+        let obj_of = |f: &[Complex64; 6], in_l: bool| -> f64 {
             let r: [Complex64; 6] = std::array::from_fn(|i| target[i] - f[i]);
-            rows(&r).iter().map(|v| v.norm()).fold(0.0, nan_max)
+            rows(&r, in_l).iter().map(|v| v.norm()).fold(0.0, nan_max)
         };
         let six = |r1: &[Complex64; 5], r2: &[Complex64; 5], g: Complex64| {
             let dz = dz_of(r1[b1], r2[b2]);
@@ -783,68 +852,156 @@ impl KotterCurve {
             })
         };
         let mut f = six(&r1, &r2, g);
-        let obj_start = obj_of(&f);
-        let mut obj = obj_start;
-        for _ in 0..8 {
-            if g == zero || dz_of(r1[b1], r2[b2]) == zero {
-                break;
+        let mut improved = false;
+        // Two phases. First Levenberg–Marquardt, fitting each component
+        // relative to its size (in the 2-norm), from the closed-form start,
+        // which near the singular set h1² = 4h0² can be far off (the closed form
+        // cancels by ~|d_4|/|z| there, and a point may sit between two branch
+        // points that nearly coincide); skipped when the start is already within
+        // LM_HANDOVER. Then Gauss–Newton to rounding, in the metric of (23) when
+        // `lmap` is given (it moves the components `l` is least sensitive to; see
+        // `points_from_xi_eta_fit`), else relative again (max-norm). The metric
+        // of (23) is not used from a far start: its α_j … δ_j are large and nearly
+        // dependent near the singular set, and the Gauss–Newton step ran off
+        // along the wrong direction.
+        #[derive(Clone, Copy, PartialEq)]
+        enum Phase {
+            Lm,
+            Gn,
+            GnL,
+        }
+        let last = if lmap.is_some() {
+            (Phase::GnL, 6)
+        } else {
+            (Phase::Gn, 8)
+        };
+        for (phase, iterations) in [(Phase::Lm, 40), last] {
+            let in_l = phase == Phase::GnL;
+            let sq_of = |f: &[Complex64; 6]| -> f64 {
+                let r: [Complex64; 6] = std::array::from_fn(|i| target[i] - f[i]);
+                rows(&r, false).iter().map(|v| v.norm_sqr()).sum()
+            };
+            let cost = |f: &[Complex64; 6]| {
+                if phase == Phase::Lm {
+                    sq_of(f)
+                } else {
+                    obj_of(f, in_l)
+                }
+            };
+            let mut obj = cost(&f);
+            // a start already within reach of Gauss–Newton skips LM
+            if phase == Phase::Lm && obj <= LM_HANDOVER * LM_HANDOVER {
+                continue;
             }
-            let (h1, h2) = (1e-7 * ws1, 1e-7 * ws2);
-            let mut jac = nalgebra::SMatrix::<Complex64, 6, 3>::zeros();
-            let c = |x: f64| Complex64::new(x, 0.0);
-            let fp1 = six(&moved(&r1, b1, &dd1, c(h1)), &r2, g);
-            let fm1 = six(&moved(&r1, b1, &dd1, c(-h1)), &r2, g);
-            let fp2 = six(&r1, &moved(&r2, b2, &dd2, c(h2)), g);
-            let fm2 = six(&r1, &moved(&r2, b2, &dd2, c(-h2)), g);
-            let mut rhs = nalgebra::SVector::<Complex64, 6>::zeros();
-            let col0 = rows(&std::array::from_fn(|i| (fp1[i] - fm1[i]) / (2.0 * h1)));
-            let col1 = rows(&std::array::from_fn(|i| (fp2[i] - fm2[i]) / (2.0 * h2)));
-            let col2 = rows(&std::array::from_fn(|i| f[i] / g));
-            let res = rows(&std::array::from_fn(|i| target[i] - f[i]));
-            for i in 0..6 {
-                jac[(i, 0)] = col0[i];
-                jac[(i, 1)] = col1[i];
-                jac[(i, 2)] = col2[i];
-                rhs[i] = res[i];
-            }
-            // nalgebra's SVD never returns on a NaN entry and panics on an
-            // infinite one (curves of scale 1e27 and beyond overflow here):
-            // only finite systems are solved.
-            let finite = |v: &Complex64| v.re.is_finite() && v.im.is_finite();
-            if !(jac.iter().all(finite) && rhs.iter().all(finite)) {
-                break;
-            }
-            // Columns scaled to unit norm: the solve's cut-off 1e-14 is absolute
-            // on the singular values, and the columns differ by the curve's
-            // scale (|dP/dw| against |P/g|: 1e-20 against 1 at |d| ~ 1e4), so
-            // unscaled a whole direction was dropped and the polish stalled.
-            let mut colscale = [1.0f64; 3];
-            for (cidx, cs) in colscale.iter_mut().enumerate() {
-                let nrm = jac.column(cidx).norm();
-                if nrm > 0.0 && nrm.is_finite() {
-                    *cs = nrm;
-                    for i in 0..6 {
-                        jac[(i, cidx)] /= nrm;
+            let mut mu = 1e-3;
+            for _ in 0..iterations {
+                if g == zero || dz_of(r1[b1], r2[b2]) == zero {
+                    break;
+                }
+                let (h1, h2) = (1e-7 * ws1, 1e-7 * ws2);
+                let mut jac = nalgebra::SMatrix::<Complex64, 6, 3>::zeros();
+                let c = |x: f64| Complex64::new(x, 0.0);
+                let fp1 = six(&moved(&r1, b1, &dd1, c(h1)), &r2, g);
+                let fm1 = six(&moved(&r1, b1, &dd1, c(-h1)), &r2, g);
+                let fp2 = six(&r1, &moved(&r2, b2, &dd2, c(h2)), g);
+                let fm2 = six(&r1, &moved(&r2, b2, &dd2, c(-h2)), g);
+                let mut rhs = nalgebra::SVector::<Complex64, 6>::zeros();
+                let col0 = rows(
+                    &std::array::from_fn(|i| (fp1[i] - fm1[i]) / (2.0 * h1)),
+                    in_l,
+                );
+                let col1 = rows(
+                    &std::array::from_fn(|i| (fp2[i] - fm2[i]) / (2.0 * h2)),
+                    in_l,
+                );
+                let col2 = rows(&std::array::from_fn(|i| f[i] / g), in_l);
+                let res = rows(&std::array::from_fn(|i| target[i] - f[i]), in_l);
+                for i in 0..6 {
+                    jac[(i, 0)] = col0[i];
+                    jac[(i, 1)] = col1[i];
+                    jac[(i, 2)] = col2[i];
+                    rhs[i] = res[i];
+                }
+                // nalgebra's SVD never returns on a NaN entry and panics on an
+                // infinite one (curves of scale 1e27 and beyond overflow here):
+                // only finite systems are solved.
+                let finite = |v: &Complex64| v.re.is_finite() && v.im.is_finite();
+                if !(jac.iter().all(finite) && rhs.iter().all(finite)) {
+                    break;
+                }
+                // Columns scaled to unit norm: the solve's cut-off 1e-14 is absolute
+                // on the singular values, and the columns differ by the curve's
+                // scale (|dP/dw| against |P/g|: 1e-20 against 1 at |d| ~ 1e4), so
+                // unscaled a whole direction was dropped and the polish stalled.
+                let mut colscale = [1.0f64; 3];
+                for (cidx, cs) in colscale.iter_mut().enumerate() {
+                    let nrm = jac.column(cidx).norm();
+                    if nrm > 0.0 && nrm.is_finite() {
+                        *cs = nrm;
+                        for i in 0..6 {
+                            jac[(i, cidx)] /= nrm;
+                        }
                     }
                 }
+                let try_step = |step: &nalgebra::SVector<Complex64, 3>, lam: f64| {
+                    let s: [Complex64; 3] = std::array::from_fn(|i| step[i] / colscale[i] * lam);
+                    let nr1 = moved(&r1, b1, &dd1, s[0]);
+                    let nr2 = moved(&r2, b2, &dd2, s[1]);
+                    let ng = g + s[2];
+                    let nf = six(&nr1, &nr2, ng);
+                    (ng, nr1, nr2, nf, cost(&nf))
+                };
+                let mut accepted = None;
+                if phase == Phase::Lm {
+                    // (JᴴJ + μ I) δ = Jᴴ r on the unit-norm columns; μ grows
+                    // until the step decreases the sum of squares, and shrinks
+                    // after a success.
+                    let jh = jac.adjoint();
+                    let (a, b) = (jh * jac, jh * rhs);
+                    for _ in 0..12 {
+                        let m = a + nalgebra::Matrix3::<Complex64>::identity() * c(mu);
+                        let Some(step) = m.lu().solve(&b) else {
+                            mu *= 4.0;
+                            continue;
+                        };
+                        let next = try_step(&step, 1.0);
+                        if !next.4.is_nan() && next.4 < obj {
+                            accepted = Some(next);
+                            mu = (mu / 3.0).max(1e-15);
+                            break;
+                        }
+                        mu *= 4.0;
+                    }
+                } else {
+                    let Ok(step) = jac.svd(true, true).solve(&rhs, 1e-14) else {
+                        break;
+                    };
+                    // The full step, else up to three halvings of it; none
+                    // decreasing the objective ends the phase (converged to
+                    // rounding, or stuck).
+                    let mut lam = 1.0;
+                    for _ in 0..4 {
+                        let next = try_step(&step, lam);
+                        if !next.4.is_nan() && next.4 < obj {
+                            accepted = Some(next);
+                            break;
+                        }
+                        lam *= 0.5;
+                    }
+                }
+                let Some(next) = accepted else {
+                    break;
+                };
+                (g, r1, r2, f, obj) = next;
+                improved = true;
+                // LM hands over to Gauss–Newton once the relative residuals are
+                // at 1e-12: a step or two from rounding.
+                if phase == Phase::Lm && obj <= LM_HANDOVER * LM_HANDOVER {
+                    break;
+                }
             }
-            let Ok(mut step) = jac.svd(true, true).solve(&rhs, 1e-14) else {
-                break;
-            };
-            for (cidx, cs) in colscale.iter().enumerate() {
-                step[cidx] /= *cs;
-            }
-            let nr1 = moved(&r1, b1, &dd1, step[0]);
-            let nr2 = moved(&r2, b2, &dd2, step[1]);
-            let ng = g + step[2];
-            let nf = six(&nr1, &nr2, ng);
-            let nobj = obj_of(&nf);
-            if nobj.is_nan() || nobj >= obj {
-                break;
-            }
-            (g, r1, r2, f, obj) = (ng, nr1, nr2, nf, nobj);
         }
-        if obj >= obj_start {
+        if !improved {
             return start;
         }
         let resid = resid_of(&f);
@@ -969,7 +1126,9 @@ fn quadratic_roots(s: Complex64, p: Complex64) -> Result<(Complex64, Complex64)>
 /// (then `r1 − r2` does not cancel).
 fn factor_quotient(r1: Complex64, r2: Complex64, dz: Complex64) -> Complex64 {
     let sum = r1 + r2;
-    if sum.norm() >= (r1 - r2).norm() && sum != Complex64::new(0.0, 0.0) {
+    // |r1 + r2| ≥ |r1 − r2| ⇔ Re(r1 conj r2) ≥ 0 (no modulus: libm's hypot was
+    // the largest cost of the inverse map)
+    if (r1 * r2.conj()).re >= 0.0 && sum != Complex64::new(0.0, 0.0) {
         cdiv(Complex64::new(1.0, 0.0), sum)
     } else {
         cdiv(r1 - r2, dz)
@@ -1026,14 +1185,17 @@ fn wurzel_from_roots(
             for i in 0..5 {
                 let term = prefix * q[i] * suffix[i + 1];
                 sum += term;
-                size_t += term.norm();
+                size_t += term.re.abs() + term.im.abs();
                 prefix *= fa[i];
             }
             // The plain difference (a − b)/(z1 − z2) rounds to u (|a| + |b|)/|z1 − z2|,
             // the telescoped sum to u Σ|terms|: take the one with the smaller bound
             // (far-apart points: the plain form, whose terms do not cancel).
             let (a, b) = (prefix, suffix[0]);
-            let size_p = (a.norm() + b.norm()) / dz.norm();
+            // both bounds from above without a modulus (1-norm over ∞-norm, each
+            // within √2 of the modulus): hypot was the largest cost here
+            let l1 = |z: Complex64| z.re.abs() + z.im.abs();
+            let size_p = (l1(a) + l1(b)) / dz.re.abs().max(dz.im.abs());
             let val = if dz != zero && size_p.is_finite() && size_p < size_t {
                 cdiv(a - b, dz)
             } else {

@@ -587,3 +587,61 @@ fn inconsistent_offsets_rejected() {
     let err = curve.wurzel_points(&p1, &p2, None).unwrap_err();
     assert!(format!("{err}").contains("offset"));
 }
+
+/// A curve of the shape met near the singular set `h1² = 4h0²` of the top:
+/// `|d_4| = 1.4e22` against points of `~6e7`, one point 124 from `d_1` of a
+/// pair `d_1, d_2` 298 apart (the branch points of a recorded state at
+/// `(h1² − 4h0²)/h1² = 4e-12`). The closed form (30) cancels by
+/// `|d_4|/|z| ~ 1e14` and starts the point ~130 away, on the other side of the
+/// pair; Gauss–Newton from there diverged ("no pair of points reproduces
+/// them"), the Levenberg–Marquardt phase converges, and `g` keeps the sign
+/// of `g_ref` (the polish may end on the involution image).
+#[test]
+fn inverse_converges_from_a_far_start_near_the_singular_set() {
+    let curve = KotterCurve::new(
+        c(0.0, 62599030.22251573),
+        c(0.0, 62598732.31495725),
+        c(0.0, -3602658.536126834),
+    )
+    .unwrap();
+    let (z1, z2) = (c(0.0, 62598906.33249337), c(0.0, -2154359.6293255948));
+    let g = c(5.931665132190953e-32, -5.931665132190953e-32);
+    let (xi, eta) = curve
+        .xi_eta(z1, curve.y(z1), z2, -curve.y(z2), g, None, None)
+        .unwrap();
+    let w = curve
+        .points_from_xi_eta(xi, eta, None, Some(g), INVERSE_RTOL)
+        .unwrap();
+    let (r1, r2) = if (w.z1 - z1).norm() < (w.z2 - z1).norm() {
+        (w.z1, w.z2)
+    } else {
+        (w.z2, w.z1)
+    };
+    // the points to ~1e-8 of the pair's gap: the data fix them only to their
+    // conditioning (the map is nearly flat in z across the pair)
+    assert!((r1 - z1).norm() <= 1e-8 * 298.0, "{r1} vs {z1}");
+    assert!((r2 - z2).norm() <= 1e-12 * z2.norm(), "{r2} vs {z2}");
+    assert!((w.g.conj() * g).re > 0.0);
+    let q1 = CurvePoint {
+        z: w.z1,
+        y: w.y1,
+        zd: w.zd1,
+    };
+    let q2 = CurvePoint {
+        z: w.z2,
+        y: w.y2,
+        zd: w.zd2,
+    };
+    let (xi2, eta2) = curve
+        .xi_eta_points(&q1, &q2, w.g, Some(w.eps), None)
+        .unwrap();
+    let scale = xi
+        .iter()
+        .chain(eta.iter())
+        .map(|v| v.norm())
+        .fold(0.0, f64::max);
+    for j in 0..3 {
+        assert!(close(xi2[j], xi[j], scale, BACKWARD_RTOL));
+        assert!(close(eta2[j], eta[j], scale, BACKWARD_RTOL));
+    }
+}

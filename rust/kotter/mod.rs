@@ -46,9 +46,13 @@ const ONE: C = C::new(1.0, 0.0);
 pub const CYCLIC: [(usize, usize, usize); 3] = [(0, 1, 2), (1, 2, 0), (2, 0, 1)];
 
 /// `|h1² − 4 h0²| ≤ DEGENERATE_RTOL · h1²` is treated as `h1² = 4 h0²`: the
-/// denominator of (19) vanishes. `h1² − 4h0² = |m − n|² |m + n|² ≥ 0` is a
-/// difference of rounded squares, accurate to a few ulps of `h1²`; 1e-12
-/// leaves room for that and for states given to ~12 digits.
+/// denominator of (19) vanishes. From the state, `h1² − 4h0² = |m − n|² |m + n|²`
+/// is exact to a few ulps; the bound is where the double-double level-set
+/// constants run out of digits: at `(h1² − 4h0²)/h1² = 4e-12` 2 of 600 random
+/// states fail (the inverse map of the curve); with the bound removed, 5 of 80
+/// states of the shared tops fail at 1e-14, and at 1e-16 64 of 80 fail while
+/// the others round-trip to only 5e-9 (`tests/data/kotter_singular_sweep.py`;
+/// the guaranteed range ends at [`NEAR_SINGULAR_RTOL`]).
 pub const DEGENERATE_RTOL: f64 = 1e-12;
 
 /// Roots of `F` closer than `REPEATED_ROOT_RTOL` times their scale are
@@ -304,7 +308,10 @@ fn quartic_f_den(a: &[f64; 4], h: &[f64; 4], den: f64) -> Result<[f64; 5]> {
             kind: SingularKind::SelfDual,
             reason: format!(
                 "h1^2 - 4 h0^2 = {den:e} vanishes (h1 = {h1}, h0 = {h0}; the state is \
-                 self-dual or anti-self-dual, m = +-n): F(s) (19) is not defined"
+                 self-dual or anti-self-dual, m = +-n, or at a relative distance \
+                 (h1^2 - 4 h0^2)/h1^2 = {:e} <= {DEGENERATE_RTOL:e} from it): F(s) (19) is not \
+                 defined",
+                den / (h1 * h1)
             ),
         });
     }
@@ -370,7 +377,11 @@ pub fn quartic_roots(f: &[f64; 5]) -> Result<[C; 4]> {
             }
             let w = ratio / (ONE - ratio * sum);
             z[k] -= w;
-            maxstep = maxstep.max(w.norm() / (1.0 + z[k].norm()));
+            // the ∞-norm over the 1-norm (a relative step within a factor √2 of
+            // the modulus ratio, without libm's hypot, which cost more than the
+            // iteration's arithmetic)
+            let step = w.re.abs().max(w.im.abs()) / (1.0 + z[k].re.abs() + z[k].im.abs());
+            maxstep = maxstep.max(step);
         }
         last = maxstep;
         if maxstep < 1e-15 {
@@ -511,6 +522,11 @@ pub struct KotterConstants {
     pub sqrt_d: [C; 3],
     /// `d_j` (26), the constants of Kötter's quadrics (11) and of the curve (8).
     pub d: [C; 3],
+    /// The rounding errors of `d`: `d + d_lo` is `d_j` to double-double
+    /// accuracy. [`kotter_with`] starts the inverse map of (37) from the closed
+    /// form (30) on this unrounded curve: near the singular set the closed form
+    /// cancels by `|d_4|/|z|` (docs/kotter.md, "Near the singular set").
+    pub d_lo: [C; 3],
     /// `α_j, β_j, γ_j, δ_j` of (23) in corrected form (24):
     /// `m_j = α_j ξ_j + β_j η_j`, `n_j = γ_j ξ_j + δ_j η_j`.
     pub alpha: [C; 3],
@@ -565,7 +581,47 @@ pub fn kotter_constants(a: &[f64; 4], l: &[f64; 6]) -> Result<KotterConstants> {
             })
             .sum()
     });
-    constants_impl(a, &h, &p_at_a, Some((m, n)))
+    near_singular(l, constants_impl(a, &h, &p_at_a, Some((m, n))))
+}
+
+/// States closer than `NEAR_SINGULAR_RTOL` to the singular set `h1² = 4h0²`,
+/// in the relative distance `δ = (h1² − 4h0²)/h1²` (`= |m − n|²|m + n|²/h1²`),
+/// may raise. Down to it the reduction round-trips at roundoff: all 3000 states
+/// of `tests/data/kotter_singular_sweep.py` at `δ` from 1e-10 to 1e-4 (shared,
+/// random and pinched tops), worst 2.4e-15, and 600 more at 2.5e-11; the
+/// mismatch of (42) is ≤ 3.4e-11 there (1e-6 is refused). Below it the
+/// double-double level-set constants run out of digits (`d_j` to 2e-17 at
+/// `δ = 4e-12`, the mismatch of (42) reaches 6e-9) and the inverse map of the
+/// curve starts to fail (2 of 600 states at `δ = 4e-12`; docs/kotter.md, "Near
+/// the singular set"). Below [`DEGENERATE_RTOL`] every state raises.
+pub const NEAR_SINGULAR_RTOL: f64 = 1e-10;
+
+/// `δ = (h1² − 4h0²)/h1²` from the state (`h1² − 4h0² = |m − n|²|m + n|²`,
+/// full relative accuracy).
+fn singular_distance(l: &[f64; 6]) -> f64 {
+    let (m, n) = m_n(l);
+    let h1: f64 = l.iter().map(|x| x * x).sum();
+    den_from_state(&m, &n) / (h1 * h1)
+}
+
+/// A failure of a state closer than [`NEAR_SINGULAR_RTOL`] to the singular set
+/// is reported as such (kind [`SingularKind::SelfDual`]), with the step that failed.
+fn near_singular<T>(l: &[f64; 6], r: Result<T>) -> Result<T> {
+    r.map_err(|e| {
+        let dist = singular_distance(l);
+        if matches!(e, Error::Singular { .. }) || dist.is_nan() || dist >= NEAR_SINGULAR_RTOL {
+            return e;
+        }
+        Error::Singular {
+            what: "state l",
+            kind: SingularKind::SelfDual,
+            reason: format!(
+                "it lies at relative distance (h1^2 - 4 h0^2)/h1^2 = {dist:e} from the singular \
+                 set h1^2 = 4 h0^2 (m = +-n), closer than {NEAR_SINGULAR_RTOL:e}, where the \
+                 reduction is no longer guaranteed: {e}"
+            ),
+        }
+    })
 }
 
 /// [`kotter_constants`] from the integrals `h = (h0, h1, h2, h3)` directly.
@@ -1088,6 +1144,9 @@ fn constants_impl(
     }
     let mut sqrt_d = [ZERO; 3];
     let mut d = [ZERO; 3];
+    let mut d_lo = [ZERO; 3];
+    let mut d_dd = [Cdd::ZERO; 3];
+    let mut abgd_dd = [[Cdd::ZERO; 3]; 4];
     let mut alpha = [ZERO; 3];
     let mut beta = [ZERO; 3];
     let mut gamma = [ZERO; 3];
@@ -1116,13 +1175,20 @@ fn constants_impl(
             d3.div(plus).neg()
         };
         sqrt_d[j] = sd.to_c();
-        d[j] = sd.mul(sd).to_c();
+        let dj = sd.mul(sd);
+        d[j] = dj.to_c();
+        d_lo[j] = dj.sub(Cdd::new(d[j])).to_c();
         let (u1, v1, u2, v2) = (u[0][j], v[0][j], u[1][j], v[1][j]);
         let two_d3 = d3.mul_f64(2.0);
-        alpha[j] = v2.add(v1.mul_i()).div(two_d3).to_c();
-        beta[j] = v2.sub(v1.mul_i()).div(two_d3).to_c();
-        gamma[j] = u2.add(u1.mul_i()).div(two_d3).neg().to_c();
-        delta[j] = u2.sub(u1.mul_i()).div(two_d3).neg().to_c();
+        abgd_dd[0][j] = v2.add(v1.mul_i()).div(two_d3);
+        abgd_dd[1][j] = v2.sub(v1.mul_i()).div(two_d3);
+        abgd_dd[2][j] = u2.add(u1.mul_i()).div(two_d3).neg();
+        abgd_dd[3][j] = u2.sub(u1.mul_i()).div(two_d3).neg();
+        d_dd[j] = dj;
+        alpha[j] = abgd_dd[0][j].to_c();
+        beta[j] = abgd_dd[1][j].to_c();
+        gamma[j] = abgd_dd[2][j].to_c();
+        delta[j] = abgd_dd[3][j].to_c();
         if d[j].norm() == 0.0 || !d[j].norm().is_finite() {
             return Err(Error::InvalidArgument {
                 what: "state l",
@@ -1137,7 +1203,9 @@ fn constants_impl(
     let dd = dd.map(|row| row.map(Cdd::to_c));
     let sigma: [C; 4] = std::array::from_fn(|p| roots[p].sigma.to_c());
     let sqrt_fp: [C; 4] = std::array::from_fn(|p| roots[p].sqrt_fprime.to_c());
-    let (a_coef, b_coef, abgd39, eps, k) = h0_structure(&alpha, &beta, &gamma, &delta, &d)?;
+    let kk = k_keps_dd(&abgd_dd, &d_dd);
+    let (a_coef, b_coef, abgd39, eps, k) =
+        h0_structure(&alpha, &beta, &gamma, &delta, &d, Some(kk))?;
     Ok(KotterConstants {
         a: *a,
         h: *h,
@@ -1151,6 +1219,7 @@ fn constants_impl(
         delta_det: dd,
         sqrt_d,
         d,
+        d_lo,
         alpha,
         beta,
         gamma,
@@ -1164,6 +1233,44 @@ fn constants_impl(
 }
 
 type H0Structure = ([C; 3], [C; 3], [C; 4], C, C);
+
+/// `K`, `2Kε` and `K/κ` of the corrected (40) (the closed forms of
+/// [`h0_structure`]) evaluated in DD from the DD `α_j … δ_j` (`abgd`) and `d_j`,
+/// rounded once. Near the singular set `d_4` dominates the `d_j` by 1e15 and
+/// more, so `w_j = 1/(d_j − d_4)` agree to ~`|d_j|/|d_4|` and the slope
+/// `2Kε = (q_j − q_k)/(w_j − w_k)` divides a difference of nearly equal `q_j`
+/// by one of nearly equal `w_j`: in double both are rounding noise (ε came out
+/// NaN at `d_4 ~ 1e26`); `w_j − w_k = (d_k − d_j)/((d_j − d_4)(d_k − d_4))` and DD
+/// `q_j` keep them.
+fn k_keps_dd(abgd: &[[Cdd; 3]; 4], d: &[Cdd; 3]) -> (C, C, C) {
+    let [al, be, ga, de] = abgd;
+    let d4 = d[0].mul(d[1]).mul(d[2]);
+    let dm4: [Cdd; 3] = std::array::from_fn(|j| d[j].sub(d4));
+    let kappa = dm4[0].mul(dm4[1]).mul(dm4[2]);
+    let mut k_over_kappa = Cdd::ZERO;
+    for (j, &(_, kk, ll)) in CYCLIC.iter().enumerate() {
+        let ct = d[j].sub(d[kk]).mul(d[j].sub(d[ll])).recip();
+        k_over_kappa = k_over_kappa.add(ct.mul(d[j]).mul(be[j].mul(de[j])));
+    }
+    let dw = |j: usize, k: usize| d[k].sub(d[j]).div(dm4[j].mul(dm4[k]));
+    let (pj, pk) = [(0, 1), (0, 2), (1, 2)]
+        .into_iter()
+        .max_by(|&(a, b), &(c, e)| {
+            dw(a, b)
+                .to_c()
+                .norm()
+                .partial_cmp(&dw(c, e).to_c().norm())
+                .unwrap_or(std::cmp::Ordering::Equal)
+        })
+        .unwrap_or((0, 1));
+    let q = |j: usize| al[j].mul(de[j]).add(be[j].mul(ga[j]));
+    let k_eps = q(pj).sub(q(pk)).div(dw(pj, pk)).mul_f64(0.5);
+    (
+        kappa.mul(k_over_kappa).to_c(),
+        k_eps.to_c(),
+        k_over_kappa.to_c(),
+    )
+}
 
 /// (38)–(40): `H0 = Σ_j m_j n_j` as a quadratic form in `ξ, η`, reduced modulo
 /// Kötter's quadrics (11), all in closed form.
@@ -1195,6 +1302,7 @@ fn h0_structure(
     gamma: &[C; 3],
     delta: &[C; 3],
     d: &[C; 3],
+    k_dd: Option<(C, C, C)>,
 ) -> Result<H0Structure> {
     let d4 = d[0] * d[1] * d[2];
     let ac: [C; 3] = std::array::from_fn(|j| alpha[j] * gamma[j]);
@@ -1236,8 +1344,14 @@ fn h0_structure(
     // κ = Π (d_m − d4) (docs/kotter.md §7).
     let kappa = (d[0] - d4) * (d[1] - d4) * (d[2] - d4);
     // K/κ directly (no division by κ, which vanishes when some d_j = d4).
-    let k_over_kappa: C = (0..3).map(|j| ct[j] * d[j] * cc[j]).sum::<C>();
-    let k = kappa * k_over_kappa;
+    let k_over_kappa: C = match k_dd {
+        Some((_, _, kok)) => kok,
+        None => (0..3).map(|j| ct[j] * d[j] * cc[j]).sum::<C>(),
+    };
+    let k = match k_dd {
+        Some((k, _, _)) => k,
+        None => kappa * k_over_kappa,
+    };
     // 2Kε: (d_j − d4) q_j is of degree 1 in d_j, so two nodes suffice and the
     // symmetric three-node form κ Σ c̃_j q_j equals the slope
     // (q_j − q_k)/(w_j − w_k), w_j = 1/(d_j − d4), through any pair. The pair with
@@ -1253,7 +1367,10 @@ fn h0_structure(
                 best
             }
         });
-    let k_eps: C = 0.5 * (bc[pj] - bc[pk]) / (w[pj] - w[pk]);
+    let k_eps: C = match k_dd {
+        Some((_, ke, _)) => ke,
+        None => 0.5 * (bc[pj] - bc[pk]) / (w[pj] - w[pk]),
+    };
     let eps = k_eps / k;
     // The perfect square of (40), (Kε)² = K · Kε², with Kε² d4 = κ Σ c̃_j p_j;
     // relative to the size of the terms (the sum cancels when two d_j are close).
@@ -1380,6 +1497,69 @@ fn real_state(k: &Coefficients23, xi: &[C; 3], eta: &[C; 3]) -> Result<[f64; 6]>
     Ok(l_from_m_n(&m, &n))
 }
 
+/// The start of the inverse map of (37) and `P_0` of (31b), from the closed
+/// forms of the curve module (`g² = Σ_j c̃_j Y_j²/d_4` (30a),
+/// `z1 + z2 = d_4 + Σ_j c̃_j X_j²/g²`, `z1 z2 = Σ_j c̃_j d_j X_j²/g²` (30b),
+/// `g² P_0 = −Σ_j c̃_j X_j Y_j` (31b), `X_j = ξ_j/√c_j`, `Y_j = η_j/√c_j`), evaluated
+/// in DD on the unrounded curve `d + d_lo` from the DD `ξ, η`. Near the singular
+/// set these sums cancel by `|d_4|/|z|` (1e13 and more: `d_4 ~ 1e19` against
+/// points `~1e7`), so in double precision they put a point thousands of units
+/// off, across a pair of branch points a few units apart; in DD they leave
+/// ~`u² |d_4|/|z|`. The offsets are taken from the rounded curve's branch
+/// points. `None` when a value is not finite (then the double-precision
+/// closed forms stand).
+fn inverse_start(
+    k: &KotterConstants,
+    curve: &KotterCurve,
+    xi: &[Cdd; 3],
+    eta: &[Cdd; 3],
+) -> Option<(crate::curve::InverseStart, C)> {
+    let d: [Cdd; 3] = std::array::from_fn(|j| Cdd::from_parts(k.d[j], k.d_lo[j]));
+    let d4 = d[0].mul(d[1]).mul(d[2]);
+    let sc_round = curve.c().map(sqrt_principal);
+    let mut ct = [Cdd::ZERO; 3];
+    let mut x = [Cdd::ZERO; 3];
+    let mut y = [Cdd::ZERO; 3];
+    for (j, &(_, kk, ll)) in CYCLIC.iter().enumerate() {
+        ct[j] = d[j].sub(d[kk]).mul(d[j].sub(d[ll])).recip();
+        let mut sc = d[j].sub(d4).mul(ct[j]).sqrt();
+        // the curve's branch of √c_j (principal of the rounded c_j)
+        if (sc.to_c() * sc_round[j].conj()).re < 0.0 {
+            sc = sc.neg();
+        }
+        x[j] = xi[j].div(sc);
+        y[j] = eta[j].div(sc);
+    }
+    let sum = |f: &dyn Fn(usize) -> Cdd| (0..3).fold(Cdd::ZERO, |acc, j| acc.add(f(j)));
+    let g2 = sum(&|j| ct[j].mul(y[j]).mul(y[j])).div(d4);
+    let s1 = d4.add(sum(&|j| ct[j].mul(x[j]).mul(x[j])).div(g2));
+    let s2 = sum(&|j| ct[j].mul(d[j]).mul(x[j]).mul(x[j])).div(g2);
+    let p0 = sum(&|j| ct[j].mul(x[j]).mul(y[j])).div(g2).neg();
+    // roots of z² − s1 z + s2, the larger first, without cancellation
+    let sq = s1.mul(s1).sub(s2.mul_f64(4.0)).sqrt();
+    let q = if (s1.to_c().conj() * sq.to_c()).re >= 0.0 {
+        s1.add(sq)
+    } else {
+        s1.sub(sq)
+    };
+    let z1 = q.mul_f64(0.5);
+    let z2 = s2.div(z1);
+    let bp = curve.branch_points();
+    let offsets = |z: Cdd| -> [C; 5] { bp.map(|b| z.sub(Cdd::new(b)).to_c()) };
+    let start = crate::curve::InverseStart {
+        z: [z1.to_c(), z2.to_c()],
+        zd: [offsets(z1), offsets(z2)],
+        g2: g2.to_c(),
+    };
+    let finite = |v: &C| v.re.is_finite() && v.im.is_finite();
+    let ok = start.z.iter().all(finite)
+        && start.zd.iter().flatten().all(finite)
+        && finite(&start.g2)
+        && start.g2 != ZERO
+        && finite(&p0.to_c());
+    ok.then_some((start, p0.to_c()))
+}
+
 /// Tolerance passed to the inverse map of the curve module
 /// ([`KotterCurve::points_from_xi_eta`]): exact data reproduce `(ξ, η)` to
 /// ~1e-14 relative on well-conditioned curves, to ~1e-7 when two branch
@@ -1436,35 +1616,75 @@ pub fn kotter(a: &[f64; 4], l: &[f64; 6]) -> Result<KotterState> {
 /// (e.g. along a trajectory). The constants must belong to `l`'s level set.
 pub fn kotter_with(constants: KotterConstants, l: &[f64; 6]) -> Result<KotterState> {
     check_finite("l", l)?;
-    let lp = l_p(&constants, l);
-    let (xi, eta) = xi_eta(&constants, l);
+    near_singular(l, kotter_with_impl(constants, l))
+}
+
+fn kotter_with_impl(constants: KotterConstants, l: &[f64; 6]) -> Result<KotterState> {
+    let lp_dd = l_p_dd(&constants, l);
+    let lp = lp_dd.map(|row| row.map(Cdd::to_c));
+    let xi_dd: [Cdd; 3] = std::array::from_fn(|j| lp_dd[0][j].add(lp_dd[1][j].mul_i()));
+    let eta_dd: [Cdd; 3] = std::array::from_fn(|j| lp_dd[0][j].sub(lp_dd[1][j].mul_i()));
+    let (xi, eta) = (xi_dd.map(Cdd::to_c), eta_dd.map(Cdd::to_c));
     let [d1, d2, d3] = constants.d;
     let curve = KotterCurve::new(d1, d2, d3)?;
-    let ct = curve.c_tilde();
-    let sc = curve.c().map(sqrt_principal);
-    let d4 = curve.branch_points()[4];
-    let x: [C; 3] = std::array::from_fn(|j| xi[j] / sc[j]);
-    let y: [C; 3] = std::array::from_fn(|j| eta[j] / sc[j]);
-    let g2: C = (0..3).map(|j| ct[j] * y[j] * y[j]).sum::<C>() / d4;
-    let g2p0: C = -(0..3).map(|j| ct[j] * x[j] * y[j]).sum::<C>();
-    let p0 = g2p0 / g2;
-    let one_m = ONE - constants.eps * p0;
-    let size = 1.0 + (constants.eps * p0).norm();
-    if one_m.norm().is_nan() || one_m.norm() <= 1e-12 * size {
-        return Err(Error::InvalidArgument {
-            what: "state l",
-            reason: format!("1 - eps P_0 = {one_m} vanishes: g (42) is infinite at this state"),
-        });
-    }
-    let g42 = sqrt_principal(C::new(constants.h[0], 0.0) / constants.k) / one_m;
+    let start = inverse_start(&constants, &curve, &xi_dd, &eta_dd);
+    let p0 = match &start {
+        Some((_, p0)) => *p0,
+        None => {
+            let ct = curve.c_tilde();
+            let sc = curve.c().map(sqrt_principal);
+            let d4 = curve.branch_points()[4];
+            let x: [C; 3] = std::array::from_fn(|j| xi[j] / sc[j]);
+            let y: [C; 3] = std::array::from_fn(|j| eta[j] / sc[j]);
+            let g2: C = (0..3).map(|j| ct[j] * y[j] * y[j]).sum::<C>() / d4;
+            let g2p0: C = -(0..3).map(|j| ct[j] * x[j] * y[j]).sum::<C>();
+            g2p0 / g2
+        }
+    };
+    let g42_at = |p0: C| -> Result<C> {
+        let one_m = ONE - constants.eps * p0;
+        let size = 1.0 + (constants.eps * p0).norm();
+        if !(one_m.re.is_finite() && one_m.im.is_finite()) {
+            return Err(Error::InvalidArgument {
+                what: "state l",
+                reason: format!(
+                    "1 - eps P_0 is not finite (eps = {}, P_0 = {p0}): g (42) is undefined",
+                    constants.eps
+                ),
+            });
+        }
+        if one_m.norm() <= 1e-12 * size {
+            return Err(Error::InvalidArgument {
+                what: "state l",
+                reason: format!("1 - eps P_0 = {one_m} vanishes: g (42) is infinite at this state"),
+            });
+        }
+        Ok(sqrt_principal(C::new(constants.h[0], 0.0) / constants.k) / one_m)
+    };
+    // The sign of g from (42) at the closed-form P_0 (31b); the consistency
+    // check at P_0 of the polished points: near the singular set the closed
+    // form cancels like the start of the inverse map (to ~1e-6 at
+    // (h1² − 4h0²)/h1² = 4e-12), while P_0 = eps_0 √z1 √z2 of the points is
+    // accurate.
+    let g_sign = g42_at(p0)?;
     let lmap = [
         constants.alpha,
         constants.beta,
         constants.gamma,
         constants.delta,
     ];
-    let points =
-        curve.points_from_xi_eta_fit(xi, eta, None, Some(g42), UNIFORM_RTOL, Some(&lmap))?;
+    let points = curve.points_from_xi_eta_start(
+        xi,
+        eta,
+        None,
+        Some(g_sign),
+        UNIFORM_RTOL,
+        Some(&lmap),
+        start.as_ref().map(|(s, _)| s),
+    )?;
+    let p0 =
+        f64::from(points.eps[0]) * sqrt_principal(points.zd1[0]) * sqrt_principal(points.zd2[0]);
+    let g42 = g42_at(p0)?;
     let mis = (points.g - g42).norm();
     if mis.is_nan() || mis > G42_RTOL * g42.norm() {
         return Err(Error::InvalidArgument {

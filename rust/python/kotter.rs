@@ -107,6 +107,7 @@ fn nan_state() -> PyResult<kotter::KotterState> {
         delta_det: [[n; 3]; 3],
         sqrt_d: [n; 3],
         d: [n; 3],
+        d_lo: [n; 3],
         alpha: [n; 3],
         beta: [n; 3],
         gamma: [n; 3],
