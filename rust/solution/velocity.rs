@@ -212,7 +212,7 @@ fn state_jet(
         (v, [d1, d2])
     };
     let den = ONE - k.eps * p[0];
-    if den.norm() < POLE_MARGIN {
+    if den.norm_sqr() < POLE_MARGIN * POLE_MARGIN {
         return None;
     }
     let g = big_g / den;
@@ -250,7 +250,7 @@ fn level_residual(a: &[f64; 4], h: &[f64; 4], l: &[C; 6]) -> f64 {
     let am = a.iter().fold(0.0f64, |m, x| m.max(x.abs())).max(1.0);
     let w = [1.0, 1.0, 2.0 * am, am * am];
     (0..4)
-        .map(|q| (hl[q] - h[q]).norm() / (size * w[q]))
+        .map(|q| (hl[q] - h[q]).norm_sqr().sqrt() / (size * w[q]))
         .fold(0.0f64, f64::max)
 }
 
@@ -341,11 +341,12 @@ pub fn algebraic_rates(
     };
     let agree = |x: &Candidate, y: &Candidate| {
         x.u.iter().zip(&y.u).all(|(p, q)| {
-            let s = p[0]
-                .norm()
-                .max(p[1].norm())
-                .max(q[0].norm().max(q[1].norm()));
-            (p[0] - q[0]).norm().max((p[1] - q[1]).norm()) <= AGREE_RTOL * s
+            // squared moduli: no libm hypot in the per-state path
+            let s2 = p[0]
+                .norm_sqr()
+                .max(p[1].norm_sqr())
+                .max(q[0].norm_sqr().max(q[1].norm_sqr()));
+            (p[0] - q[0]).norm_sqr().max((p[1] - q[1]).norm_sqr()) <= AGREE_RTOL * AGREE_RTOL * s2
         })
     };
     let best = |cands: &[Candidate]| {
@@ -370,9 +371,10 @@ pub fn algebraic_rates(
                 origin + C::new(a1, b1) * scale,
                 origin + C::new(a2, b2) * scale,
             ];
-            let clear = (z[0] - z[1]).norm() >= MIN_DISTANCE * scale
+            let min2 = (MIN_DISTANCE * scale).powi(2);
+            let clear = (z[0] - z[1]).norm_sqr() >= min2
                 && z.iter()
-                    .all(|zi| d.iter().all(|dm| (zi - dm).norm() >= MIN_DISTANCE * scale));
+                    .all(|zi| d.iter().all(|dm| (zi - dm).norm_sqr() >= min2));
             if !clear {
                 continue;
             }
