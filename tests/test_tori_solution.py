@@ -33,9 +33,9 @@ FLOW_PERIOD_RTOL = {"near_degenerate": 1e-9}
 FRACTION_MIN = 1e-6
 # The frequency map's route (level set: U, U' by the chain rule at auxiliary
 # divisors) and the solution's (U from the theta quotients at v0) agree to the
-# accuracy of the reduction's constants: ~1e-15 measured on generic, physical
-# and wide; 1e-11 on near_degenerate, whose d_1, d_2 are 3.8e-5 apart (the
-# constants are conditioned like u/|d_1 - d_2|², docs/kotter.md).
+# accuracy of the reduction's constants, relative to max(nu1, nu2) (the NAFF
+# checks' measure): ~1e-15 measured on generic, physical and wide; 1e-11 on
+# near_degenerate, whose d_1, d_2 are 3.8e-5 apart.
 ROUTES_RTOL = {"near_degenerate": 1e-10}
 ROUTES_RTOL_DEFAULT = 1e-13
 
@@ -171,7 +171,8 @@ def test_solution_torus_api(name):
     np.testing.assert_allclose(sol.angles([0.0, 3.0]), [[0, 0], np.mod(3 * nu, 1)], atol=1e-14)
     fm = tori.frequency_map(top, l0)
     assert fm.status == tori.OK
-    np.testing.assert_allclose(fm.nu, nu, rtol=ROUTES_RTOL.get(name, ROUTES_RTOL_DEFAULT))
+    tol = ROUTES_RTOL.get(name, ROUTES_RTOL_DEFAULT)
+    np.testing.assert_allclose(fm.nu, nu, rtol=0, atol=tol * np.max(nu))
 
 
 def test_frequency_map_shapes_and_status_codes():
@@ -242,7 +243,8 @@ SINGULAR_STATES = [
         # The root's digits belong to the root finder: start and end only.
         (
             "invalid state l: F(s) (19) has a repeated root s = 5.28842287",
-            "(|s_1 - s_4| = 4.6",
+            # (the separation of a double root is rounding noise: no digits)
+            "(|s_1 - s_4| = ",
             "e-7): l^(p) (20) divides by sqrt(F'(s_p)) = 0",
         ),
         tori.COINCIDING_BRANCH_POINTS,
