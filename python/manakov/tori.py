@@ -86,9 +86,9 @@ INCONSISTENT_QUOTIENTS = 11
 #: See docs/tori.md for the measurement behind both defaults.
 LOCAL_CHUNK = 4096
 #: States per dask task: the measured per-task overhead (scheduling, shipping
-#: the chunk and the result: 9-15 ms on a LocalCluster) stays < 1 % of the
-#: ~2.5 s a chunk takes on one core at ~150 us per state (docs/tori.md).
-DASK_CHUNK = 16384
+#: the chunk and the result: 9-15 ms on a LocalCluster) stays about 1 % of the
+#: ~1.3 s a chunk takes on one core at ~40 us per state (docs/tori.md).
+DASK_CHUNK = 32768
 #: Above this many states the progress bar is shown by default (on a terminal).
 PROGRESS_MIN_STATES = 20000
 

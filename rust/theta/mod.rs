@@ -744,6 +744,7 @@ impl ThetaPlan {
     /// `Re τ = Re τ' + 2S` with `S` integer, so replacing `τ'` by `τ` in
     /// `z = z_r + p + τ'q` moves `p` by the even vector `2Sq` and `qᵀX'q` by
     /// the even `2qᵀSq`: the parities and the phase mod 2 are unchanged.
+    #[inline(always)]
     fn reduce2_lattice(&self, x: [f64; 2], y: [f64; 2]) -> Result<Reduced> {
         for (k, v) in x.iter().chain(y.iter()).enumerate() {
             if !v.is_finite() {
@@ -1156,6 +1157,7 @@ impl ThetaPlan {
         )
     }
 
+    #[inline(always)]
     fn g2_reduce(&self, pt: G2Point) -> Result<Reduced> {
         match pt {
             G2Point::Z(z) => self.reduce2::<false>(z),
