@@ -937,4 +937,4 @@ fn aux_constants_squared(
 }
 
 #[cfg(test)]
-mod tests;
+pub(crate) mod tests;

@@ -3,7 +3,7 @@ use crate::integrate::{integrate, Method, Options};
 use crate::so4::FrahmTop;
 
 /// The four shared tops of /work/shared/reference/problems.json.
-const TOPS: [([f64; 4], [f64; 4], [f64; 6]); 4] = [
+pub(crate) const TOPS: [([f64; 4], [f64; 4], [f64; 6]); 4] = [
     (
         [0.3, 1.1, 2.0, 3.7],
         [0.5, -0.2, 1.4, 0.9],

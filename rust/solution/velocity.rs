@@ -485,11 +485,9 @@ mod tests {
     use crate::kotter::kotter_constants;
     use crate::so4::{integrals4, vector_field4};
 
-    const GENERIC: ([f64; 4], [f64; 4], [f64; 6]) = (
-        [0.3, 1.1, 2.0, 3.7],
-        [0.5, -0.2, 1.4, 0.9],
-        [0.8, -0.3, 0.5, 1.1, -0.7, 0.2],
-    );
+    use crate::solution::tests::TOPS;
+
+    const GENERIC: ([f64; 4], [f64; 4], [f64; 6]) = TOPS[0];
 
     #[test]
     fn complex_field_and_integrals_match_the_real_ones() {
@@ -570,24 +568,7 @@ mod tests {
     }
 
     fn shared(n: usize) -> ([f64; 4], [f64; 4], [f64; 6]) {
-        [
-            GENERIC,
-            (
-                [1.0, 2.25, 4.84, 9.61],
-                [1.0, 1.5, 2.2, 3.1],
-                [0.4, 1.2, -0.6, 0.9, 0.3, -1.0],
-            ),
-            (
-                [0.01, 1.0, 10.0, 100.0],
-                [2.0, -1.0, 0.5, 3.0],
-                [1.0, 0.5, -0.25, 0.75, -1.5, 0.1],
-            ),
-            (
-                [1.0, 1.000001, 2.0, 3.0],
-                [0.3, 0.300002, -0.4, 1.2],
-                [0.2, -0.9, 0.4, 0.6, 1.1, -0.3],
-            ),
-        ][n]
+        TOPS[n]
     }
 
     /// The chain rule at auxiliary divisors against the solution's theta-side

@@ -368,11 +368,9 @@ mod on_the_solution {
     use crate::error::SingularKind;
     use crate::solution::Solution;
 
-    const GENERIC: ([f64; 4], [f64; 4], [f64; 6]) = (
-        [0.3, 1.1, 2.0, 3.7],
-        [0.5, -0.2, 1.4, 0.9],
-        [0.8, -0.3, 0.5, 1.1, -0.7, 0.2],
-    );
+    use crate::solution::tests::TOPS;
+
+    const GENERIC: ([f64; 4], [f64; 4], [f64; 6]) = TOPS[0];
 
     #[test]
     fn rate_for_the_tops_own_field_is_the_solutions_rate() {
@@ -417,14 +415,7 @@ mod on_the_solution {
         // U' by rate_for (the l rows of (9)–(10) at v0) against the set-up of
         // ManakovTop(a, a²) itself (its own U): the same curve and divisor
         // (the reduction depends on a and l0 only), so the same vector.
-        for (a, b, l0) in [
-            GENERIC,
-            (
-                [1.0, 2.25, 4.84, 9.61],
-                [1.0, 1.5, 2.2, 3.1],
-                [0.4, 1.2, -0.6, 0.9, 0.3, -1.0],
-            ),
-        ] {
+        for (a, b, l0) in [TOPS[0], TOPS[1]] {
             let s = Solution::new(&a, &b, &l0).unwrap();
             let b2 = a.map(|x| x * x);
             let u2 = rate_for(&s, &c_pairs(&a, &b2).unwrap()).unwrap();
@@ -587,24 +578,7 @@ mod on_the_solution {
     }
 
     /// The four shared tops (/work/shared/reference/problems.json).
-    const SHARED: [([f64; 4], [f64; 4], [f64; 6]); 4] = [
-        GENERIC,
-        (
-            [1.0, 2.25, 4.84, 9.61],
-            [1.0, 1.5, 2.2, 3.1],
-            [0.4, 1.2, -0.6, 0.9, 0.3, -1.0],
-        ),
-        (
-            [0.01, 1.0, 10.0, 100.0],
-            [2.0, -1.0, 0.5, 3.0],
-            [1.0, 0.5, -0.25, 0.75, -1.5, 0.1],
-        ),
-        (
-            [1.0, 1.000001, 2.0, 3.0],
-            [0.3, 0.300002, -0.4, 1.2],
-            [0.2, -0.9, 0.4, 0.6, 1.1, -0.3],
-        ),
-    ];
+    use crate::solution::tests::TOPS as SHARED;
 
     #[test]
     fn consistent_set_ups_fit_both_flows() {
