@@ -88,6 +88,19 @@ def test_shapes_and_attributes() -> None:
     assert sol.U.shape == (2,) and sol.u0.shape == (2,) and sol.tau.shape == (2, 2)
     np.testing.assert_allclose(sol.tau, sol.curve.tau, rtol=0, atol=1e-14)
     assert "U = [" in repr(sol) and "d = [" in repr(sol)
+
+
+@pytest.mark.parametrize("name", ["generic", "wide"])
+def test_repr_shows_the_branch_points_without_rounding_noise(name: str) -> None:
+    # generic's d_j are real with ~1e-32 imaginary noise, wide's imaginary.
+    p = manakov.problem(name)
+    sol = manakov.ManakovTop(p.a, p.b).solve(p.l0)
+    shown = repr(sol).split("d = [")[1].split("]")[0].split(", ")
+    d = sol.curve.branch_points
+    assert len(shown) == len(d)
+    for text, x in zip(shown, d):
+        assert "e-" not in text, text
+        assert abs(complex(text) - x) <= 1e-5 * max(abs(x), 1.0), (text, x)
     ch = sol.characteristics
     # chi_jk = chi_j + chi_k: P23 + P31 = P12 + 2 chi_3 ... check one closed relation
     s = [(ch["P23"][0][i] + ch["P31"][0][i] + ch["P12"][0][i]) % 2 for i in range(2)]

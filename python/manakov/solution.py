@@ -227,9 +227,23 @@ class Solution:
         return self._core.quotient()
 
     def __repr__(self) -> str:
-        d = ", ".join(f"{complex(x):.6g}" for x in self._core.branch_points)
-        u = ", ".join(f"{complex(x):.12g}" for x in self._core.rate)
+        d = ", ".join(_show(x, 6) for x in self._core.branch_points)
+        u = ", ".join(_show(x, 12) for x in self._core.rate)
         return f"Solution(curve: y^2 = prod (x - d_j), d = [{d}]; U = [{u}])"
+
+
+def _show(x: complex, digits: int) -> str:
+    """``x`` to ``digits`` significant digits, without a real or imaginary part
+    below the shown precision (rounding noise such as ``3.19+7e-32j``)."""
+    x = complex(x)
+    cut = abs(x) * 10.0 ** (-digits)
+    re = x.real if abs(x.real) > cut else 0.0
+    im = x.imag if abs(x.imag) > cut else 0.0
+    if im == 0.0:
+        return f"{re:.{digits}g}"
+    if re == 0.0:
+        return f"{im:.{digits}g}j"
+    return f"{complex(re, im):.{digits}g}"
 
 
 def plot_theorem(
