@@ -105,9 +105,15 @@ impl ChunkIn {
         }
         self.phase[p] = red.phase;
         self.logs[p] = red.log_scale;
+        self.set_signs(p, red.pbits, red.qbits);
+    }
+
+    /// The signs `(-1)^{a·p}`, `(-1)^{b·q}` of lane `p` from the parities.
+    #[inline(always)]
+    pub(super) fn set_signs(&mut self, p: usize, pbits: usize, qbits: usize) {
         for h in 0..4 {
-            self.sa[h][p] = 1.0 - 2.0 * f64::from((h & red.pbits).count_ones() & 1);
-            self.sb[h][p] = 1.0 - 2.0 * f64::from((h & red.qbits).count_ones() & 1);
+            self.sa[h][p] = 1.0 - 2.0 * f64::from((h & pbits).count_ones() & 1);
+            self.sb[h][p] = 1.0 - 2.0 * f64::from((h & qbits).count_ones() & 1);
         }
     }
 }

@@ -744,8 +744,17 @@ impl ThetaPlan {
     /// `Re τ = Re τ' + 2S` with `S` integer, so replacing `τ'` by `τ` in
     /// `z = z_r + p + τ'q` moves `p` by the even vector `2Sq` and `qᵀX'q` by
     /// the even `2qᵀSq`: the parities and the phase mod 2 are unchanged.
+    /// The reduction of a point given in lattice coordinates `z = x + τ y`,
+    /// written straight into lane `lane` of the batch kernel's input (the
+    /// hot path of `l(t)`: no [`Reduced`] is built and copied per point).
     #[inline(always)]
-    fn reduce2_lattice(&self, x: [f64; 2], y: [f64; 2]) -> Result<Reduced> {
+    fn reduce2_lattice_into(
+        &self,
+        x: [f64; 2],
+        y: [f64; 2],
+        inp: &mut batch::ChunkIn,
+        lane: usize,
+    ) -> Result<()> {
         for (k, v) in x.iter().chain(y.iter()).enumerate() {
             if !v.is_finite() {
                 return Err(Error::NonFinite {
@@ -763,22 +772,20 @@ impl ThetaPlan {
         let (rt, it) = (&self.re_tau, &self.y);
         let q = [sum::round_i64(y[0]) as f64, sum::round_i64(y[1]) as f64];
         let yr = [y[0] - q[0], y[1] - q[1]];
-        let mut red = Reduced::default();
         let mut p = [0.0; 2];
+        let mut zr_re = [0.0; 2];
         for i in 0..2 {
             let re = x[i] + rt[2 * i] * yr[0] + rt[2 * i + 1] * yr[1];
             let im = it[2 * i] * yr[0] + it[2 * i + 1] * yr[1];
             p[i] = integer_part(re, re)?;
-            red.zr[i] = Complex64::new(re - p[i], im);
+            zr_re[i] = re - p[i];
+            inp.zre[i][lane] = zr_re[i];
+            inp.zim[i][lane] = im;
+            inp.wr[i][lane] = yr[i];
         }
-        red.wr[0] = yr[0];
-        red.wr[1] = yr[1];
-        red.q[0] = q[0];
-        red.q[1] = q[1];
         let imz = [it[0] * y[0] + it[1] * y[1], it[2] * y[0] + it[3] * y[1]];
-        red.log_scale = finite_log_scale(pi() * (imz[0] * y[0] + imz[1] * y[1]))?;
-        red.prefactor = Complex64::new(1.0, 0.0);
-        if q[0] != 0.0 || q[1] != 0.0 {
+        inp.logs[lane] = finite_log_scale(pi() * (imz[0] * y[0] + imz[1] * y[1]))?;
+        inp.phase[lane] = if q[0] != 0.0 || q[1] != 0.0 {
             let xq = &self.x;
             let quad = if q[0].abs() <= 1.0 && q[1].abs() <= 1.0 {
                 // q_i q_k ∈ {−1, 0, 1}: the products are exact.
@@ -786,11 +793,16 @@ impl ThetaPlan {
             } else {
                 quad_mod2(xq, &q, 2)
             };
-            red.phase = -quad - 2.0 * (q[0] * red.zr[0].re + q[1] * red.zr[1].re);
-        }
-        red.pbits = ((p[0] as i64 & 1) << 1 | (p[1] as i64 & 1)) as usize;
-        red.qbits = ((q[0] as i64 & 1) << 1 | (q[1] as i64 & 1)) as usize;
-        Ok(red)
+            -quad - 2.0 * (q[0] * zr_re[0] + q[1] * zr_re[1])
+        } else {
+            0.0
+        };
+        inp.set_signs(
+            lane,
+            ((p[0] as i64 & 1) << 1 | (p[1] as i64 & 1)) as usize,
+            ((q[0] as i64 & 1) << 1 | (q[1] as i64 & 1)) as usize,
+        );
+        Ok(())
     }
 
     /// Genus 2, values only: 4 Walsh–Hadamard transforms of length 4 (the hot
@@ -1157,11 +1169,16 @@ impl ThetaPlan {
         )
     }
 
+    /// Reduces `pt` into lane `lane` of the batch kernel's input.
     #[inline(always)]
-    fn g2_reduce(&self, pt: G2Point) -> Result<Reduced> {
+    fn g2_reduce_into(&self, pt: G2Point, inp: &mut batch::ChunkIn, lane: usize) -> Result<()> {
         match pt {
-            G2Point::Z(z) => self.reduce2::<false>(z),
-            G2Point::Lattice(x, y) => self.reduce2_lattice(x, y),
+            G2Point::Z(z) => {
+                let red = self.reduce2::<false>(z)?;
+                inp.set(lane, &red);
+                Ok(())
+            }
+            G2Point::Lattice(x, y) => self.reduce2_lattice_into(x, y, inp, lane),
         }
     }
 
@@ -1213,8 +1230,7 @@ impl ThetaPlan {
                     inp = batch::ChunkIn::default();
                 }
                 for p in 0..m {
-                    let red = self.g2_reduce(point(i0 + p))?;
-                    inp.set(p, &red);
+                    self.g2_reduce_into(point(i0 + p), &mut inp, p)?;
                 }
                 b2.eval_chunk(self, &inp, false, want, &mut sc);
                 blk.len = m;
