@@ -600,6 +600,30 @@ mod tests {
         }
     }
 
+    /// Constants that do not belong to one level set (`α_1` off by 1e-6)
+    /// give no auxiliary state on it: the consensus refuses, naming itself,
+    /// where the true constants give a velocity.
+    #[test]
+    fn inconsistent_constants_give_no_consensus() {
+        let (a, b, l0) = GENERIC;
+        let k = kotter_constants(&a, &l0).unwrap();
+        let curve = KotterCurve::new(k.d[0], k.d[1], k.d[2]).unwrap();
+        let hc = crate::riemann::HyperellipticCurve::new(&curve.branch_points()).unwrap();
+        let ap = super::super::a_periods_of(&hc);
+        let c = crate::so4::manakov_c(&a, &b).unwrap();
+        let c4 = [c[1], c[2], c[3], c[6], c[7], c[11]];
+        let good = algebraic_rates(&k, &curve, &ap, &[c4]).unwrap();
+        assert!(good.support >= MIN_SUPPORT);
+        let mut bad = k.clone();
+        bad.alpha[0] *= 1.0 + 1e-6;
+        match algebraic_rates(&bad, &curve, &ap, &[c4]) {
+            Err(Error::InvalidArgument { what, reason }) => {
+                assert_eq!(what, NO_CONSENSUS, "{reason}");
+            }
+            other => panic!("expected no consensus, got {other:?}"),
+        }
+    }
+
     /// Any sheet of the second point gives a state on the level set and the
     /// same velocity (they differ by the involution and half periods).
     #[test]
