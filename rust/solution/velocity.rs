@@ -600,16 +600,22 @@ mod tests {
         }
     }
 
+    /// The reduction's constants, the curve (8) and its a-periods for `a, l0`.
+    fn level_set_data(a: &[f64; 4], l0: &[f64; 6]) -> (KotterConstants, KotterCurve, [C; 4]) {
+        let k = kotter_constants(a, l0).unwrap();
+        let curve = KotterCurve::new(k.d[0], k.d[1], k.d[2]).unwrap();
+        let hc = crate::riemann::HyperellipticCurve::new(&curve.branch_points()).unwrap();
+        let ap = super::super::a_periods_of(&hc);
+        (k, curve, ap)
+    }
+
     /// Constants that do not belong to one level set (`α_1` off by 1e-6)
     /// give no auxiliary state on it: the consensus refuses, naming itself,
     /// where the true constants give a velocity.
     #[test]
     fn inconsistent_constants_give_no_consensus() {
         let (a, b, l0) = GENERIC;
-        let k = kotter_constants(&a, &l0).unwrap();
-        let curve = KotterCurve::new(k.d[0], k.d[1], k.d[2]).unwrap();
-        let hc = crate::riemann::HyperellipticCurve::new(&curve.branch_points()).unwrap();
-        let ap = super::super::a_periods_of(&hc);
+        let (k, curve, ap) = level_set_data(&a, &l0);
         let c = crate::so4::manakov_c(&a, &b).unwrap();
         let c4 = [c[1], c[2], c[3], c[6], c[7], c[11]];
         let good = algebraic_rates(&k, &curve, &ap, &[c4]).unwrap();
@@ -662,10 +668,7 @@ mod tests {
     #[test]
     fn bad_flows_are_refused_and_a_zero_flow_is_at_rest() {
         let (a, _, l0) = GENERIC;
-        let k = kotter_constants(&a, &l0).unwrap();
-        let curve = KotterCurve::new(k.d[0], k.d[1], k.d[2]).unwrap();
-        let hc = crate::riemann::HyperellipticCurve::new(&curve.branch_points()).unwrap();
-        let ap = super::super::a_periods_of(&hc);
+        let (k, curve, ap) = level_set_data(&a, &l0);
         assert!(matches!(
             algebraic_rates(&k, &curve, &ap, &[]),
             Err(Error::InvalidArgument { what: "c4s", .. })
