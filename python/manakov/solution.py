@@ -128,7 +128,7 @@ class Solution:
         ValueError
             Non-finite ``t``.
         """
-        tt = _float_array(t, "t").astype(float)
+        tt = _float_array(t, "t")
         out = self._core.l(np.ascontiguousarray(tt.reshape(-1)))
         return out.reshape(tt.shape + (6,))
 
