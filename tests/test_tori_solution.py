@@ -314,7 +314,9 @@ def test_dask_frequency_map_equals_local_bit_for_bit(client):
 
 
 def test_dask_frequency_map_survives_a_killed_worker(client):
-    top, states = _slice(40)
+    # 10^4 states in 200 tasks: ~1 s of map on two workers at ~40 us per state
+    # plus the per-task overhead, so the kill at 0.2 s lands mid-map.
+    top, states = _slice(100)
     local = tori.frequency_map(top, states)
     victim = sorted(client.run(os.getpid).values())[-1]
     killed = {}
@@ -326,7 +328,7 @@ def test_dask_frequency_map_survives_a_killed_worker(client):
     timer = threading.Timer(0.2, kill)
     start = time.perf_counter()
     timer.start()
-    remote = tori.frequency_map(top, states, client=client, chunk_size=25)
+    remote = tori.frequency_map(top, states, client=client, chunk_size=50)
     end = time.perf_counter()
     timer.join()
     assert start < killed["t"] < end
