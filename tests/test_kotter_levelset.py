@@ -10,7 +10,6 @@ map along the vector field, not from the samples themselves.
 
 from __future__ import annotations
 
-import inspect
 import sys
 from functools import cache
 from pathlib import Path
@@ -139,33 +138,11 @@ def test_per_state_kotter_jumps_where_level_set_does_not() -> None:
 def _mp_roots(a: np.ndarray, l: np.ndarray) -> list:
     """Roots of F (19) and F'(s_p) = prod_{q != p} (s_p - s_q) in mpmath from the state."""
     mpmath.mp.dps = 50
-    A = [mpmath.mpf(float(x)) for x in a]
     L = [mpmath.mpf(float(x)) for x in l]
-    m = [L[3], -L[1], L[0]]
-    n = [L[2], L[4], L[5]]
-    h0 = sum(m[j] * n[j] for j in range(3))
+    _, h0, num = near.quartic([mpmath.mpf(float(x)) for x in a], L)
     h1 = sum(x * x for x in L)
-    cyc = [(0, 1, 2), (1, 2, 0), (2, 0, 1)]
-    # P(s) = sum_j s_j4 m_j^2 + s_kl n_j^2 as polynomial coefficients
-    P = [mpmath.mpf(0)] * 3
-    for j, k_, l_ in cyc:
-        for (u, w), c in (((j, 3), m[j] ** 2), ((k_, l_), n[j] ** 2)):
-            P[0] += c
-            P[1] += -c * (A[u] + A[w])
-            P[2] += c * A[u] * A[w]
-    G = [mpmath.mpf(1)]
-    for x in A:
-        G = [*G, mpmath.mpf(0)]
-        for i in range(len(G) - 1, 0, -1):
-            G[i] -= x * G[i - 1]
-    P2 = [sum(P[i] * P[k - i] for i in range(3) if 0 <= k - i <= 2) for k in range(5)]
-    num = [P2[i] - 4 * h0**2 * G[i] for i in range(5)]
     assert abs(num[0] - (h1**2 - 4 * h0**2)) < mpmath.mpf(10) ** -40
-    # mpmath >= 1.4 deprecates descending coefficients unless asc= is given.
-    if "asc" in inspect.signature(mpmath.polyroots).parameters:
-        roots = mpmath.polyroots(num[::-1], maxsteps=200, extraprec=200, asc=True)
-    else:
-        roots = mpmath.polyroots(num, maxsteps=200, extraprec=200)
+    roots = near.polyroots(num, 200)
     out = []
     for r in roots:
         fp = mpmath.fprod(r - q for q in roots if q is not r)

@@ -519,6 +519,33 @@ fn stats_forward_error() {
     );
 }
 
+/// (37) at the recovered points `w`, evaluated from their offsets,
+/// reproduces `(ξ, η)` to [`BACKWARD_RTOL`] of the largest component.
+fn assert_backward(curve: &KotterCurve, w: &WurzelPoints, xi: &[C; 3], eta: &[C; 3]) {
+    let q1 = CurvePoint {
+        z: w.z1,
+        y: w.y1,
+        zd: w.zd1,
+    };
+    let q2 = CurvePoint {
+        z: w.z2,
+        y: w.y2,
+        zd: w.zd2,
+    };
+    let (xi2, eta2) = curve
+        .xi_eta_points(&q1, &q2, w.g, Some(w.eps), None)
+        .unwrap();
+    let scale = xi
+        .iter()
+        .chain(eta.iter())
+        .map(|v| v.norm())
+        .fold(0.0, f64::max);
+    for j in 0..3 {
+        assert!(close(xi2[j], xi[j], scale, BACKWARD_RTOL));
+        assert!(close(eta2[j], eta[j], scale, BACKWARD_RTOL));
+    }
+}
+
 /// A point 1e-11 from the branch point `d_1` (offsets exact by construction):
 /// the inverse map returns offsets `zd` that resolve it — the offset to `d_1`
 /// comes back to 1e-8 relative (a double `z` alone fixes it only to
@@ -550,28 +577,7 @@ fn inverse_resolves_points_near_branch_points() {
         w.zd2[1]
     };
     assert!((zd_near - t).norm() <= 1e-8 * t.norm(), "{zd_near} vs {t}");
-    let q1 = CurvePoint {
-        z: w.z1,
-        y: w.y1,
-        zd: w.zd1,
-    };
-    let q2 = CurvePoint {
-        z: w.z2,
-        y: w.y2,
-        zd: w.zd2,
-    };
-    let (xi2, eta2) = curve
-        .xi_eta_points(&q1, &q2, w.g, Some(w.eps), None)
-        .unwrap();
-    let scale = xi
-        .iter()
-        .chain(eta.iter())
-        .map(|v| v.norm())
-        .fold(0.0, f64::max);
-    for j in 0..3 {
-        assert!(close(xi2[j], xi[j], scale, BACKWARD_RTOL));
-        assert!(close(eta2[j], eta[j], scale, BACKWARD_RTOL));
-    }
+    assert_backward(&curve, &w, &xi, &eta);
 }
 
 /// Offsets inconsistent with `z` are rejected.
@@ -622,26 +628,5 @@ fn inverse_converges_from_a_far_start_near_the_singular_set() {
     assert!((r1 - z1).norm() <= 1e-8 * 298.0, "{r1} vs {z1}");
     assert!((r2 - z2).norm() <= 1e-12 * z2.norm(), "{r2} vs {z2}");
     assert!((w.g.conj() * g).re > 0.0);
-    let q1 = CurvePoint {
-        z: w.z1,
-        y: w.y1,
-        zd: w.zd1,
-    };
-    let q2 = CurvePoint {
-        z: w.z2,
-        y: w.y2,
-        zd: w.zd2,
-    };
-    let (xi2, eta2) = curve
-        .xi_eta_points(&q1, &q2, w.g, Some(w.eps), None)
-        .unwrap();
-    let scale = xi
-        .iter()
-        .chain(eta.iter())
-        .map(|v| v.norm())
-        .fold(0.0, f64::max);
-    for j in 0..3 {
-        assert!(close(xi2[j], xi[j], scale, BACKWARD_RTOL));
-        assert!(close(eta2[j], eta[j], scale, BACKWARD_RTOL));
-    }
+    assert_backward(&curve, &w, &xi, &eta);
 }

@@ -27,6 +27,7 @@ way back):
 
 from __future__ import annotations
 
+import inspect
 import sys
 
 import mpmath
@@ -55,10 +56,9 @@ def _order(roots):
     return [roots[i1], roots[i2], roots[i3], roots[i4]]
 
 
-def constants(a, l):
-    """s_p, u, v, d_j, alpha_j..delta_j of (19)-(26) at 80 digits."""
-    A = [mpmath.mpf(x) for x in a]
-    L = [mpmath.mpf(x) for x in l]
+def quartic(A, L):
+    """Schottky's P(s) = h1 s^2 - h2 s + h3, h0, and the numerator P^2 - 4 h0^2 G of F
+    (19), all coefficients descending, in mpmath from mpf lists ``A`` (a) and ``L`` (l)."""
     m = [L[3], -L[1], L[0]]
     n = [L[2], L[4], L[5]]
     h0 = sum(m[j] * n[j] for j in range(3))
@@ -75,7 +75,25 @@ def constants(a, l):
             G[i] -= x * G[i - 1]
     P2 = [sum(P[i] * P[k - i] for i in range(3) if 0 <= k - i <= 2) for k in range(5)]
     num = [P2[i] - 4 * h0**2 * G[i] for i in range(5)]
-    s = _order(list(mpmath.polyroots(num[::-1], maxsteps=800, extraprec=800, asc=True)))
+    return P, h0, num
+
+
+def polyroots(coeffs, steps: int) -> list:
+    """Roots of the polynomial with descending ``coeffs`` (mpmath >= 1.4 deprecates
+    descending coefficients unless asc= is given)."""
+    if "asc" in inspect.signature(mpmath.polyroots).parameters:
+        return list(mpmath.polyroots(coeffs[::-1], maxsteps=steps, extraprec=steps, asc=True))
+    return list(mpmath.polyroots(coeffs, maxsteps=steps, extraprec=steps))
+
+
+def constants(a, l):
+    """s_p, u, v, d_j, alpha_j..delta_j of (19)-(26) at 80 digits."""
+    A = [mpmath.mpf(x) for x in a]
+    L = [mpmath.mpf(x) for x in l]
+    m = [L[3], -L[1], L[0]]
+    n = [L[2], L[4], L[5]]
+    P, h0, num = quartic(A, L)
+    s = _order(polyroots(num, 800))
     sig = [-(P[0] * x * x + P[1] * x + P[2]) / (2 * h0) for x in s]
     sfp = [mpmath.sqrt(mpmath.fprod(s[p] - s[q] for q in range(4) if q != p)) for p in range(4)]
     u = [[mpmath.sqrt((s[p] - A[j]) * (s[p] - A[3])) / sfp[p] for j in range(3)] for p in range(4)]
