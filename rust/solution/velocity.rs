@@ -172,20 +172,33 @@ struct StateJet {
     dl: [[C; 6]; 2],
 }
 
+/// What the auxiliary states need of the level set: the reduction's
+/// constants, the branch points `d_m` of (8), `√c_j` and the constant
+/// `G = g (1 − ε P_0) = √(h0/K)` of the corrected (42).
+struct Level<'a> {
+    k: &'a KotterConstants,
+    d: [C; 5],
+    sc: [C; 3],
+    big_g: C,
+}
+
+impl<'a> Level<'a> {
+    fn new(k: &'a KotterConstants, curve: &KotterCurve) -> Self {
+        Level {
+            k,
+            d: curve.branch_points(),
+            sc: curve.c().map(sqrt_principal),
+            big_g: sqrt_principal(C::new(k.h[0], 0.0) / k.k),
+        }
+    }
+}
+
 /// `l(D)` and `∂l/∂z_i` at the divisor with roots `r[i][m] = √(z_i − d_m)`
 /// (signs carrying the sheet: `Π_m r[i][m] = y_i`) and branch `eps` of the
 /// `P_j`. With `A = r2_j r2_k Π_{m≠j,k} r1_m`, `B = r1_j r1_k Π_{m≠j,k} r2_m`,
 /// (28) reads `P_jk = (A − B)/(z1 − z2)`, and `∂r_im/∂z_i = r_im/(2(z_i − d_m))`.
-#[allow(clippy::too_many_arguments)]
-fn state_jet(
-    k: &KotterConstants,
-    sc: &[C; 3],
-    big_g: C,
-    d: &[C; 5],
-    z: [C; 2],
-    r: &[[C; 5]; 2],
-    eps: &[f64; 5],
-) -> Option<StateJet> {
+fn state_jet(lv: &Level, z: [C; 2], r: &[[C; 5]; 2], eps: &[f64; 5]) -> Option<StateJet> {
+    let Level { k, d, sc, big_g } = *lv;
     let dz = z[0] - z[1];
     // h[i][m] = 1/(2(z_i − d_m)): the logarithmic derivative of r[i][m].
     let h: [[C; 5]; 2] = std::array::from_fn(|i| std::array::from_fn(|m| 0.5 / (z[i] - d[m])));
@@ -318,9 +331,8 @@ pub fn algebraic_rates(
     for c4 in c4s {
         crate::error::check_finite("c4", c4)?;
     }
-    let d = curve.branch_points();
-    let sc = curve.c().map(sqrt_principal);
-    let big_g = sqrt_principal(C::new(k.h[0], 0.0) / k.k);
+    let lv = Level::new(k, curve);
+    let d = lv.d;
     let amat = Matrix2::new(a_periods[0], a_periods[1], a_periods[2], a_periods[3]);
     let ainv = amat.try_inverse().ok_or(Error::InvalidArgument {
         what: "a-periods",
@@ -378,7 +390,7 @@ pub fn algebraic_rates(
             if !clear {
                 continue;
             }
-            if let Some(c) = candidate(k, &sc, big_g, &d, z, c4s, &ainv) {
+            if let Some(c) = candidate(&lv, z, c4s, &ainv) {
                 cands.push(c);
             }
         }
@@ -435,24 +447,16 @@ pub fn algebraic_rates(
 /// point on the canonical sheet, the second on either: both give the same
 /// velocity; the other sheet only when the first puts the divisor at a pole),
 /// or `None` when it does not qualify (see [`algebraic_rates`]).
-fn candidate(
-    k: &KotterConstants,
-    sc: &[C; 3],
-    big_g: C,
-    d: &[C; 5],
-    z: [C; 2],
-    c4s: &[[f64; 6]],
-    ainv: &Matrix2<C>,
-) -> Option<Candidate> {
+fn candidate(lv: &Level, z: [C; 2], c4s: &[[f64; 6]], ainv: &Matrix2<C>) -> Option<Candidate> {
     let eps_default = [1.0; 5];
     let r0: [[C; 5]; 2] =
-        std::array::from_fn(|i| std::array::from_fn(|m| sqrt_principal(z[i] - d[m])));
+        std::array::from_fn(|i| std::array::from_fn(|m| sqrt_principal(z[i] - lv.d[m])));
     let (jet, r) = [1.0, -1.0].into_iter().find_map(|s2| {
         let mut r = r0;
         r[1][0] *= s2;
-        state_jet(k, sc, big_g, d, z, &r, &eps_default).map(|j| (j, r))
+        state_jet(lv, z, &r, &eps_default).map(|j| (j, r))
     })?;
-    let level = level_residual(&k.a, &k.h, &jet.l);
+    let level = level_residual(&lv.k.a, &lv.k.h, &jet.l);
     if level.is_nan() || level > AUX_LEVEL_RTOL {
         return None;
     }
@@ -515,9 +519,8 @@ mod tests {
         let (a, _, l0) = GENERIC;
         let k = kotter_constants(&a, &l0).unwrap();
         let curve = KotterCurve::new(k.d[0], k.d[1], k.d[2]).unwrap();
-        let d = curve.branch_points();
-        let sc = curve.c().map(sqrt_principal);
-        let big_g = sqrt_principal(C::new(k.h[0], 0.0) / k.k);
+        let lv = Level::new(&k, &curve);
+        let d = lv.d;
         let z = [C::new(1.1, 0.9), C::new(-2.3, 1.7)];
         // roots continued from the centre of the circle (no cut crossed)
         let roots = |zz: [C; 2], r0: &[[C; 5]; 2]| -> [[C; 5]; 2] {
@@ -535,7 +538,7 @@ mod tests {
         let r0: [[C; 5]; 2] =
             std::array::from_fn(|i| std::array::from_fn(|m| sqrt_principal(z[i] - d[m])));
         let e = [1.0; 5];
-        let jet = state_jet(&k, &sc, big_g, &d, z, &r0, &e).unwrap();
+        let jet = state_jet(&lv, z, &r0, &e).unwrap();
         let near = (0..2)
             .map(|i| {
                 d.iter()
@@ -551,7 +554,7 @@ mod tests {
                 let mut zz = z;
                 zz[i] += w * rad;
                 let r = roots(zz, &r0);
-                let lj = state_jet(&k, &sc, big_g, &d, zz, &r, &e).unwrap();
+                let lj = state_jet(&lv, zz, &r, &e).unwrap();
                 for (a, lq) in acc.iter_mut().zip(lj.l) {
                     *a += lq / w;
                 }
@@ -645,15 +648,14 @@ mod tests {
             .unwrap();
         let c = crate::so4::manakov_c(&a, &b).unwrap();
         let c4 = [c[1], c[2], c[3], c[6], c[7], c[11]];
-        let sc = curve.c().map(sqrt_principal);
-        let big_g = sqrt_principal(C::new(k.h[0], 0.0) / k.k);
+        let lv = Level::new(&k, &curve);
         let z = [C::new(1.1, 0.9), C::new(-2.3, 1.7)];
         let mut us = Vec::new();
         for s2 in [1.0, -1.0] {
             let mut r: [[C; 5]; 2] =
                 std::array::from_fn(|i| std::array::from_fn(|m| sqrt_principal(z[i] - d[m])));
             r[1][0] *= s2;
-            let jet = state_jet(&k, &sc, big_g, &d, z, &r, &[1.0; 5]).unwrap();
+            let jet = state_jet(&lv, z, &r, &[1.0; 5]).unwrap();
             assert!(level_residual(&k.a, &k.h, &jet.l) <= 1e-14);
             let (zd, res) = lstsq_6x2(&jet.dl, &vector_field_complex(&c4, &jet.l)).unwrap();
             assert!(res <= 1e-13);
