@@ -13,7 +13,7 @@
 //!   theta-side fit at `v0`, `U'` from the same equations.
 //!
 //! They agree to the accuracy of the level-set constants (~1e-13 relative on
-//! the shared tops; `tests/test_tori.py`).
+//! the shared tops; `tests/test_tori_solution.py`, `tori::tests`).
 
 use num_complex::Complex64 as C;
 
