@@ -87,6 +87,66 @@ fn phase_reduction_is_exact_for_large_t() {
     assert!((r - ex).abs() <= 4.0 * f64::EPSILON, "{r} vs {ex}");
 }
 
+/// The block form of the phase (vectorised, `vfmadd` for the error-free
+/// product) gives the bits of the per-time form (`f64::mul_add`), for short
+/// blocks too, at times up to 1e15 and beyond (where `rem2` takes its
+/// large-argument branch) and of both signs.
+#[test]
+fn block_phase_gives_the_bits_of_the_per_time_phase() {
+    let (a, b, l0) = TOPS[0];
+    let sol = Solution::new(&a, &b, &l0).unwrap();
+    let mut times: Vec<f64> = vec![
+        0.0,
+        -0.0,
+        1.0,
+        -1.0,
+        1e6 + 0.25,
+        1e15,
+        -3e15,
+        7e15,
+        1e17,
+        -1e300,
+    ];
+    times.extend((0..50).map(|k| (k as f64 * 0.754_877_666).fract() * 10f64.powi(k % 17)));
+    for len in [1, 5, BLOCK] {
+        for blk in times.chunks(len) {
+            let mut lanes = LatticeLanes::default();
+            sol.lattice_lanes(blk, &mut lanes);
+            for (p, &t) in blk.iter().enumerate() {
+                let (x, y) = sol.lattice_reduced(t);
+                let got = [lanes.x[0][p], lanes.x[1][p], lanes.y[0][p], lanes.y[1][p]];
+                let want = [x[0], x[1], y[0], y[1]];
+                assert_eq!(got.map(f64::to_bits), want.map(f64::to_bits), "t = {t:e}");
+            }
+        }
+    }
+}
+
+/// Far beyond the exact range of the phase (|t| up to f64::MAX), `l(t)` is
+/// either finite or an error naming the lattice coordinates: never a NaN.
+#[test]
+fn extreme_times_give_finite_values_or_an_error() {
+    for (a, b, l0) in TOPS {
+        let sol = Solution::new(&a, &b, &l0).unwrap();
+        for t in [1e300, -1e300, f64::MAX, f64::MIN] {
+            let mut out = [0.0; 6];
+            match sol.l_batch(&[t], &mut out, &Cancel::never()) {
+                Ok(()) => assert!(out.iter().all(|v| v.is_finite()), "t = {t:e}: {out:?}"),
+                Err(e) => assert!(
+                    matches!(
+                        e,
+                        Error::NonFinite {
+                            what: "lattice coordinates",
+                            ..
+                        }
+                    ),
+                    "t = {t:e}: {e:?}"
+                ),
+            }
+        }
+    }
+}
+
 /// The guard of `Solution::new`: a residual at roundoff passes, one above
 /// [`QUOTIENT_RESIDUAL_RTOL`] (or NaN) is refused with the documented `what`.
 #[test]

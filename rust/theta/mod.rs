@@ -739,14 +739,13 @@ impl ThetaPlan {
     }
 
     /// [`ThetaPlan::reduce2`] (without the prefactor) for a point given by real
-    /// lattice coordinates, `z = x + τ y`: `q = round(y)`, `y_r = y − q`, so
-    /// `(Im τ)^{-1} Im z_r = y_r` exactly and no solve with `Im τ` is needed.
-    /// `Re τ = Re τ' + 2S` with `S` integer, so replacing `τ'` by `τ` in
-    /// `z = z_r + p + τ'q` moves `p` by the even vector `2Sq` and `qᵀX'q` by
-    /// the even `2qᵀSq`: the parities and the phase mod 2 are unchanged.
-    /// The reduction of a point given in lattice coordinates `z = x + τ y`,
-    /// written straight into lane `lane` of the batch kernel's input (the
-    /// hot path of `l(t)`: no [`Reduced`] is built and copied per point).
+    /// lattice coordinates, `z = x + τ y`, written straight into lane `lane`
+    /// of the batch kernel's input (no [`Reduced`] is built and copied):
+    /// `q = round(y)`, `y_r = y − q`, so `(Im τ)^{-1} Im z_r = y_r` exactly
+    /// and no solve with `Im τ` is needed. `Re τ = Re τ' + 2S` with `S`
+    /// integer, so replacing `τ'` by `τ` in `z = z_r + p + τ'q` moves `p` by
+    /// the even vector `2Sq` and `qᵀX'q` by the even `2qᵀSq`: the parities
+    /// and the phase mod 2 are unchanged.
     #[inline(always)]
     fn reduce2_lattice_into(
         &self,
@@ -1108,14 +1107,7 @@ pub const BLOCK: usize = batch::LANES;
 /// Normalised values of selected characteristics at one block of genus-2
 /// points, structure of arrays: `Ω[chars[m]]` of point `p` is
 /// `re[m][p] + i im[m][p]`, and `θ = exp(log_scale[p]) Ω`. Lanes `p ≥ len`
-/// hold zeros; rows `m ≥ chars.len()` are unspecified.
-/// A genus-2 point for [`ThetaPlan::eval_selected_g2_impl`].
-#[derive(Debug, Clone, Copy)]
-enum G2Point {
-    Z([Complex64; 2]),
-    Lattice([f64; 2], [f64; 2]),
-}
-
+/// are unspecified, and so are rows `m ≥ chars.len()`.
 #[derive(Debug, Clone)]
 pub struct SelectedBlock {
     /// Points in this block (`1 ..= BLOCK`).
@@ -1123,6 +1115,15 @@ pub struct SelectedBlock {
     pub re: [[f64; BLOCK]; 16],
     pub im: [[f64; BLOCK]; 16],
     pub log_scale: [f64; BLOCK],
+}
+
+/// Real lattice coordinates of one block of genus-2 points, `z = x + τ y`,
+/// one lane per point (structure of arrays): `x[i][p]`, `y[i][p]`.
+#[derive(Debug, Clone, Default)]
+#[repr(C, align(64))]
+pub struct LatticeLanes {
+    pub x: [[f64; BLOCK]; 2],
+    pub y: [[f64; BLOCK]; 2],
 }
 
 impl ThetaPlan {
@@ -1140,11 +1141,22 @@ impl ThetaPlan {
     pub fn eval_selected_g2(
         &self,
         npts: usize,
-        mut point: impl FnMut(usize) -> [Complex64; 2],
+        point: impl Fn(usize) -> [Complex64; 2],
         chars: &[usize],
         sink: impl FnMut(usize, &SelectedBlock),
     ) -> Result<()> {
-        self.eval_selected_g2_impl(npts, |i| G2Point::Z(point(i)), chars, sink)
+        self.eval_selected_g2_impl(
+            npts,
+            |i0, m, inp| {
+                for p in 0..m {
+                    inp.set(p, &self.reduce2::<false>(point(i0 + p))?);
+                }
+                Ok(())
+            },
+            &point,
+            chars,
+            sink,
+        )
     }
 
     /// [`ThetaPlan::eval_selected_g2`] for points given by real lattice
@@ -1154,50 +1166,165 @@ impl ThetaPlan {
     pub fn eval_selected_g2_lattice(
         &self,
         npts: usize,
-        mut lattice: impl FnMut(usize) -> ([f64; 2], [f64; 2]),
+        lattice: impl Fn(usize) -> ([f64; 2], [f64; 2]),
         chars: &[usize],
         sink: impl FnMut(usize, &SelectedBlock),
     ) -> Result<()> {
-        self.eval_selected_g2_impl(
+        self.eval_selected_g2_lattice_lanes(
             npts,
-            |i| {
-                let (x, y) = lattice(i);
-                G2Point::Lattice(x, y)
+            |first, m, lanes| {
+                for p in 0..m {
+                    let (x, y) = lattice(first + p);
+                    for i in 0..2 {
+                        lanes.x[i][p] = x[i];
+                        lanes.y[i][p] = y[i];
+                    }
+                }
             },
             chars,
             sink,
         )
     }
 
-    /// Reduces `pt` into lane `lane` of the batch kernel's input.
-    #[inline(always)]
-    fn g2_reduce_into(&self, pt: G2Point, inp: &mut batch::ChunkIn, lane: usize) -> Result<()> {
-        match pt {
-            G2Point::Z(z) => {
-                let red = self.reduce2::<false>(z)?;
-                inp.set(lane, &red);
-                Ok(())
-            }
-            G2Point::Lattice(x, y) => self.reduce2_lattice_into(x, y, inp, lane),
-        }
+    /// [`ThetaPlan::eval_selected_g2_lattice`] with the coordinates of the
+    /// points `first .. first + m` written a block at a time by
+    /// `fill(first, m, lanes)` into lanes `0..m` (the others start at zero;
+    /// `fill` may write them too, they are not used), so that the caller can
+    /// vectorise across the block too. A block whose
+    /// coordinates all lie in `[−1, 1]` (as after a reduction modulo 2) is
+    /// reduced for all its lanes at once, branch-free; any other goes point
+    /// by point. Both give the same bits and the same errors.
+    pub fn eval_selected_g2_lattice_lanes(
+        &self,
+        npts: usize,
+        fill: impl Fn(usize, usize, &mut LatticeLanes),
+        chars: &[usize],
+        sink: impl FnMut(usize, &SelectedBlock),
+    ) -> Result<()> {
+        let lanes_of = |first: usize, m: usize| {
+            let mut lanes = LatticeLanes::default();
+            fill(first, m, &mut lanes);
+            lanes
+        };
+        self.eval_selected_g2_impl(
+            npts,
+            |i0, m, inp| self.reduce2_lattice_lanes(&lanes_of(i0, m), m, inp),
+            // Only without the batch kernel, where the per-point sum costs far
+            // more than refilling the block.
+            |i| {
+                let first = i - i % BLOCK;
+                let lanes = lanes_of(first, (npts - first).min(BLOCK));
+                let p = i - first;
+                std::array::from_fn(|k| {
+                    let y = [lanes.y[0][p], lanes.y[1][p]];
+                    Complex64::new(
+                        lanes.x[k][p] + self.re_tau[2 * k] * y[0] + self.re_tau[2 * k + 1] * y[1],
+                        self.y[2 * k] * y[0] + self.y[2 * k + 1] * y[1],
+                    )
+                })
+            },
+            chars,
+            sink,
+        )
     }
 
-    fn g2_z(&self, pt: G2Point) -> [Complex64; 2] {
-        match pt {
-            G2Point::Z(z) => z,
-            G2Point::Lattice(x, y) => std::array::from_fn(|i| {
-                Complex64::new(
-                    x[i] + self.re_tau[2 * i] * y[0] + self.re_tau[2 * i + 1] * y[1],
-                    self.y[2 * i] * y[0] + self.y[2 * i + 1] * y[1],
-                )
-            }),
+    /// Lanes `0..m` of the batch kernel's input from the lattice coordinates
+    /// `lanes`: [`ThetaPlan::reduce2_lattice_into`]
+    /// lane by lane, or, when every coordinate lies in `[−1, 1]`, the same
+    /// arithmetic for all lanes at once.
+    fn reduce2_lattice_lanes(
+        &self,
+        lanes: &LatticeLanes,
+        m: usize,
+        inp: &mut batch::ChunkIn,
+    ) -> Result<()> {
+        // NaN fails the comparison, so non-finite blocks take the checked path.
+        let bounded =
+            (lanes.x.iter().chain(&lanes.y).flatten()).fold(true, |ok, v| ok & (v.abs() <= 1.0));
+        if !bounded {
+            if m < BLOCK {
+                *inp = batch::ChunkIn::default();
+            }
+            for p in 0..m {
+                let x = [lanes.x[0][p], lanes.x[1][p]];
+                let y = [lanes.y[0][p], lanes.y[1][p]];
+                self.reduce2_lattice_into(x, y, inp, p)?;
+            }
+            return Ok(());
+        }
+        #[cfg(target_arch = "x86_64")]
+        {
+            if std::is_x86_feature_detected!("avx2") {
+                // SAFETY: the CPU supports AVX2 (checked just above).
+                unsafe { self.reduce2_bounded_avx2(lanes, inp) };
+                return Ok(());
+            }
+        }
+        self.reduce2_bounded(lanes, inp);
+        Ok(())
+    }
+
+    /// [`ThetaPlan::reduce2_bounded`] compiled for AVX2 (rounding by
+    /// `vroundpd`, four lanes per instruction; no FMA, so the same bits).
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    unsafe fn reduce2_bounded_avx2(&self, lanes: &LatticeLanes, inp: &mut batch::ChunkIn) {
+        self.reduce2_bounded(lanes, inp);
+    }
+
+    /// [`ThetaPlan::reduce2_lattice_into`] for all lanes, given `|x|, |y| ≤ 1`:
+    /// then `q = round(y) ∈ {−1, 0, 1}`, nothing can overflow, and the
+    /// rounding `floor(v + 1/2)`, the parities `v − 2 floor(v/2)` and the
+    /// signs are plain arithmetic on every lane.
+    #[inline(always)]
+    fn reduce2_bounded(&self, lanes: &LatticeLanes, inp: &mut batch::ChunkIn) {
+        // Fixed-size copies: no bounds checks in the loop, so it vectorises.
+        let four = |v: &[f64]| -> [f64; 4] { std::array::from_fn(|k| v[k]) };
+        let (rt, it, xq) = (four(&self.re_tau), four(&self.y), four(&self.x));
+        let parity = |v: f64| v - 2.0 * (0.5 * v).floor();
+        for p in 0..BLOCK {
+            let y = [lanes.y[0][p], lanes.y[1][p]];
+            let q = [(y[0] + 0.5).floor(), (y[1] + 0.5).floor()];
+            let yr = [y[0] - q[0], y[1] - q[1]];
+            let mut zr_re = [0.0; 2];
+            let mut sp = [0.0; 2];
+            for i in 0..2 {
+                let re = lanes.x[i][p] + rt[2 * i] * yr[0] + rt[2 * i + 1] * yr[1];
+                let pi_ = (re + 0.5).floor();
+                zr_re[i] = re - pi_;
+                sp[i] = 1.0 - 2.0 * parity(pi_);
+                inp.zre[i][p] = zr_re[i];
+                inp.zim[i][p] = it[2 * i] * yr[0] + it[2 * i + 1] * yr[1];
+                inp.wr[i][p] = yr[i];
+            }
+            let imz = [it[0] * y[0] + it[1] * y[1], it[2] * y[0] + it[3] * y[1]];
+            inp.logs[p] = (pi() * (imz[0] * y[0] + imz[1] * y[1])).max(0.0);
+            // q_i q_k ∈ {−1, 0, 1}: the products are exact.
+            let quad = q[0] * q[0] * xq[0] + q[0] * q[1] * (xq[1] + xq[2]) + q[1] * q[1] * xq[3];
+            let phase = -quad - 2.0 * (q[0] * zr_re[0] + q[1] * zr_re[1]);
+            inp.phase[p] = if q[0] != 0.0 || q[1] != 0.0 {
+                phase
+            } else {
+                0.0
+            };
+            // (-1)^{h·p} with h = (h0, h1) the bits (2, 1) of the index.
+            let sq = [1.0 - 2.0 * parity(q[0]), 1.0 - 2.0 * parity(q[1])];
+            inp.sa[0][p] = 1.0;
+            inp.sa[1][p] = sp[1];
+            inp.sa[2][p] = sp[0];
+            inp.sa[3][p] = sp[0] * sp[1];
+            inp.sb[0][p] = 1.0;
+            inp.sb[1][p] = sq[1];
+            inp.sb[2][p] = sq[0];
+            inp.sb[3][p] = sq[0] * sq[1];
         }
     }
 
     fn eval_selected_g2_impl(
         &self,
         npts: usize,
-        mut point: impl FnMut(usize) -> G2Point,
+        mut reduce_block: impl FnMut(usize, usize, &mut batch::ChunkIn) -> Result<()>,
+        point: impl Fn(usize) -> [Complex64; 2],
         chars: &[usize],
         mut sink: impl FnMut(usize, &SelectedBlock),
     ) -> Result<()> {
@@ -1226,12 +1353,7 @@ impl ThetaPlan {
             let mut inp = batch::ChunkIn::default();
             while i0 < npts {
                 let m = (npts - i0).min(BLOCK);
-                if m < BLOCK {
-                    inp = batch::ChunkIn::default();
-                }
-                for p in 0..m {
-                    self.g2_reduce_into(point(i0 + p), &mut inp, p)?;
-                }
+                reduce_block(i0, m, &mut inp)?;
                 b2.eval_chunk(self, &inp, false, want, &mut sc);
                 blk.len = m;
                 blk.log_scale = inp.logs;
@@ -1252,7 +1374,7 @@ impl ThetaPlan {
             blk.im = [[0.0; BLOCK]; 16];
             blk.log_scale = [0.0; BLOCK];
             for p in 0..m {
-                let z = self.g2_z(point(i0 + p));
+                let z = point(i0 + p);
                 blk.log_scale[p] = self.eval_into(&z, &mut ws, &mut vals, &mut [], &mut [])?;
                 for (k, &c) in chars.iter().enumerate() {
                     blk.re[k][p] = vals[c].re;

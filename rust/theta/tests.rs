@@ -543,6 +543,90 @@ fn large_genus_sums_over_the_cost_budget_are_refused() {
     assert!(info.seconds_per_point > 0.0 && info.seconds_per_point <= MAX_SECONDS_PER_POINT);
 }
 
+/// The branch-free reduction of a block whose lattice coordinates lie in
+/// [−1, 1] writes the same bits, lane by lane, as the per-point reduction of
+/// the same coordinates: on the ends ±1, the rounding ties ±1/2 (where
+/// `floor(v + 1/2)` and round-half-even differ), ±0 and a sweep in between,
+/// with `Re τ` beyond [−1, 1] so that `Re z_r` also crosses the ties.
+#[test]
+fn bounded_block_reduction_writes_the_bits_of_the_per_point_reduction() {
+    let tau = tau2(C::new(2.3, 1.1), C::new(-3.1, 0.4), C::new(-0.2, 1.3));
+    let plan = ThetaPlan::new(&tau, 2, 1e-16, 0).unwrap();
+    let edges = [-1.0, -0.5, -0.0, 0.0, 0.5, 1.0, 0.25, -0.75];
+    let mut values: Vec<f64> = edges.to_vec();
+    values.extend((0..200).map(|k| ((k as f64) * 0.618_033_988_749_895).fract() * 2.0 - 1.0));
+    let mut blocks = 0;
+    for start in (0..values.len()).step_by(3) {
+        let mut lanes = LatticeLanes::default();
+        for p in 0..BLOCK {
+            let v = |o: usize| values[(start + 7 * p + o) % values.len()];
+            lanes.x[0][p] = v(0);
+            lanes.x[1][p] = v(1);
+            lanes.y[0][p] = v(2);
+            lanes.y[1][p] = v(3);
+        }
+        let mut fast = batch::ChunkIn::default();
+        plan.reduce2_lattice_lanes(&lanes, BLOCK, &mut fast)
+            .unwrap();
+        let mut slow = batch::ChunkIn::default();
+        for p in 0..BLOCK {
+            let x = [lanes.x[0][p], lanes.x[1][p]];
+            let y = [lanes.y[0][p], lanes.y[1][p]];
+            plan.reduce2_lattice_into(x, y, &mut slow, p).unwrap();
+        }
+        let bits = |c: &batch::ChunkIn| -> Vec<u64> {
+            let rows = c
+                .zre
+                .iter()
+                .chain(&c.zim)
+                .chain(&c.wr)
+                .chain([&c.phase, &c.logs]);
+            rows.chain(&c.sa)
+                .chain(&c.sb)
+                .flatten()
+                .map(|v| v.to_bits())
+                .collect()
+        };
+        assert_eq!(bits(&fast), bits(&slow), "block starting at value {start}");
+        blocks += 1;
+    }
+    assert!(blocks > 60);
+}
+
+/// A block with a coordinate outside [−1, 1] or not finite goes point by
+/// point: the thetas of large coordinates as before, and a non-finite one is
+/// an error naming the lattice coordinates, not a NaN.
+#[test]
+fn unbounded_or_non_finite_lanes_take_the_checked_path() {
+    let tau = tau2(C::new(0.3, 1.1), C::new(0.1, 0.4), C::new(-0.2, 1.3));
+    let plan = ThetaPlan::new(&tau, 2, 1e-16, 0).unwrap();
+    for bad in [f64::NAN, f64::INFINITY] {
+        let err = plan
+            .eval_selected_g2_lattice_lanes(
+                BLOCK,
+                |_, m, lanes| {
+                    for p in 0..m {
+                        lanes.x[0][p] = 0.1;
+                        lanes.y[1][p] = if p == 5 { bad } else { 0.2 };
+                    }
+                },
+                &[0, 1],
+                |_, _| {},
+            )
+            .unwrap_err();
+        assert!(
+            matches!(
+                err,
+                Error::NonFinite {
+                    what: "lattice coordinates",
+                    ..
+                }
+            ),
+            "{err:?}"
+        );
+    }
+}
+
 /// Points given by lattice coordinates (`z = x + τ y`) give the thetas of `z`:
 /// against the brute-force sum, through the batch kernel (a full block) and the
 /// per-point path (a short tail), with `Re τ` beyond [−1, 1] (`S ≠ 0`) and
