@@ -123,6 +123,7 @@ pub struct AlgebraicRates {
 
 /// One auxiliary divisor's result: `U` and `V` of each flow, and the
 /// level-set residual of its state.
+#[derive(Debug)]
 struct Candidate {
     u: Vec<[C; 2]>,
     v: Vec<[C; 2]>,
@@ -298,6 +299,56 @@ fn lstsq_6x2(j: &[[C; 6]; 2], b: &[C; 6]) -> Option<([C; 2], f64)> {
     (x.iter().all(|v| v.re.is_finite() && v.im.is_finite()) && rel.is_finite()).then_some((x, rel))
 }
 
+/// Two candidates agree (a vote) when their velocities do, flow by flow,
+/// within [`AGREE_RTOL`] of the larger.
+fn agree(x: &Candidate, y: &Candidate) -> bool {
+    x.u.iter().zip(&y.u).all(|(p, q)| {
+        // squared moduli: no libm hypot in the per-state path
+        let s2 = p[0]
+            .norm_sqr()
+            .max(p[1].norm_sqr())
+            .max(q[0].norm_sqr().max(q[1].norm_sqr()));
+        (p[0] - q[0]).norm_sqr().max((p[1] - q[1]).norm_sqr()) <= AGREE_RTOL * AGREE_RTOL * s2
+    })
+}
+
+/// `(votes, index)` of the candidate with the most votes (itself included),
+/// ties to the smaller of its residuals; `None` without candidates.
+fn best_supported(cands: &[Candidate]) -> Option<(usize, usize)> {
+    cands
+        .iter()
+        .enumerate()
+        .map(|(i, c)| {
+            let votes = cands.iter().filter(|o| agree(c, o)).count();
+            (votes, -c.chain.max(c.level), i)
+        })
+        .max_by(|a, b| a.0.cmp(&b.0).then(a.1.total_cmp(&b.1)))
+        .map(|(votes, _, i)| (votes, i))
+}
+
+/// The candidates that agree with the best-supported one, if there are at
+/// least [`MIN_SUPPORT`]; otherwise the error naming [`NO_CONSENSUS`] and
+/// whether no candidate or too few agreeing ones were found.
+fn supporters(cands: &[Candidate]) -> Result<Vec<&Candidate>> {
+    let (votes, i) = best_supported(cands).ok_or(Error::InvalidArgument {
+        what: NO_CONSENSUS,
+        reason: "no auxiliary divisor gives a consistent state on the level set: the \
+                 reduction's constants are inconsistent"
+            .into(),
+    })?;
+    if votes < MIN_SUPPORT {
+        return Err(Error::InvalidArgument {
+            what: NO_CONSENSUS,
+            reason: format!(
+                "only {votes} of {} auxiliary divisors agree on the velocity (at least \
+                 {MIN_SUPPORT} must, to {AGREE_RTOL:e})",
+                cands.len()
+            ),
+        });
+    }
+    Ok(cands.iter().filter(|o| agree(&cands[i], o)).collect())
+}
+
 /// The velocities `U` of the flows with coefficients `c4s` (the six `c_ij`,
 /// `i < j`, of (1)) on the level set of the constants `k`, by the chain rule
 /// at auxiliary divisors, for the sign `G = +√(h0/K)` (principal).
@@ -351,32 +402,12 @@ pub fn algebraic_rates(
     } else {
         radius
     };
-    let agree = |x: &Candidate, y: &Candidate| {
-        x.u.iter().zip(&y.u).all(|(p, q)| {
-            // squared moduli: no libm hypot in the per-state path
-            let s2 = p[0]
-                .norm_sqr()
-                .max(p[1].norm_sqr())
-                .max(q[0].norm_sqr().max(q[1].norm_sqr()));
-            (p[0] - q[0]).norm_sqr().max((p[1] - q[1]).norm_sqr()) <= AGREE_RTOL * AGREE_RTOL * s2
-        })
-    };
-    let best = |cands: &[Candidate]| {
-        cands
-            .iter()
-            .enumerate()
-            .map(|(i, c)| {
-                let votes = cands.iter().filter(|o| agree(c, o)).count();
-                (votes, -c.chain.max(c.level), i)
-            })
-            .max_by(|a, b| a.0.cmp(&b.0).then(a.1.total_cmp(&b.1)))
-    };
     let mut cands: Vec<Candidate> = Vec::new();
     // Divisors one at a time until MIN_SUPPORT agree (on a well-conditioned
     // curve the first ones do), the geometric-mean scale first.
     'scales: for (origin, scale) in [(ZERO, geo), (center, 1.3 * radius)] {
         for &(a1, b1, a2, b2) in &OFFSETS {
-            if best(&cands).is_some_and(|(votes, _, _)| votes >= MIN_SUPPORT) {
+            if best_supported(&cands).is_some_and(|(votes, _)| votes >= MIN_SUPPORT) {
                 break 'scales;
             }
             let z = [
@@ -395,24 +426,8 @@ pub fn algebraic_rates(
             }
         }
     }
-    let (votes, _, i) = best(&cands).ok_or(Error::InvalidArgument {
-        what: NO_CONSENSUS,
-        reason: "no auxiliary divisor gives a consistent state on the level set: the \
-                 reduction's constants are inconsistent"
-            .into(),
-    })?;
-    if votes < MIN_SUPPORT {
-        return Err(Error::InvalidArgument {
-            what: NO_CONSENSUS,
-            reason: format!(
-                "only {votes} of {} auxiliary divisors agree on the velocity (at least \
-                 {MIN_SUPPORT} must, to {AGREE_RTOL:e})",
-                cands.len()
-            ),
-        });
-    }
     // The mean over the divisors that agree with the best-supported one.
-    let sup: Vec<&Candidate> = cands.iter().filter(|o| agree(&cands[i], o)).collect();
+    let sup = supporters(&cands)?;
     let nf = sup.len() as f64;
     let mean = |pick: &dyn Fn(&Candidate) -> [C; 2]| -> [C; 2] {
         let s = sup.iter().fold([ZERO; 2], |acc, c| {
@@ -436,7 +451,7 @@ pub fn algebraic_rates(
     Ok(AlgebraicRates {
         rates,
         v,
-        support: votes,
+        support: sup.len(),
         spread,
         level_residual: sup.iter().map(|c| c.level).fold(0.0f64, f64::max),
         chain_residual: sup.iter().map(|c| c.chain).fold(0.0f64, f64::max),
@@ -628,9 +643,45 @@ mod tests {
         match algebraic_rates(&bad, &curve, &ap, &[c4]) {
             Err(Error::InvalidArgument { what, reason }) => {
                 assert_eq!(what, NO_CONSENSUS, "{reason}");
+                assert!(reason.contains("no auxiliary divisor"), "{reason}");
             }
             other => panic!("expected no consensus, got {other:?}"),
         }
+    }
+
+    /// The vote on its own, on made-up candidates: no candidate, and too few
+    /// agreeing ones (two of four, where three must), are refused with their
+    /// reasons; with three agreeing (within [`AGREE_RTOL`]) and one off, the
+    /// supporters are the three, the off one and the near miss excluded.
+    #[test]
+    fn the_vote_needs_min_support_and_drops_the_dissenters() {
+        let cand = |u0: f64| Candidate {
+            u: vec![[C::new(u0, 0.0), C::new(2.0, -1.0)]],
+            v: vec![[ZERO; 2]],
+            level: 1e-15,
+            chain: 1e-15,
+        };
+        let reason = |r: Result<Vec<&Candidate>>| match r {
+            Err(Error::InvalidArgument { what, reason }) => {
+                assert_eq!(what, NO_CONSENSUS);
+                reason
+            }
+            other => panic!("expected no consensus, got {other:?}"),
+        };
+        assert!(reason(supporters(&[])).contains("no auxiliary divisor"));
+        let two = [cand(1.0), cand(1.0 + 1e-13), cand(1.5), cand(0.5)];
+        assert!(reason(supporters(&two)).contains("only 2 of 4"));
+        let near_miss = 1.0 + 3.0 * AGREE_RTOL;
+        let three = [
+            cand(1.0),
+            cand(0.7),
+            cand(1.0 - 1e-13),
+            cand(near_miss),
+            cand(1.0 + 1e-13),
+        ];
+        let sup = supporters(&three).unwrap();
+        assert_eq!(sup.len(), 3);
+        assert!(sup.iter().all(|c| (c.u[0][0].re - 1.0).abs() <= 1e-12));
     }
 
     /// Any sheet of the second point gives a state on the level set and the
