@@ -567,3 +567,73 @@ def test_bad_points_and_u():
         h3.invert(np.zeros(3))
     with pytest.raises(ValueError, match="shape"):
         h3.invert(np.zeros(2))
+
+
+def _local_integral_mp(e: np.ndarray, k: int, dx: complex, w_end: complex) -> list:
+    """``int_{e_k}^{e_k + dx} x^i dx / y`` (i = 0, 1) by mpmath at 40 digits, in the
+    local parameter ``x = e_k + s^2``: ``y = s w(s)`` with ``w^2 = prod_{m != k}
+    (x - e_m)``, ``w`` continued from ``w_end`` at ``s = sqrt(dx)`` (``|dx|`` is far
+    below the distances to the other branch points, so ``w`` stays near its value
+    at ``s = 0``)."""
+    with mp.workdps(40):
+        ek = mp.mpc(e[k])
+        others = [mp.mpc(v) for j, v in enumerate(e) if j != k]
+        s_end = mp.sqrt(mp.mpc(dx))
+        w_ref = mp.mpc(w_end)
+
+        def w(s):
+            r = mp.sqrt(mp.fprod(ek + s * s - em for em in others))
+            return r if abs(r - w_ref) <= abs(r + w_ref) else -r
+
+        return [
+            mp.quad(lambda t, i=i: 2 * s_end * (ek + (t * s_end) ** 2) ** i / w(t * s_end), [0, 1])
+            for i in range(2)
+        ]
+
+
+@pytest.mark.parametrize("r", [1e-3, 1e-8, 1e-13])
+def test_abel_near_branch_against_mpmath_local_integral(r):
+    """``abel_near_branch(k, dx, y) = u(e_k) + A^{-1} int_{e_k}^{e_k+dx} omega`` with
+    the integral from mpmath (40 digits) in the local parameter, on both sheets,
+    to REF_RTOL modulo the lattice, down to |dx| = 1e-13 where the double
+    ``x = e_k + dx`` has lost the offset to ~1e-3 relative."""
+    e = np.array([0, 1 + 0.3j, -0.7 + 1.1j, 2 - 0.5j, 0.4 - 1.3j])
+    h = HyperellipticCurve(e)
+    a_per, _ = h.periods
+    scale = np.max(np.abs(h.tau))
+    for k in (1, 3):
+        ek = h.branch_points[k]
+        for phi in (0.3, 2.1):
+            dx = r * np.exp(1j * phi)
+            with mp.workdps(40):
+                w_end = complex(
+                    mp.sqrt(mp.fprod(mp.mpc(ek) + mp.mpc(dx) - mp.mpc(v) for v in np.delete(e, k)))
+                )
+                s = complex(mp.sqrt(mp.mpc(dx)))
+            for sheet in (1, -1):
+                y = sheet * s * w_end
+                got = h.abel_near_branch(k, dx, y)
+                integral = np.array([complex(v) for v in _local_integral_mp(e, k, dx, w_end)])
+                want = h.abel_branch_points[k] + sheet * np.linalg.solve(a_per, integral)
+                err = np.max(np.abs(h.reduce(got - want)))
+                assert err <= REF_RTOL * scale, (k, phi, sheet, err)
+
+
+def test_abel_near_branch_shapes_and_bad_input():
+    h = HyperellipticCurve([0, 1 + 0.3j, -0.7 + 1.1j, 2 - 0.5j, 0.4 - 1.3j])
+    dx = np.array([[1e-4, 1e-4j], [-1e-4, 2e-4]])
+    ek = h.branch_points[2]
+    y = h.y(ek + dx)
+    u = h.abel_near_branch(2, dx, y)
+    assert u.shape == (2, 2, 2)
+    # Where the offset is well above roundoff of x, it agrees with abel.
+    assert np.max(np.abs(h.reduce(u - h.abel(ek + dx, y)))) <= REF_RTOL * np.max(np.abs(h.tau))
+    for k in (-1, 5, 1.0, True):
+        with pytest.raises(ValueError, match="k must be"):
+            h.abel_near_branch(k, 1e-4, h.y(h.branch_points[0] + 1e-4))
+    with pytest.raises(ValueError, match="not on the curve"):
+        h.abel_near_branch(2, 1e-4, 2 * h.y(ek + 1e-4))
+    with pytest.raises(ValueError, match="finite"):
+        h.abel_near_branch(2, np.nan, 0.0)
+    with pytest.raises(ValueError, match="shape"):
+        h.abel_near_branch(2, [1e-4, 2e-4], [0.1, 0.2, 0.3])

@@ -150,6 +150,35 @@ impl HyperellipticCore {
             .into_pyarray(py))
     }
 
+    /// Abel map of `N` points `(e_k + dx, y)` near the branch point `e_k`,
+    /// given their offsets `dx` (full relative accuracy), `(N, g)`.
+    fn abel_near_branch<'py>(
+        &self,
+        py: Python<'py>,
+        k: usize,
+        dx: PyReadonlyArray1<'py, C>,
+        y: PyReadonlyArray1<'py, C>,
+    ) -> PyResult<Bound<'py, PyArray2<C>>> {
+        let dxs = vec1(&dx, "dx", None)?;
+        let ys = vec1(&y, "y", Some(dxs.len()))?;
+        let g = self.curve.genus();
+        let n = dxs.len();
+        let cancel = py_cancel();
+        let out = py.detach(|| -> Result<Vec<C>, Error> {
+            let mut out = Vec::with_capacity(n * g);
+            for (i, (&d, &w)) in dxs.iter().zip(&ys).enumerate() {
+                if i % CHUNK == 0 {
+                    cancel.check()?;
+                }
+                out.extend(self.curve.abel_near_branch(k, d, w)?);
+            }
+            Ok(out)
+        })?;
+        Ok(Array2::from_shape_vec((n, g), out)
+            .map_err(out_shape_err)?
+            .into_pyarray(py))
+    }
+
     /// `u(e_k)` for every finite branch point (unreduced, tree paths), `(n, g)`.
     fn abel_branch_points<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<C>>> {
         let (n, g) = (self.curve.branch_points().len(), self.curve.genus());
