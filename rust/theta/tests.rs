@@ -593,6 +593,64 @@ fn bounded_block_reduction_writes_the_bits_of_the_per_point_reduction() {
     assert!(blocks > 60);
 }
 
+/// Without the batch kernel (`Im τ_11 = 60`: its tables would overflow), the
+/// block form of the lattice input takes the per-point sum, point by point
+/// from the right lanes: the thetas of `z = x + τ y` against the brute-force
+/// sum, for a full block and a short tail.
+#[test]
+fn lattice_lanes_without_the_batch_kernel_give_the_thetas_of_the_point() {
+    let tau = tau2(C::new(0.3, 60.0), C::new(0.1, 0.4), C::new(-0.2, 1.3));
+    let plan = ThetaPlan::new(&tau, 2, 1e-16, 0).unwrap();
+    assert!(batch::Batch2::build(&plan).is_none());
+    let n = BLOCK + 3;
+    let coords = |p: usize| {
+        let t = p as f64;
+        (
+            [(0.37 * t).sin(), (0.53 * t).cos()],
+            [(0.71 * t).cos() * 0.9, (0.29 * t).sin() * 0.6],
+        )
+    };
+    let chars = [0, 5, 9, 15];
+    let mut got = vec![[C::new(0.0, 0.0); 4]; n];
+    plan.eval_selected_g2_lattice_lanes(
+        n,
+        |first, m, lanes| {
+            for p in 0..m {
+                let (x, y) = coords(first + p);
+                for i in 0..2 {
+                    lanes.x[i][p] = x[i];
+                    lanes.y[i][p] = y[i];
+                }
+            }
+        },
+        &chars,
+        |first, blk| {
+            for p in 0..blk.len {
+                for k in 0..chars.len() {
+                    got[first + p][k] = C::new(blk.re[k][p], blk.im[k][p]) * blk.log_scale[p].exp();
+                }
+            }
+        },
+    )
+    .unwrap();
+    for (p, row) in got.iter().enumerate() {
+        let (x, y) = coords(p);
+        let z: Vec<C> = (0..2)
+            .map(|i| C::new(x[i], 0.0) + tau[2 * i] * y[0] + tau[2 * i + 1] * y[1])
+            .collect();
+        let refs: Vec<C> = (0..16).map(|c| brute(&z, &tau, 2, c, 14, &one)).collect();
+        let scale = max_abs(&refs);
+        for (k, &c) in chars.iter().enumerate() {
+            assert!(
+                (row[k] - refs[c]).norm() <= AGREE * scale,
+                "point {p} char {c}: {} vs {}",
+                row[k],
+                refs[c]
+            );
+        }
+    }
+}
+
 /// A block with a coordinate outside [−1, 1] or not finite goes point by
 /// point: the thetas of large coordinates as before, and a non-finite one is
 /// an error naming the lattice coordinates, not a NaN.
