@@ -122,6 +122,30 @@ fn block_phase_gives_the_bits_of_the_per_time_phase() {
     }
 }
 
+/// A time's `l` does not depend on the other times of its block (lanes are
+/// independent, a short block's padding included): batches of 1, 15, 16, 17
+/// and 33 times give, bit for bit, what each time gives alone.
+#[test]
+fn l_of_a_time_does_not_depend_on_its_block() {
+    for (a, b, l0) in TOPS {
+        let sol = Solution::new(&a, &b, &l0).unwrap();
+        let times: Vec<f64> = (0..33)
+            .map(|k| 0.37 * k as f64 - 2.0 + 1e6 * (k % 3) as f64)
+            .collect();
+        let alone: Vec<u64> = times
+            .iter()
+            .flat_map(|&t| sol.l(t).unwrap().map(f64::to_bits))
+            .collect();
+        for len in [1, 15, 16, 17, 33] {
+            let mut out = vec![0.0; 6 * len];
+            sol.l_batch(&times[..len], &mut out, &Cancel::never())
+                .unwrap();
+            let got: Vec<u64> = out.iter().map(|v| v.to_bits()).collect();
+            assert_eq!(got, alone[..6 * len], "a = {a:?}, {len} times");
+        }
+    }
+}
+
 /// Far beyond the exact range of the phase (|t| up to f64::MAX), `l(t)` is
 /// either finite or an error naming the lattice coordinates: never a NaN.
 #[test]

@@ -1188,12 +1188,14 @@ impl ThetaPlan {
 
     /// [`ThetaPlan::eval_selected_g2_lattice`] with the coordinates of the
     /// points `first .. first + m` written a block at a time by
-    /// `fill(first, m, lanes)` into lanes `0..m` (the others start at zero;
-    /// `fill` may write them too, they are not used), so that the caller can
-    /// vectorise across the block too. A block whose
-    /// coordinates all lie in `[−1, 1]` (as after a reduction modulo 2) is
-    /// reduced for all its lanes at once, branch-free; any other goes point
-    /// by point. Both give the same bits and the same errors.
+    /// `fill(first, m, lanes)` into lanes `0..m`, so that the caller can
+    /// vectorise across the block too. The other lanes start at zero; `fill`
+    /// may write them (their results are discarded), but keep them in
+    /// `[−1, 1]`: a block whose coordinates all lie in `[−1, 1]` (as after a
+    /// reduction modulo 2), on a plan whose `Re τ` cannot carry `Re z` past
+    /// the representable range, is reduced for all its lanes at once,
+    /// branch-free; any other goes point by point. Both give the same bits
+    /// and the same errors.
     pub fn eval_selected_g2_lattice_lanes(
         &self,
         npts: usize,
@@ -1229,9 +1231,10 @@ impl ThetaPlan {
     }
 
     /// Lanes `0..m` of the batch kernel's input from the lattice coordinates
-    /// `lanes`: [`ThetaPlan::reduce2_lattice_into`]
-    /// lane by lane, or, when every coordinate lies in `[−1, 1]`, the same
-    /// arithmetic for all lanes at once.
+    /// `lanes`: [`ThetaPlan::reduce2_lattice_into`] lane by lane, or, when
+    /// every coordinate lies in `[−1, 1]` and `Re τ` keeps `Re z` far inside
+    /// the representable range, the same arithmetic for all lanes at once
+    /// ([`ThetaPlan::reduce2_bounded`]).
     fn reduce2_lattice_lanes(
         &self,
         lanes: &LatticeLanes,
@@ -1241,7 +1244,13 @@ impl ThetaPlan {
         // NaN fails the comparison, so non-finite blocks take the checked path.
         let bounded =
             (lanes.x.iter().chain(&lanes.y).flatten()).fold(true, |ok, v| ok & (v.abs() <= 1.0));
-        if !bounded {
+        // |Re z| ≤ |x| + Σ_k |Re τ_ik| |y_r,k| ≤ 1 + (|Re τ_i1| + |Re τ_i2|)/2: well
+        // within the range the per-point path checks (`integer_part`; half of it,
+        // so that rounding cannot cross it), or that path decides.
+        let rt = &self.re_tau;
+        let re_ok = (0..2)
+            .all(|i| 1.0 + 0.5 * (rt[2 * i].abs() + rt[2 * i + 1].abs()) <= 0.5 * MAX_REDUCTION);
+        if !(bounded && re_ok) {
             if m < BLOCK {
                 *inp = batch::ChunkIn::default();
             }

@@ -565,6 +565,10 @@ fn bounded_block_reduction_writes_the_bits_of_the_per_point_reduction() {
             lanes.y[0][p] = v(2);
             lanes.y[1][p] = v(3);
         }
+        // The portable body itself, and the block entry point (the AVX2 copy
+        // where the CPU has it): both must write the per-point bits.
+        let mut portable = batch::ChunkIn::default();
+        plan.reduce2_bounded(&lanes, &mut portable);
         let mut fast = batch::ChunkIn::default();
         plan.reduce2_lattice_lanes(&lanes, BLOCK, &mut fast)
             .unwrap();
@@ -587,10 +591,48 @@ fn bounded_block_reduction_writes_the_bits_of_the_per_point_reduction() {
                 .map(|v| v.to_bits())
                 .collect()
         };
+        assert_eq!(
+            bits(&portable),
+            bits(&slow),
+            "block starting at value {start}"
+        );
         assert_eq!(bits(&fast), bits(&slow), "block starting at value {start}");
         blocks += 1;
     }
     assert!(blocks > 60);
+}
+
+/// A `Re τ` so large that `Re z` of a bounded block leaves the range where
+/// theta is determined: the block goes point by point and gives the
+/// per-point error, as the same point does through the per-point reduction
+/// (the block path must not return a value where that path refuses).
+#[test]
+fn huge_re_tau_blocks_give_the_per_point_error() {
+    let tau = tau2(C::new(1e16, 1.1), C::new(0.1, 0.4), C::new(-0.2, 1.3));
+    let plan = ThetaPlan::new(&tau, 2, 1e-16, 0).unwrap();
+    let (x, y) = ([0.1, 0.0], [0.5, 0.1]);
+    let mut inp = batch::ChunkIn::default();
+    let single = plan.reduce2_lattice_into(x, y, &mut inp, 0).unwrap_err();
+    assert!(
+        matches!(single, Error::InvalidArgument { what: "z", .. }),
+        "{single:?}"
+    );
+    let err = plan
+        .eval_selected_g2_lattice_lanes(
+            3,
+            |_, m, lanes| {
+                for p in 0..m {
+                    for i in 0..2 {
+                        lanes.x[i][p] = x[i];
+                        lanes.y[i][p] = y[i];
+                    }
+                }
+            },
+            &[0],
+            |_, _| {},
+        )
+        .unwrap_err();
+    assert_eq!(format!("{err}"), format!("{single}"));
 }
 
 /// Without the batch kernel (`Im τ_11 = 60`: its tables would overflow), the
@@ -651,9 +693,9 @@ fn lattice_lanes_without_the_batch_kernel_give_the_thetas_of_the_point() {
     }
 }
 
-/// A block with a coordinate outside [−1, 1] or not finite goes point by
-/// point: the thetas of large coordinates as before, and a non-finite one is
-/// an error naming the lattice coordinates, not a NaN.
+/// A block with a coordinate that is not finite goes point by point: an
+/// error naming the lattice coordinates, not a NaN (coordinates beyond
+/// [−1, 1] are `lattice_coordinates_give_the_thetas_of_the_point`).
 #[test]
 fn unbounded_or_non_finite_lanes_take_the_checked_path() {
     let tau = tau2(C::new(0.3, 1.1), C::new(0.1, 0.4), C::new(-0.2, 1.3));
