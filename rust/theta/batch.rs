@@ -108,13 +108,31 @@ impl ChunkIn {
         self.set_signs(p, red.pbits, red.qbits);
     }
 
-    /// The signs `(-1)^{a·p}`, `(-1)^{b·q}` of lane `p` from the parities.
+    /// The signs `(-1)^{a·p}`, `(-1)^{b·q}` of lane `p` from the parity bit
+    /// masks (`p_1` in bit 1, `p_2` in bit 0, as in FLINT's index).
     #[inline(always)]
     pub(super) fn set_signs(&mut self, p: usize, pbits: usize, qbits: usize) {
-        for h in 0..4 {
-            self.sa[h][p] = 1.0 - 2.0 * f64::from((h & pbits).count_ones() & 1);
-            self.sb[h][p] = 1.0 - 2.0 * f64::from((h & qbits).count_ones() & 1);
-        }
+        let sign = |bits: usize, bit: usize| 1.0 - 2.0 * ((bits >> bit) & 1) as f64;
+        self.set_sign_lanes(
+            p,
+            [sign(pbits, 1), sign(pbits, 0)],
+            [sign(qbits, 1), sign(qbits, 0)],
+        );
+    }
+
+    /// The signs of lane `p` from `sp = ((-1)^{p_1}, (-1)^{p_2})` and `sq`
+    /// likewise: `sa[h] = (-1)^{h·p}` with `h = (h_1, h_2)` the bits (1, 0) of
+    /// the index `h` (plain products, so it vectorises across lanes).
+    #[inline(always)]
+    pub(super) fn set_sign_lanes(&mut self, p: usize, sp: [f64; 2], sq: [f64; 2]) {
+        self.sa[0][p] = 1.0;
+        self.sa[1][p] = sp[1];
+        self.sa[2][p] = sp[0];
+        self.sa[3][p] = sp[0] * sp[1];
+        self.sb[0][p] = 1.0;
+        self.sb[1][p] = sq[1];
+        self.sb[2][p] = sq[0];
+        self.sb[3][p] = sq[0] * sq[1];
     }
 }
 

@@ -1316,16 +1316,8 @@ impl ThetaPlan {
             } else {
                 0.0
             };
-            // (-1)^{h·p} with h = (h0, h1) the bits (2, 1) of the index.
             let sq = [1.0 - 2.0 * parity(q[0]), 1.0 - 2.0 * parity(q[1])];
-            inp.sa[0][p] = 1.0;
-            inp.sa[1][p] = sp[1];
-            inp.sa[2][p] = sp[0];
-            inp.sa[3][p] = sp[0] * sp[1];
-            inp.sb[0][p] = 1.0;
-            inp.sb[1][p] = sq[1];
-            inp.sb[2][p] = sq[0];
-            inp.sb[3][p] = sq[0] * sq[1];
+            inp.set_sign_lanes(p, sp, sq);
         }
     }
 
