@@ -4,7 +4,7 @@
 //! 4096 times are below the parallel threshold of one work unit per thread).
 
 use criterion::{black_box, criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
-use manakov::cancel::Cancel;
+use manakov::numeric::cancel::Cancel;
 use manakov::solution::Solution;
 
 const A: [f64; 4] = [0.3, 1.1, 2.0, 3.7];

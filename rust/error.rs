@@ -52,7 +52,7 @@ pub enum Error {
         reached: f64,
         iterations: usize,
     },
-    /// The computation was cancelled (Ctrl-C in Python; see [`crate::cancel`]).
+    /// The computation was cancelled (Ctrl-C in Python; see [`crate::numeric::cancel`]).
     Interrupted,
 }
 

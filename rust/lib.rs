@@ -17,11 +17,11 @@
 //! The crate is pure Rust; the Python bindings live behind the `python`
 //! feature in a private module.
 
-pub mod cancel;
 pub mod curve;
 pub mod error;
 pub mod integrate;
 pub mod kotter;
+pub mod numeric;
 pub mod riemann;
 pub mod so4;
 pub mod solution;

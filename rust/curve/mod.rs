@@ -48,6 +48,7 @@
 use num_complex::Complex64;
 
 use crate::error::{Error, Result};
+use crate::numeric::complex::{cdiv, sqrt_principal};
 
 /// Floor of the relative weights of the Gauss–Newton polish of the points
 /// (a fraction of the largest of the six targets): below it a component is
@@ -96,51 +97,6 @@ const NEAR_DOUBLE_ROOT: f64 = 1e-6;
 
 /// The cyclic permutations `(j, k, l)` of `(1, 2, 3)`, in the order `j = 1, 2, 3`.
 pub const CYCLIC: [(usize, usize, usize); 3] = [(1, 2, 3), (2, 3, 1), (3, 1, 2)];
-
-/// Principal square root, `−π/2 < arg √w ≤ π/2`, with `√(−x) = +i√x` for
-/// `x > 0` whatever the sign of the zero imaginary part.
-///
-/// Computed as `t = √((|w| + |Re w|)/2)` (Kahan's formulation), which is
-/// accurate to a few ulps in both components, unlike the polar form.
-/// `|w| = √(Re w² + Im w²)` directly while the sum of squares is a normal
-/// double (error ≤ 1 ulp, as `hypot`'s), else `hypot`: libm's `hypot` costs
-/// ~250 instructions and was 40 % of the reduction's per-state time.
-pub fn sqrt_principal(w: Complex64) -> Complex64 {
-    let (re, im) = (w.re, w.im + 0.0); // + 0.0 maps −0.0 to +0.0: one cut side
-    if re == 0.0 && im == 0.0 {
-        return Complex64::new(0.0, 0.0);
-    }
-    let s = re * re + im * im;
-    let modulus = if s.is_normal() && s < f64::MAX {
-        s.sqrt()
-    } else {
-        re.hypot(im)
-    };
-    let t = ((modulus + re.abs()) / 2.0).sqrt();
-    if re >= 0.0 {
-        Complex64::new(t, im / (2.0 * t))
-    } else {
-        Complex64::new(im.abs() / (2.0 * t), t.copysign(im))
-    }
-}
-
-/// `a / b` by Smith's algorithm: no intermediate `|b|²`, so quotients of
-/// numbers near the ends of the double range (`1/(1e-200)`, whose `|b|²`
-/// underflows to 0 in the textbook formula) stay finite when the result is.
-pub fn cdiv(a: Complex64, b: Complex64) -> Complex64 {
-    if b.re.abs() >= b.im.abs() {
-        if b.re == 0.0 {
-            return a / b; // b = 0: the IEEE result (inf/NaN), caught by the callers
-        }
-        let r = b.im / b.re;
-        let den = b.re + b.im * r;
-        Complex64::new((a.re + a.im * r) / den, (a.im - a.re * r) / den)
-    } else {
-        let r = b.re / b.im;
-        let den = b.re * r + b.im;
-        Complex64::new((a.re * r + a.im) / den, (a.im * r - a.re) / den)
-    }
-}
 
 /// The genus-2 curve (8) `y² = R(x) = Π_{j=0}^{4} (x − d_j)`, `d_0 = 0`,
 /// `d_4 = d_1 d_2 d_3`, with distinct (complex) branch points.

@@ -68,19 +68,6 @@ fn min_dist(z: C, d: &[C; 5]) -> f64 {
 }
 
 #[test]
-fn sqrt_principal_branch() {
-    assert_eq!(sqrt_principal(c(4.0, 0.0)), c(2.0, 0.0));
-    assert_eq!(sqrt_principal(c(-4.0, 0.0)), c(0.0, 2.0));
-    // The signed zero does not move a negative real to the other side of the cut.
-    assert_eq!(sqrt_principal(c(-4.0, -0.0)), c(0.0, 2.0));
-    assert_eq!(sqrt_principal(c(0.0, 0.0)), c(0.0, 0.0));
-    let w = c(-3.0, -4.0);
-    let r = sqrt_principal(w);
-    assert_eq!(r, c(1.0, -2.0));
-    assert_relative_eq!((r * r - w).norm(), 0.0, epsilon = ROUNDING_TOL);
-}
-
-#[test]
 fn construction_and_validation() {
     let k = KotterCurve::new(c(2.0, 0.0), c(3.0, 0.0), c(-0.5, 1.0)).unwrap();
     let d = k.branch_points();

@@ -44,8 +44,9 @@
 use super::dop853::{A as DA, B as DB, BHH, ER};
 use super::gauss_tables::{B8, E8, MU8};
 use super::{scaled, starting_step, substeps, StopRule};
-use crate::cancel::Cancel;
 use crate::error::{Error, Result};
+use crate::numeric::cancel::{Cancel, CHECK_EVERY};
+use crate::numeric::tol::min_step;
 use crate::so4::{vector_field4, vector_field4_lanes};
 
 /// Trajectories per vector group (f64 lanes of an AVX2 register).
@@ -54,9 +55,6 @@ pub const W: usize = 4;
 const S: usize = 8;
 /// so(4) state length.
 const M: usize = 6;
-/// Steps (gauss16) or step attempts (dop853) between two cancellation checks:
-/// ~0.1 ms of work for a group.
-const CHECK_EVERY: u32 = 64;
 
 /// Runs `body` compiled for AVX2+FMA when the CPU has them, else the baseline.
 macro_rules! dispatch {
@@ -648,7 +646,7 @@ fn dop853_group_body(
                 let remaining = times[idx[w]] - t[w];
                 last[w] = hcur[w] >= remaining;
                 hh[w] = if last[w] { remaining } else { hcur[w] };
-                if hh[w] <= 1e-14 * t[w].abs().max(1.0) && !last[w] {
+                if hh[w] <= min_step(t[w]) && !last[w] {
                     return Err(Error::NoConvergence {
                         what: "dop853 step size underflow",
                         tol: o.rtol,

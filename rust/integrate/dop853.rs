@@ -14,8 +14,9 @@
 #![allow(clippy::excessive_precision)]
 
 use super::{scaled, starting_step, VectorField};
-use crate::cancel::Cancel;
 use crate::error::{Error, Result};
+use crate::numeric::cancel::{Cancel, CHECK_EVERY};
+use crate::numeric::tol::min_step;
 
 /// Nodes `c_i`. The vector field is autonomous, so only the order-condition
 /// tests use them.
@@ -277,10 +278,10 @@ impl Dop853 {
             let last = self.h >= remaining;
             let h = if last { remaining } else { self.h };
             attempts = attempts.wrapping_add(1);
-            if attempts % super::CHECK_EVERY == 0 {
+            if attempts % CHECK_EVERY == 0 {
                 cancel.check()?;
             }
-            if h <= 1e-14 * t.abs().max(1.0) && !last {
+            if h <= min_step(*t) && !last {
                 return Err(Error::NoConvergence {
                     what: "dop853 step size underflow",
                     tol: self.rtol,

@@ -35,7 +35,8 @@
 //!
 //! **Budgets and cancellation.** Step budgets and output sizes are checked before
 //! any work or allocation ([`check_budget`]); the `_with` variants take a
-//! [`Cancel`] token and check it every [`CHECK_EVERY`] steps (well under a
+//! [`Cancel`] token and check it every
+//! [`CHECK_EVERY`](crate::numeric::cancel::CHECK_EVERY) steps (well under a
 //! millisecond of work), returning `Error::Interrupted`.
 
 // Index loops mirror the subscripts of the formulas (i, j stages; k components).
@@ -49,15 +50,14 @@ pub mod gauss_tables;
 
 use rayon::prelude::*;
 
-pub use crate::cancel::Cancel;
 use crate::error::{check_finite, Error, Result};
+pub use crate::numeric::cancel::Cancel;
+use crate::numeric::cancel::{poll_during, CHECK_EVERY};
+use crate::numeric::tol::min_step;
 
 /// Trajectories per vector group of the batch kernels (f64 lanes of AVX2).
 pub const LANES: usize = batch::W;
 
-/// Steps (or step attempts) between two checks of the [`Cancel`] token: 64
-/// steps are 0.02–0.2 ms of work, far below the 0.5 s promised for Ctrl-C.
-pub const CHECK_EVERY: u32 = 64;
 use crate::so4::FrahmTop;
 
 /// An autonomous vector field `ẏ = f(y)` on `R^dim`.
@@ -872,7 +872,7 @@ impl Dopri5 {
             if attempts % CHECK_EVERY == 0 {
                 cancel.check()?;
             }
-            if h <= 1e-14 * t.abs().max(1.0) && !last {
+            if h <= min_step(*t) && !last {
                 return Err(Error::NoConvergence {
                     what: "dopri5 step size underflow",
                     tol: self.rtol,
@@ -1246,34 +1246,6 @@ fn run_gauss<S: Stepper, F: VectorField>(
     })();
     *evals += g.evals();
     res
-}
-
-/// Runs `work` on a scoped thread while the calling thread polls `cancel` (whose
-/// poll function, e.g. Python's signal check, runs only on the thread that made
-/// it; a thread blocked in rayon would never poll). Joined before returning, so
-/// no thread outlives the call.
-fn poll_during<T: Send>(cancel: &Cancel, work: impl FnOnce() -> T + Send) -> T {
-    use std::sync::mpsc::{channel, RecvTimeoutError};
-    std::thread::scope(|s| {
-        let (done, finished) = channel::<()>();
-        let handle = s.spawn(move || {
-            let out = work();
-            // The receiver lives until the join below; a failed send cannot happen.
-            let _ = done.send(());
-            out
-        });
-        // Wakes as soon as the work is done (no polling delay on short calls).
-        while let Err(RecvTimeoutError::Timeout) =
-            finished.recv_timeout(std::time::Duration::from_millis(5))
-        {
-            // An Err here has set the shared flag; the workers see it and stop.
-            let _ = cancel.check();
-        }
-        match handle.join() {
-            Ok(v) => v,
-            Err(panic) => std::panic::resume_unwind(panic),
-        }
-    })
 }
 
 /// Trajectories per rayon task of the dop853 and Taylor batch kernels: 8 lane

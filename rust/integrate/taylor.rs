@@ -38,15 +38,13 @@
 #![allow(clippy::needless_range_loop)]
 
 use super::batch::{Lanes, V, W};
-use crate::cancel::Cancel;
 use crate::error::{Error, Result};
+use crate::numeric::cancel::{Cancel, CHECK_EVERY};
 
 /// so(4) state length.
 const M: usize = 6;
 /// Highest order: `p(ε = f64::EPSILON) = ⌈18.02 + 1⌉ = 20`.
 pub const MAX_ORDER: usize = 20;
-/// Group steps between two cancellation checks (~0.05 ms of work).
-const CHECK_EVERY: u32 = 64;
 
 /// Smallest relative tolerance: machine epsilon (a tighter one would only
 /// raise the order past the rounding of the sums).

@@ -18,7 +18,7 @@
 //!   which `f(s_p) = 0` (`σ_p = −(h1 s_p² − h2 s_p + h3)/(2 h0)`; computed as
 //!   `√G(s_p)` on that branch).
 //! * The level-set constants (`s_p`, `σ_p`, `F'(s_p)`, `u`, `v`, `Δ`, `d_j`,
-//!   `α_j … δ_j`) are computed in double-double (`rust/kotter/dd.rs`) and rounded once; the
+//!   `α_j … δ_j`) are computed in double-double (`rust/numeric/dd.rs`) and rounded once; the
 //!   low parts of `u`, `v` are kept for `l^(p)`, `ξ`, `η` (docs/kotter.md §3).
 //! * `√F'(s_p)` principal. Order of the roots: `s1` the non-real root of
 //!   largest imaginary part, `s2` the root nearest `conj(s1)`, `s3` the
@@ -33,9 +33,9 @@ use num_complex::Complex64;
 
 use crate::curve::{CurvePoint, KotterCurve, WurzelPoints};
 use crate::error::{check_finite, Error, Result, SingularKind};
-
-mod dd;
-use dd::{Cdd, Dd};
+use crate::numeric::complex::sqrt_principal;
+use crate::numeric::dd::{Cdd, Dd};
+use crate::numeric::tol::REDUCTION_FLOOR_RTOL;
 
 type C = Complex64;
 
@@ -44,16 +44,6 @@ const ONE: C = C::new(1.0, 0.0);
 
 /// `(j, k, l)` cyclic permutations of `(1, 2, 3)`, 0-based, in the order `j = 1, 2, 3`.
 pub const CYCLIC: [(usize, usize, usize); 3] = [(0, 1, 2), (1, 2, 0), (2, 0, 1)];
-
-/// `|h1² − 4 h0²| ≤ DEGENERATE_RTOL · h1²` is treated as `h1² = 4 h0²`: the
-/// denominator of (19) vanishes. From the state, `h1² − 4h0² = |m − n|² |m + n|²`
-/// is exact to a few ulps; the bound is where the double-double level-set
-/// constants run out of digits: at `(h1² − 4h0²)/h1² = 4e-12` 2 of 600 random
-/// states fail (the inverse map of the curve); with the bound removed, 5 of 80
-/// states of the shared tops fail at 1e-14, and at 1e-16 64 of 80 fail while
-/// the others round-trip to only 5e-9 (`tests/data/kotter_singular_sweep.py`;
-/// the guaranteed range ends at [`NEAR_SINGULAR_RTOL`]).
-pub const DEGENERATE_RTOL: f64 = 1e-12;
 
 /// Roots of `F` closer than `REPEATED_ROOT_RTOL` times their scale are
 /// treated as repeated: then `F'(s_p) → 0` and `l^(p)` (20) is undefined. A
@@ -76,11 +66,6 @@ pub const ROOT_STAGNATION: f64 = 1e-8;
 /// `1/|d_j − d_k|`); 1e-6 still rejects an inconsistent structure, whose
 /// residual is O(1).
 pub const STRUCTURE_RTOL: f64 = 1e-6;
-
-/// The principal square root of the curve module (`−π/2 < arg √w ≤ π/2`,
-/// `√(−x) = +i√x` whatever the sign of a zero imaginary part), so that both
-/// modules cut `(−∞, 0)` on the same side.
-pub use crate::curve::sqrt_principal;
 
 fn check_a(a: &[f64; 4]) -> Result<()> {
     check_finite("a", a)?;
@@ -292,7 +277,7 @@ pub fn p_poly(h: &[f64; 4], s: C) -> C {
 /// Coefficients of `F(s)` (19), monic, highest power first:
 /// `F = [(h1 s² − h2 s + h3)² − 4 h0² G(s)] / (h1² − 4 h0²)`.
 ///
-/// Errors: `h1² = 4 h0²` (to [`DEGENERATE_RTOL`]), i.e. `m = ±n`: (19) is not
+/// Errors: `h1² = 4 h0²` (to [`REDUCTION_FLOOR_RTOL`]), i.e. `m = ±n`: (19) is not
 /// defined (and `f(s)` has fewer than four zeros).
 pub fn quartic_f(a: &[f64; 4], h: &[f64; 4]) -> Result<[f64; 5]> {
     quartic_f_den(a, h, h[1] * h[1] - 4.0 * h[0] * h[0])
@@ -302,14 +287,14 @@ pub fn quartic_f(a: &[f64; 4], h: &[f64; 4]) -> Result<[f64; 5]> {
 /// keeps its relative accuracy where the difference of squares loses it).
 fn quartic_f_den(a: &[f64; 4], h: &[f64; 4], den: f64) -> Result<[f64; 5]> {
     let [h0, h1, h2, h3] = *h;
-    if den.abs() <= DEGENERATE_RTOL * h1 * h1 || h1 == 0.0 {
+    if den.abs() <= REDUCTION_FLOOR_RTOL * h1 * h1 || h1 == 0.0 {
         return Err(Error::Singular {
             what: "state l",
             kind: SingularKind::SelfDual,
             reason: format!(
                 "h1^2 - 4 h0^2 = {den:e} vanishes (h1 = {h1}, h0 = {h0}; the state is \
                  self-dual or anti-self-dual, m = +-n, or at a relative distance \
-                 (h1^2 - 4 h0^2)/h1^2 = {:e} <= {DEGENERATE_RTOL:e} from it): F(s) (19) is not \
+                 (h1^2 - 4 h0^2)/h1^2 = {:e} <= {REDUCTION_FLOOR_RTOL:e} from it): F(s) (19) is not \
                  defined",
                 den / (h1 * h1)
             ),
@@ -603,7 +588,7 @@ pub fn kotter_constants(a: &[f64; 4], l: &[f64; 6]) -> Result<KotterConstants> {
 /// double-double level-set constants run out of digits (`d_j` to 2e-17 at
 /// `δ = 4e-12`, the mismatch of (42) reaches 6e-9) and the inverse map of the
 /// curve starts to fail (2 of 600 states at `δ = 4e-12`; docs/kotter.md, "Near
-/// the singular set"). Below [`DEGENERATE_RTOL`] every state raises.
+/// the singular set"). Below [`REDUCTION_FLOOR_RTOL`] every state raises.
 pub const NEAR_SINGULAR_RTOL: f64 = 1e-10;
 
 /// `δ = (h1² − 4h0²)/h1²` from the state (`h1² − 4h0² = |m − n|²|m + n|²`,
@@ -1021,7 +1006,7 @@ fn dp_dd(lv: &Level, x: &[Cdd; 4]) -> Cdd {
 /// The closed forms here and in [`df_dd`] cancel near the singular set by
 /// about the relative distance `(h1² − 4h0²)/h1²` to it ([`Level::f`]), which
 /// DD absorbs: its `u²` leaves `u² h1²/(h1² − 4h0²)`, far below double
-/// precision for every state not refused by [`DEGENERATE_RTOL`].
+/// precision for every state not refused by [`REDUCTION_FLOOR_RTOL`].
 fn f_dd(lv: &Level, h0: Dd, x: &[Cdd; 4], sg: Cdd) -> Cdd {
     p_dd(lv, x).add(sg.mul_dd(h0).mul_f64(2.0))
 }
@@ -1058,7 +1043,7 @@ fn constants_impl(
         None => h[1] * h[1] - 4.0 * h[0] * h[0],
     };
     let f = quartic_f_den(a, h, den)?;
-    if h[0] == 0.0 || h[0].abs() <= DEGENERATE_RTOL * h[1] {
+    if h[0] == 0.0 || h[0].abs() <= REDUCTION_FLOOR_RTOL * h[1] {
         return Err(Error::Singular {
             what: "state l",
             kind: SingularKind::VanishingH0,

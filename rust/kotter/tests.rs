@@ -458,7 +458,7 @@ fn fprime_identity_19prime() {
 /// 2.5e-12 there).
 #[test]
 fn identities_21_hold_in_double_double() {
-    use super::dd::Cdd;
+    use crate::numeric::dd::Cdd;
     const DD_RTOL: f64 = 1e-26;
     let cases = [
         (A, L0),

@@ -36,6 +36,8 @@ impl From<Error> for PyErr {
 /// Python's signal handlers (so Ctrl-C is seen) from the calling thread, at
 /// most every `cancel::POLL_INTERVAL`.
 #[allow(dead_code)] // used by the integrate and theta bindings as they adopt it
-pub fn py_cancel() -> crate::cancel::Cancel {
-    crate::cancel::Cancel::with_poll(|| pyo3::Python::attach(|py| py.check_signals().is_err()))
+pub fn py_cancel() -> crate::numeric::cancel::Cancel {
+    crate::numeric::cancel::Cancel::with_poll(|| {
+        pyo3::Python::attach(|py| py.check_signals().is_err())
+    })
 }

@@ -48,8 +48,8 @@ use std::sync::OnceLock;
 use nalgebra::DMatrix;
 use num_complex::Complex64;
 
-use crate::curve::sqrt_principal;
 use crate::error::{Error, Result};
+use crate::numeric::complex::sqrt_principal;
 use crate::theta::ThetaPlan;
 use quad::{abs_fast, focal_half_sum_sqrt, nodes_for, sqrt_fast, Piece, SegmentSqrt, SqrtProduct};
 
@@ -795,7 +795,7 @@ impl HyperellipticCurve {
         }
         let (rn, yn) = (r.norm_sqr(), y.norm_sqr());
         let dev = if rn > 1e-200 && rn < 1e200 && yn < 1e200 {
-            (crate::curve::cdiv(y * y, r) - 1.0).norm()
+            (crate::numeric::complex::cdiv(y * y, r) - 1.0).norm()
         } else {
             let mut q = y;
             for &ek in &self.e {

@@ -152,7 +152,7 @@ pub fn abs_fast(z: C) -> f64 {
     }
 }
 
-/// [`crate::curve::sqrt_principal`] (same branch, Kahan's formulation) with
+/// [`crate::numeric::complex::sqrt_principal`] (same branch, Kahan's formulation) with
 /// the modulus from [`abs_fast`].
 #[inline(always)]
 pub fn sqrt_fast(w: C) -> C {

@@ -34,10 +34,12 @@ use nalgebra::{DMatrix, DVector};
 use num_complex::Complex64;
 use rayon::prelude::*;
 
-use crate::cancel::Cancel;
-use crate::curve::{sqrt_principal, KotterCurve, CYCLIC};
+use crate::curve::{KotterCurve, CYCLIC};
 use crate::error::{Error, Result, SingularKind};
 use crate::kotter::{kotter_constants, kotter_with, KotterConstants, KotterState};
+use crate::numeric::cancel::Cancel;
+use crate::numeric::complex::sqrt_principal;
+use crate::numeric::tol::SINGULAR_SET_RTOL;
 use crate::riemann::HyperellipticCurve;
 use crate::so4;
 use crate::theta::{char_index, LatticeLanes, SelectedBlock, ThetaJet, ThetaPlan, BLOCK};
@@ -49,10 +51,6 @@ type C = Complex64;
 /// Truncation tolerance of the theta sums (absolute, on normalised values):
 /// below the rounding of the quotients.
 pub const THETA_TOL: f64 = 1e-16;
-
-/// `h0 = 0` or `h1² = 4h0²` are detected relative to `|l|²` (resp. `|l|⁴`):
-/// the integrals are rounded sums of products of size `|l|²`.
-pub const DEGENERATE_RTOL: f64 = 1e-13;
 
 /// The divisor of `l0` contains ∞ (the `P_L` have poles) when `θ(v0)` is
 /// this small relative to the largest `|θ[χ](v0)|`.
@@ -757,7 +755,7 @@ pub struct LevelSetCurve {
 
 /// The checks of `l0` that precede the reduction, and the reduction's
 /// level-set objects: refuses `l0 = 0`, `h0 = 0`, `h1² = 4h0²` (relative to
-/// [`DEGENERATE_RTOL`]) and coinciding branch points with a
+/// [`SINGULAR_SET_RTOL`]) and coinciding branch points with a
 /// [`Error::Singular`] that names the reason.
 pub fn level_set_curve(a: &[f64; 4], l0: &[f64; 6]) -> Result<LevelSetCurve> {
     crate::error::check_finite("l0", l0)?;
@@ -770,7 +768,7 @@ pub fn level_set_curve(a: &[f64; 4], l0: &[f64; 6]) -> Result<LevelSetCurve> {
     }
     let h = so4::integrals4(a, l0);
     let s2 = size * size;
-    if h[0].abs() <= DEGENERATE_RTOL * s2 {
+    if h[0].abs() <= SINGULAR_SET_RTOL * s2 {
         return Err(singular(
             SingularKind::VanishingH0,
             format!(
@@ -782,7 +780,7 @@ pub fn level_set_curve(a: &[f64; 4], l0: &[f64; 6]) -> Result<LevelSetCurve> {
         ));
     }
     let disc = h[1] * h[1] - 4.0 * h[0] * h[0];
-    if disc.abs() <= DEGENERATE_RTOL * (h[1] * h[1] + 4.0 * h[0] * h[0]) {
+    if disc.abs() <= SINGULAR_SET_RTOL * (h[1] * h[1] + 4.0 * h[0] * h[0]) {
         return Err(singular(
             SingularKind::SelfDual,
             format!(

@@ -42,9 +42,10 @@
 use nalgebra::{Matrix2, Vector2};
 use num_complex::Complex64;
 
-use crate::curve::{sqrt_principal, KotterCurve, CYCLIC};
+use crate::curve::{KotterCurve, CYCLIC};
 use crate::error::{Error, Result};
 use crate::kotter::KotterConstants;
+use crate::numeric::complex::sqrt_principal;
 use crate::so4::PAIRS4;
 
 type C = Complex64;

@@ -41,8 +41,9 @@ mod sum;
 pub use bound::tail_bound;
 pub use chars::{char_from_index, char_index, paper_char_index, parity, MAX_GENUS, PAPER_TABLE_35};
 
-use crate::cancel::Cancel;
 use crate::error::{check_finite, Error, Result};
+use crate::numeric::cancel::{poll_during, Cancel};
+use crate::numeric::compensated::{split, two_sum};
 use num_complex::Complex64;
 use rayon::prelude::*;
 
@@ -960,7 +961,7 @@ impl ThetaPlan {
         } else {
             hessian.chunks_mut(chunk * hs).collect()
         };
-        run_polled(cancel, || {
+        poll_during(cancel, || {
             z.par_chunks(chunk * g)
                 .zip(values.par_chunks_mut(chunk * n))
                 .zip(gchunks.par_iter_mut())
@@ -1418,7 +1419,7 @@ impl ThetaPlan {
         let Some(chunk) = self.parallel_chunk(npts).filter(|_| shapes_ok) else {
             return self.eval_batch_scaled_serial(z, values, log_scale, cancel);
         };
-        run_polled(cancel, || {
+        poll_during(cancel, || {
             z.par_chunks(chunk * g)
                 .zip(values.par_chunks_mut(chunk * n))
                 .zip(log_scale.par_chunks_mut(chunk))
@@ -1443,33 +1444,6 @@ impl ThetaPlan {
         self.eval_batch_serial(z, values, &mut [], &mut [], log_scale, cancel)?;
         Ok(apply_scale(values, &mut [], &mut [], log_scale))
     }
-}
-
-/// Runs `work` (which splits itself over rayon's pool) while the calling thread
-/// polls `cancel`: the caller is not a pool thread, so without this it would
-/// only wait, and a poll that must run on the calling thread (Python's signal
-/// handlers) would never run. On cancellation the flag stops the workers at
-/// their next check.
-fn run_polled<T: Send>(cancel: &Cancel, work: impl FnOnce() -> Result<T> + Send) -> Result<T> {
-    let (tx, rx) = std::sync::mpsc::sync_channel::<()>(1);
-    let mut out = None;
-    rayon::in_place_scope(|s| {
-        let slot = &mut out;
-        s.spawn(move |_| {
-            *slot = Some(work());
-            // The receiver lives until the scope ends; a failed send cannot happen.
-            let _ = tx.send(());
-        });
-        // recv_timeout wakes as soon as the work is done: no added latency.
-        while let Err(std::sync::mpsc::RecvTimeoutError::Timeout) =
-            rx.recv_timeout(std::time::Duration::from_millis(5))
-        {
-            if cancel.check().is_err() {
-                break;
-            }
-        }
-    });
-    out.unwrap_or(Err(Error::Interrupted))
 }
 
 /// Multiplies batch outputs of [`ThetaPlan::eval_batch`] by `exp(L)` in place, giving
@@ -1533,21 +1507,6 @@ fn times_i_pow(v: Complex64, p: u8) -> Complex64 {
         2 => -v,
         _ => Complex64::new(v.im, -v.re),
     }
-}
-
-/// Veltkamp split `x = hi + lo`, `hi` with 26 significant bits: `hi·n` and
-/// `lo·n` are exact for integers `|n| < 2^26`.
-fn split(x: f64) -> (f64, f64) {
-    let c = 134_217_729.0 * x; // 2^27 + 1
-    let hi = c - (c - x);
-    (hi, x - hi)
-}
-
-/// Knuth's two-sum: `a + b = s + err` exactly.
-fn two_sum(a: f64, b: f64) -> (f64, f64) {
-    let s = a + b;
-    let bb = s - a;
-    (s, (a - (s - bb)) + (b - bb))
 }
 
 /// `base - Σ_k coef_k q_k` for integers `q_k`, with exact products (for

@@ -494,7 +494,7 @@ fn a_cancelled_batch_stops_with_interrupted_serial_and_parallel() {
         .collect();
     for parallel in [false, true] {
         let plan = plan.clone().with_parallel(parallel);
-        let cancel = crate::cancel::Cancel::never();
+        let cancel = crate::numeric::cancel::Cancel::never();
         cancel.cancel();
         let mut v = vec![C::new(0.0, 0.0); 16 * npts];
         let mut l = vec![0.0; npts];
@@ -517,7 +517,7 @@ fn a_cancelled_batch_stops_with_interrupted_serial_and_parallel() {
             &mut [],
             &mut [],
             &mut l2,
-            &crate::cancel::Cancel::never(),
+            &crate::numeric::cancel::Cancel::never(),
         )
         .unwrap();
         assert_eq!(v, v2);

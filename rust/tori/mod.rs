@@ -37,8 +37,9 @@ mod tests;
 use num_complex::Complex64;
 use rayon::prelude::*;
 
-use crate::cancel::Cancel;
 use crate::error::{Error, Result};
+use crate::numeric::cancel::Cancel;
+use crate::numeric::tol::SINGULAR_SET_RTOL;
 
 /// A point of `C²`.
 pub type C2 = [Complex64; 2];
@@ -590,12 +591,6 @@ pub fn second_flow_b(a: &[f64; 4], b: &[f64; 4]) -> [f64; 4] {
     }
 }
 
-/// Relative size of `h1² − 4h0²` below which a state counts as on the
-/// singular level set `h1² = 4h0²` (status 1): `F(s)` of (19) divides by it.
-/// The solution refuses below 1e-13 (`solution::DEGENERATE_RTOL`); this
-/// pre-check only saves its set-up and reports the same code.
-pub const CASIMIR_SINGULAR_RTOL: f64 = 1e-13;
-
 /// The status and frequencies of one state.
 ///
 /// `solve(l0)` runs the Theorem and returns [`FlowData`]; its errors become
@@ -615,7 +610,9 @@ where
     let h0 = l12 * l34 - l13 * l24 + l14 * l23;
     let h1: f64 = l0.iter().map(|v| v * v).sum();
     let disc = h1 * h1 - 4.0 * h0 * h0;
-    if disc.abs() <= CASIMIR_SINGULAR_RTOL * (h1 * h1 + 4.0 * h0 * h0) {
+    // The solution's own test (it would refuse the state): this pre-check only
+    // saves its set-up and reports the status of the singular level set.
+    if disc.abs() <= SINGULAR_SET_RTOL * (h1 * h1 + 4.0 * h0 * h0) {
         return MapEntry::failed(Status::SingularCasimirs);
     }
     let d = match solve(l0) {

@@ -7,6 +7,9 @@
 //! every [`POLL_INTERVAL`], and only from the thread that made it: Python runs
 //! signal handlers in its main thread only. Worker threads see the shared flag.
 //! The core never depends on Python: [`Cancel::never`] is the plain-Rust default.
+//!
+//! A computation split over rayon's pool runs through [`poll_during`], so that
+//! the calling thread (which made the token) keeps polling while the pool works.
 
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::thread::ThreadId;
@@ -17,6 +20,18 @@ use crate::error::{Error, Result};
 /// How often the poll function runs at most. Ctrl-C must stop a call within
 /// 0.5 s; 20 ms leaves the rest of that for the chunk of work between checks.
 pub const POLL_INTERVAL: Duration = Duration::from_millis(20);
+
+/// Steps (or step attempts) of an integrator between two [`Cancel::check`]s:
+/// 64 steps are 0.02–0.2 ms of work (one trajectory, or a lane group of the
+/// batch kernels), far below the 0.5 s promised for Ctrl-C, and the check
+/// (~50 ns) is then free.
+pub const CHECK_EVERY: u32 = 64;
+
+/// How long the calling thread of [`poll_during`] sleeps between two polls
+/// while the work runs. It wakes as soon as the work is done, so this adds no
+/// latency; 5 ms keeps the poll (itself run at most every [`POLL_INTERVAL`])
+/// on time.
+pub const POLL_WAIT: Duration = Duration::from_millis(5);
 
 type Poll = Box<dyn Fn() -> bool + Send + Sync>;
 
@@ -97,6 +112,35 @@ impl Cancel {
     }
 }
 
+/// Runs `work` (which splits itself over rayon's pool) while the calling
+/// thread polls `cancel` every [`POLL_WAIT`]: the caller is not a pool
+/// thread, so without this it would only wait, and a poll that must run on
+/// the thread that made the token (Python's signal handlers) would never run.
+/// On cancellation the shared flag stops the workers at their next check;
+/// the call returns once `work` has returned (no thread outlives it).
+pub fn poll_during<T: Send>(cancel: &Cancel, work: impl FnOnce() -> Result<T> + Send) -> Result<T> {
+    use std::sync::mpsc::{sync_channel, RecvTimeoutError};
+    let (done, finished) = sync_channel::<()>(1);
+    let mut out = None;
+    rayon::in_place_scope(|s| {
+        let slot = &mut out;
+        s.spawn(move |_| {
+            *slot = Some(work());
+            // The receiver lives until the scope ends; a failed send cannot happen.
+            let _ = done.send(());
+        });
+        // recv_timeout wakes as soon as the work is done: no added latency.
+        while let Err(RecvTimeoutError::Timeout) = finished.recv_timeout(POLL_WAIT) {
+            if cancel.check().is_err() {
+                break;
+            }
+        }
+    });
+    // The scope returns after the spawned work (re-raising its panic, if any),
+    // so the slot is filled; `Interrupted` only to avoid an unwrap.
+    out.unwrap_or(Err(Error::Interrupted))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -128,5 +172,21 @@ mod tests {
         std::thread::scope(|s| {
             s.spawn(|| assert_eq!(c.check(), Err(Error::Interrupted))); // the flag is shared
         });
+    }
+
+    #[test]
+    fn poll_during_returns_the_work_and_polls_while_it_runs() {
+        assert_eq!(poll_during(&Cancel::never(), || Ok(7)), Ok(7));
+        // A poll that asks to stop on its first call: the work sees the flag.
+        let c = Cancel::with_poll(|| true);
+        let r = poll_during(&c, || {
+            let t0 = Instant::now();
+            while t0.elapsed() < Duration::from_secs(5) {
+                c.check()?;
+                std::thread::sleep(Duration::from_millis(1));
+            }
+            Ok(())
+        });
+        assert_eq!(r, Err(Error::Interrupted));
     }
 }

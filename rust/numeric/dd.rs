@@ -1,9 +1,9 @@
-//! Double-double ("DD") arithmetic for the level-set constants.
+//! Double-double ("DD") arithmetic (the reduction's level-set constants).
 //!
 //! A DD number is an unevaluated sum `hi + lo` with `|lo| ≤ ulp(hi)/2`,
-//! carrying about 106 bits. The error-free transformations are Knuth's
-//! `two_sum`, the `fast_two_sum` of Dekker (for `|a| ≥ |b|`) and the product
-//! through a fused multiply-add; the operations are the "accurate" sum and
+//! carrying about 106 bits. The error-free transformations are those of
+//! [`super::compensated`] (Knuth's `two_sum`, Dekker's `fast_two_sum` and
+//! Dekker's product, without FMA); the operations are the "accurate" sum and
 //! the product of Joldes, Muller and Popescu, *Tight and rigorous error bounds
 //! for basic building blocks of double-word arithmetic*, ACM TOMS 44 (2017),
 //! Algorithms 6 and 12 (relative errors ≤ 3u² and ≤ 5u²), and divisions by one
@@ -16,42 +16,8 @@
 
 use num_complex::Complex64;
 
-use crate::curve::cdiv;
-
-/// `a + b = s + e` exactly (Knuth).
-#[inline]
-fn two_sum(a: f64, b: f64) -> (f64, f64) {
-    let s = a + b;
-    let bb = s - a;
-    (s, (a - (s - bb)) + (b - bb))
-}
-
-/// `a + b = s + e` exactly, for `|a| ≥ |b|` (or `a = 0`) (Dekker).
-#[inline]
-fn fast_two_sum(a: f64, b: f64) -> (f64, f64) {
-    let s = a + b;
-    (s, b - (s - a))
-}
-
-/// Veltkamp's splitting `a = hi + lo` into two 26-bit halves (valid for
-/// `|a| < 2^995`, far beyond the magnitudes met here).
-#[inline]
-fn split(a: f64) -> (f64, f64) {
-    let c = 134_217_729.0 * a; // 2^27 + 1
-    let hi = c - (c - a);
-    (hi, a - hi)
-}
-
-/// `a b = p + e` exactly (Dekker's product). Not `f64::mul_add`: without the
-/// `fma` target feature (the default x86-64 target) that is a library call
-/// of ~9 ns, several times the cost of these seventeen flops.
-#[inline]
-fn two_prod(a: f64, b: f64) -> (f64, f64) {
-    let p = a * b;
-    let (ah, al) = split(a);
-    let (bh, bl) = split(b);
-    (p, ((ah * bh - p) + ah * bl + al * bh) + al * bl)
-}
+use super::compensated::{fast_two_sum, two_prod, two_sum};
+use super::complex::{cdiv, sqrt_principal};
 
 /// A real double-double number `hi + lo`.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -268,12 +234,12 @@ impl Cdd {
     }
 
     /// The principal square root (the branch of
-    /// [`crate::curve::sqrt_principal`] applied to the leading double, which
+    /// [`sqrt_principal`] applied to the leading double, which
     /// decides the side of the cut): one Newton step
     /// `r = r0 + (z − r0²)/(2 r0)` from the double root `r0`, with `r0²`
     /// formed exactly, doubles the number of correct digits.
     pub fn sqrt(self) -> Cdd {
-        let r0 = crate::curve::sqrt_principal(self.to_c());
+        let r0 = sqrt_principal(self.to_c());
         if r0 == Complex64::new(0.0, 0.0) {
             return Cdd::ZERO;
         }

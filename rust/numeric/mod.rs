@@ -1,0 +1,20 @@
+//! Shared numerics, below every layer of the chain: each item is defined once
+//! here and used by the layers above (statrs' `prec.rs` is the model).
+//!
+//! * [`compensated`]: error-free transformations — Knuth's `two_sum`,
+//!   Dekker's `fast_two_sum`, Veltkamp's `split` and Dekker's `two_prod`.
+//! * [`dd`]: double-double real and complex numbers built on them (the
+//!   reduction's level-set constants, `crate::kotter`).
+//! * [`complex`]: the principal square root with the crate's one branch cut
+//!   and Smith's complex division.
+//! * [`cancel`]: cooperative cancellation ([`cancel::Cancel`]), the poll of a
+//!   parallel computation from the calling thread ([`cancel::poll_during`])
+//!   and the step count between two checks ([`cancel::CHECK_EVERY`]).
+//! * [`tol`]: thresholds shared by several layers (the smallest step of the
+//!   explicit integrators, the two tests for the singular level sets).
+
+pub mod cancel;
+pub mod compensated;
+pub mod complex;
+pub mod dd;
+pub mod tol;
