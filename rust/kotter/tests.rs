@@ -1,5 +1,7 @@
 #![allow(clippy::needless_range_loop)]
 use super::*;
+use crate::error::SingularKind;
+use crate::numeric::complex::sqrt_principal;
 use approx::assert_relative_eq;
 use proptest::prelude::*;
 

@@ -1,0 +1,398 @@
+//! Each root `s_p` of `F` (19) polished on its own branch of `√G`: Newton's
+//! method on `f(s) = P(s) + 2 h0 √G(s)` (15) in the offset from the nearest
+//! `a_i`, then one step in double-double for `s_p`, `σ_p` and `F'(s_p)`
+//! consistent to better than double precision (docs/kotter.md §3).
+
+use super::schottky::p_poly;
+use super::{C, CYCLIC, ONE, ZERO};
+use crate::numeric::complex::sqrt_principal;
+use crate::numeric::dd::{Cdd, Dd};
+
+/// What the polish of the roots of `F` needs of the level set: `a`, `h`,
+/// `h1² − 4h0²` and, when the reduction starts from a state, `(m, n)`
+/// themselves (then `P(s)` and `f(s)` are summed from the state, without the
+/// cancellation of the forms in `h`).
+pub(super) struct Level<'a> {
+    pub(super) a: &'a [f64; 4],
+    pub(super) h: &'a [f64; 4],
+    pub(super) mn: Option<([f64; 3], [f64; 3])>,
+    pub(super) den: f64,
+}
+
+impl Level<'_> {
+    /// `P(s) = h1 s² − h2 s + h3` and `P'(s)` from the offsets `x_m = s − a_m`.
+    /// From the state, `P(s) = Σ_j (x_j x_4 m_j² + x_k x_l n_j²)`: the
+    /// offsets carry `s − a_m` to full relative accuracy, so `P` near a root of
+    /// `G` (where it is small) keeps its relative accuracy.
+    fn p_dp(&self, s: C, x: &[C; 4]) -> (C, C) {
+        match self.mn {
+            Some((m, n)) => {
+                let mut p = ZERO;
+                let mut dp = ZERO;
+                for (j, &(_, k, l)) in CYCLIC.iter().enumerate() {
+                    let (m2, n2) = (m[j] * m[j], n[j] * n[j]);
+                    p += x[j] * x[3] * m2 + x[k] * x[l] * n2;
+                    dp += (x[j] + x[3]) * m2 + (x[k] + x[l]) * n2;
+                }
+                (p, dp)
+            }
+            None => (p_poly(self.h, s), 2.0 * self.h[1] * s - self.h[2]),
+        }
+    }
+
+    /// `f(s) = Σ_j l_j(s)²` (14) on the branch `√G = sigma` and its size (the
+    /// sum of the magnitudes of its terms, for the convergence test). From the
+    /// state, `l_j(s) = √s_j4 (m_j + τ n_j) + n_j (s_kl − s_j4)/(√s_kl + τ √s_j4)`
+    /// with `τ = ±1` making the denominator the larger of `√s_kl ± √s_j4`:
+    /// near the singular set `m ≈ ∓n` and at large `|s|` the two terms of
+    /// `√s_j4 m_j + √s_kl n_j` cancel, this form does not.
+    fn f(&self, s: C, x: &[C; 4], sigma: C) -> (C, f64) {
+        match self.mn {
+            Some((m, n)) => {
+                let mut f = ZERO;
+                let mut size = 0.0;
+                for (j, &(_, k, l)) in CYCLIC.iter().enumerate() {
+                    let r = sqrt_principal(x[j] * x[3]);
+                    let q = sigma / r;
+                    let tau = if (q * r.conj()).re >= 0.0 { 1.0 } else { -1.0 };
+                    let lj = r * (m[j] + tau * n[j])
+                        + n[j] * (x[k] * x[l] - x[j] * x[3]) / (q + tau * r);
+                    f += lj * lj;
+                    size += (r.norm() * m[j].abs() + q.norm() * n[j].abs()).powi(2);
+                }
+                (f, size)
+            }
+            None => {
+                let (p, _) = self.p_dp(s, x);
+                let [h0, h1, h2, h3] = *self.h;
+                let size =
+                    (h1 * s * s).norm() + (h2 * s).norm() + h3.abs() + (2.0 * h0 * sigma).norm();
+                (p + 2.0 * h0 * sigma, size)
+            }
+        }
+    }
+
+    /// `f'(s)` on the branch `√G = sigma`. From the state, `f' = 2 Σ_j l_j l_j'`
+    /// with `l_j` as in [`Level::f`] and, with `w_a = 1/x_j + 1/x_4`,
+    /// `w_b = 1/x_k + 1/x_l`, `w_b − w_a = (a_k − a_j)/(x_j x_k) + (a_l − a_4)/(x_l x_4)`,
+    /// `l_j' = ½ [w_a l_j + √s_kl n_j (w_b − w_a)]` or `½ [w_b l_j − √s_j4 m_j (w_b − w_a)]`
+    /// (the derivative `½ (w_a √s_j4 m_j + w_b √s_kl n_j)` regrouped so that the
+    /// two terms that cancel near `m = ∓n` at large `|s|` enter only through
+    /// `l_j`; of the two, the one whose `w` has no pole at a nearby `a_i`). The
+    /// closed form `P'(s) + h0 σ Σ_m 1/x_m` cancels there by about the relative
+    /// distance `(h1² − 4h0²)/h1²` to the singular set (docs/kotter.md §3).
+    fn df(&self, s: C, x: &[C; 4], sigma: C) -> C {
+        match self.mn {
+            Some((m, n)) => {
+                let a = self.a;
+                let mut df = ZERO;
+                for (j, &(_, k, l)) in CYCLIC.iter().enumerate() {
+                    let r = sqrt_principal(x[j] * x[3]);
+                    let q = sigma / r;
+                    let tau = if (q * r.conj()).re >= 0.0 { 1.0 } else { -1.0 };
+                    let lj = r * (m[j] + tau * n[j])
+                        + n[j] * (x[k] * x[l] - x[j] * x[3]) / (q + tau * r);
+                    // w_a = 1/x_j + 1/x_4, w_b = 1/x_k + 1/x_l; w_b − w_a from the
+                    // differences of the a's (no cancellation)
+                    let wa = ONE / x[j] + ONE / x[3];
+                    let wb = ONE / x[k] + ONE / x[l];
+                    let wba = (a[k] - a[j]) / (x[j] * x[k]) + (a[l] - a[3]) / (x[l] * x[3]);
+                    let dlj = if wa.norm() <= wb.norm() {
+                        0.5 * (wa * lj + q * n[j] * wba)
+                    } else {
+                        0.5 * (wb * lj - r * m[j] * wba)
+                    };
+                    df += 2.0 * lj * dlj;
+                }
+                df
+            }
+            None => {
+                let (_, dp) = self.p_dp(s, x);
+                dp + self.h[0] * sigma * x.iter().map(|&xm| ONE / xm).sum::<C>()
+            }
+        }
+    }
+}
+
+/// The offsets `x_m = s − a_m` with `s = a_i + t` (`i` the nearest `a`):
+/// `x_i = t`, `x_m = (a_i − a_m) + t`, to full relative accuracy when `t` is.
+fn offsets_at(a: &[f64; 4], i: usize, t: C) -> [C; 4] {
+    std::array::from_fn(|m| if m == i { t } else { (a[i] - a[m]) + t })
+}
+
+/// The continuation of the branch `√G(s)`: the root of `Π x_m` nearest `prev`.
+fn sqrt_g_near(x: &[C; 4], prev: C) -> C {
+    let r = sqrt_principal(x.iter().product());
+    if (r - prev).norm() <= (r + prev).norm() {
+        r
+    } else {
+        -r
+    }
+}
+
+/// A root of `F` (19) polished on its own branch, with what (20) needs there.
+pub(super) struct PolishedRoot {
+    pub(super) s: C,
+    /// `s − a_m` in DD (exact sums from the root's offset to its nearest `a_i`).
+    pub(super) x: [Cdd; 4],
+    /// `σ = √G(s)` on the branch where `f(s) = 0`.
+    pub(super) sigma: Cdd,
+    /// `F'(s) = f'(s) f̃(s) / (h1² − 4h0²)` with `f̃(s) = −4 h0 σ` (docs/kotter.md §3).
+    pub(super) fprime: C,
+    /// `√F'(s)`, principal.
+    pub(super) sqrt_fprime: Cdd,
+}
+
+impl PolishedRoot {
+    /// The root of the conjugate pair's partner: every quantity conjugated,
+    /// `√F'` kept principal (`conj(√F')` is the principal root of `conj(F')`
+    /// except on the cut `F' < 0`, where both are `+i√|F'|`).
+    pub(super) fn conj(&self) -> PolishedRoot {
+        let c = self.sqrt_fprime.conj();
+        let sqrt_fprime = if c.re.hi == 0.0 && c.im.hi < 0.0 {
+            c.neg()
+        } else {
+            c
+        };
+        PolishedRoot {
+            s: self.s.conj(),
+            x: self.x.map(Cdd::conj),
+            sigma: self.sigma.conj(),
+            fprime: self.fprime.conj(),
+            sqrt_fprime,
+        }
+    }
+}
+
+/// Newton's method on `f(s) = P(s) + 2 h0 √G(s)` (15) itself, on the branch
+/// `√G = σ` that vanishes at the root (chosen from the starting value: the
+/// sign with the smaller `|f|`), in the offset `t = s − a_i` from the
+/// nearest `a_i`. `F = f f̃/(h1² − 4h0²)` merges the two branches: when two
+/// roots of `F` lie on different branches `δ` apart, `F'(s_p) ~ δ` and the
+/// quartic's root is good to `u/δ` only, while `f'(s_p)` is not small.
+///
+/// Near `a_i`, where `√G ~ √t` is not smooth, the start is first refined on
+/// `(P(a_i) + P'(a_i) t + h1 t²)² − 4h0² t Π_{m≠i}(a_i − a_m + t)` (the
+/// numerator of (19) at `s = a_i + t`, all terms of the size of `t`).
+pub(super) fn polish_root(lv: &Level, p_at_a: &[f64; 4], s0: C) -> PolishedRoot {
+    let a = lv.a;
+    let [h0, h1, h2, _] = *lv.h;
+    let mut best = 0;
+    for i in 1..4 {
+        if (s0 - a[i]).norm() < (s0 - a[best]).norm() {
+            best = i;
+        }
+    }
+    let ai = a[best];
+    let gap = (0..4)
+        .filter(|&m| m != best)
+        .map(|m| (a[m] - ai).abs())
+        .fold(f64::INFINITY, f64::min);
+    let mut t = s0 - ai;
+    if t.norm() < 0.1 * gap {
+        let pa = p_at_a[best];
+        let dpa = 2.0 * h1 * ai - h2;
+        for _ in 0..4 {
+            let pt = pa + (h1 * t + dpa) * t;
+            let dpt = dpa + 2.0 * h1 * t;
+            let mut prod = ONE;
+            let mut dprod = ZERO;
+            for m in (0..4).filter(|&m| m != best) {
+                let f = ai - a[m] + t;
+                dprod = dprod * f + prod;
+                prod *= f;
+            }
+            let val = pt * pt - 4.0 * h0 * h0 * t * prod;
+            let der = 2.0 * pt * dpt - 4.0 * h0 * h0 * (prod + t * dprod);
+            if der == ZERO || !(val / der).norm().is_finite() {
+                break;
+            }
+            let step = val / der;
+            t -= step;
+            if step.norm() <= f64::EPSILON * t.norm() {
+                break;
+            }
+        }
+    }
+    // the branch: of ±√G(s0), the one on which f is the smaller
+    let x0 = offsets_at(a, best, t);
+    let g0 = sqrt_principal(x0.iter().product());
+    let (fp, _) = lv.f(ai + t, &x0, g0);
+    let (fm, _) = lv.f(ai + t, &x0, -g0);
+    let mut sigma = if fp.norm() <= fm.norm() { g0 } else { -g0 };
+    let mut cur = (t, x0, sigma);
+    let (f_cur, size) = lv.f(ai + t, &x0, sigma);
+    let mut res_best = f_cur.norm() / size.max(f64::MIN_POSITIVE);
+    let mut best_state = cur;
+    for _ in 0..8 {
+        let (t, x, sg) = cur;
+        let s = ai + t;
+        let (f, _) = lv.f(s, &x, sg);
+        let df = lv.df(s, &x, sg);
+        let step = f / df;
+        if !(step.re.is_finite() && step.im.is_finite()) {
+            break;
+        }
+        let tn = t - step;
+        let xn = offsets_at(a, best, tn);
+        sigma = sqrt_g_near(&xn, sg);
+        cur = (tn, xn, sigma);
+        let (fn_, size) = lv.f(ai + tn, &xn, sigma);
+        let res = fn_.norm() / size.max(f64::MIN_POSITIVE);
+        if res < res_best {
+            res_best = res;
+            best_state = cur;
+        }
+        if step.norm() <= 2.0 * f64::EPSILON * (ai + tn).norm().max(tn.norm()) || res == 0.0 {
+            break;
+        }
+    }
+    let (t, x, sigma) = best_state;
+    let s = ai + t;
+    let df = lv.df(s, &x, sigma);
+    let fprime = df * (-4.0 * h0 * sigma) / lv.den;
+    let plain = PolishedRoot {
+        s,
+        x: x.map(Cdd::new),
+        sigma: Cdd::new(sigma),
+        fprime,
+        sqrt_fprime: Cdd::new(sqrt_principal(fprime)),
+    };
+    refine_dd(lv, best, t, sigma, df).unwrap_or(plain)
+}
+
+/// The root, `σ`, the offsets `s − a_m` and `√F'(s)` to double-double
+/// accuracy: one Newton step on `f` evaluated in DD from the double root
+/// (`t = s − a_i`), then `σ`, `f'` and `F' = −4h0 σ f'/(h1² − 4h0²)` in DD at
+/// the new root.
+///
+/// Why: `l^(p)`, `Δ`, `d_j` and `α_j … δ_j` are all built from `(s_p, σ_p, F'(s_p))`,
+/// and the third quadric (11) of the rounded constants holds only as well as
+/// these are consistent with each other, amplified by about `√|d_j|` for a
+/// large branch point: `F'` in double (a few ulps off) left a round trip of
+/// 3.5e-12 at `|d_1| = 1.2e7`, DD constants 5e-16 (docs/kotter.md §3). `None`
+/// when a DD value is not finite (then the double values stand).
+fn refine_dd(lv: &Level, i: usize, t: C, sigma: C, df: C) -> Option<PolishedRoot> {
+    let (h0, den) = match lv.mn {
+        Some((m, n)) => {
+            let mut h0 = Dd::ZERO;
+            let (mut dm, mut dp) = (Dd::ZERO, Dd::ZERO);
+            for j in 0..3 {
+                h0 = h0.add(Dd::prod(m[j], n[j]));
+                let (mi, pl) = (Dd::sum(m[j], -n[j]), Dd::sum(m[j], n[j]));
+                dm = dm.add(mi.mul(mi));
+                dp = dp.add(pl.mul(pl));
+            }
+            (h0, dm.mul(dp))
+        }
+        None => {
+            let [h0, h1, _, _] = *lv.h;
+            (
+                Dd::new(h0),
+                Dd::prod(h1, h1).sub(Dd::prod(h0, h0).mul_f64(4.0)),
+            )
+        }
+    };
+    let (x, sg) = offsets_dd(lv.a, i, Cdd::new(t), sigma);
+    let f = f_dd(lv, h0, &x, sg);
+    let step = f.to_c() / df;
+    if !(step.re.is_finite() && step.im.is_finite()) {
+        return None;
+    }
+    let t_dd = Cdd::new(t).sub(Cdd::new(step));
+    let (x, sg) = offsets_dd(lv.a, i, t_dd, sigma);
+    let dfd = df_dd(lv, h0, &x, sg);
+    let fp = dfd.mul(sg).mul_dd(h0).mul_f64(-4.0).div_dd(den);
+    let sq = fp.sqrt();
+    let s = t_dd.add_f64(lv.a[i]);
+    let out = PolishedRoot {
+        s: s.to_c(),
+        x,
+        sigma: sg,
+        fprime: fp.to_c(),
+        sqrt_fprime: sq,
+    };
+    let finite = |z: Cdd| {
+        let (hi, lo) = (z.to_c(), C::new(z.re.lo, z.im.lo));
+        hi.re.is_finite() && hi.im.is_finite() && lo.re.is_finite() && lo.im.is_finite()
+    };
+    let ok = finite(s)
+        && out.x.iter().all(|&v| finite(v))
+        && finite(sg)
+        && finite(sq)
+        && sq.to_c() != ZERO;
+    ok.then_some(out)
+}
+
+/// The offsets `x_m = s − a_m` at `s = a_i + t` (exact sums) and `√G(s)` on
+/// the branch nearest `sigma`, in DD.
+fn offsets_dd(a: &[f64; 4], i: usize, t: Cdd, sigma: C) -> ([Cdd; 4], Cdd) {
+    let x: [Cdd; 4] = std::array::from_fn(|m| {
+        if m == i {
+            t
+        } else {
+            t.add(Cdd::real(Dd::sum(a[i], -a[m])))
+        }
+    });
+    let sg = x[0].mul(x[1]).mul(x[2]).mul(x[3]).sqrt();
+    if (sg.to_c() * sigma.conj()).re < 0.0 {
+        (x, sg.neg())
+    } else {
+        (x, sg)
+    }
+}
+
+/// `P(s) = h1 s² − h2 s + h3` in DD from the offsets: from the state,
+/// `P = Σ_j (x_j x_4 m_j² + x_k x_l n_j²)` (no cancellation near a root of
+/// `G`), else from `h`.
+fn p_dd(lv: &Level, x: &[Cdd; 4]) -> Cdd {
+    match lv.mn {
+        Some((m, n)) => CYCLIC
+            .iter()
+            .enumerate()
+            .fold(Cdd::ZERO, |p, (j, &(_, k, l))| {
+                p.add(x[j].mul(x[3]).mul_dd(Dd::prod(m[j], m[j])))
+                    .add(x[k].mul(x[l]).mul_dd(Dd::prod(n[j], n[j])))
+            }),
+        None => {
+            let [_, h1, h2, h3] = *lv.h;
+            let s = x[0].add_f64(lv.a[0]);
+            s.mul_f64(h1).add_f64(-h2).mul(s).add_f64(h3)
+        }
+    }
+}
+
+/// `P'(s)` in DD (the derivative of the forms of [`p_dd`]).
+fn dp_dd(lv: &Level, x: &[Cdd; 4]) -> Cdd {
+    match lv.mn {
+        Some((m, n)) => CYCLIC
+            .iter()
+            .enumerate()
+            .fold(Cdd::ZERO, |p, (j, &(_, k, l))| {
+                p.add(x[j].add(x[3]).mul_dd(Dd::prod(m[j], m[j])))
+                    .add(x[k].add(x[l]).mul_dd(Dd::prod(n[j], n[j])))
+            }),
+        None => {
+            let [_, h1, h2, _] = *lv.h;
+            x[0].add_f64(lv.a[0]).mul_f64(2.0 * h1).add_f64(-h2)
+        }
+    }
+}
+
+/// `f = P + 2h0 σ` (15) in DD.
+///
+/// The closed forms here and in [`df_dd`] cancel near the singular set by
+/// about the relative distance `(h1² − 4h0²)/h1²` to it ([`Level::f`]), which
+/// DD absorbs: its `u²` leaves `u² h1²/(h1² − 4h0²)`, far below double
+/// precision for every state not refused by [`REDUCTION_FLOOR_RTOL`].
+fn f_dd(lv: &Level, h0: Dd, x: &[Cdd; 4], sg: Cdd) -> Cdd {
+    p_dd(lv, x).add(sg.mul_dd(h0).mul_f64(2.0))
+}
+
+/// `f' = P' + h0 G'/σ` in DD (`G'/√G = σ Σ_m 1/x_m`), with
+/// `G' = (x_1 + x_2) x_3 x_4 + x_1 x_2 (x_3 + x_4)`.
+fn df_dd(lv: &Level, h0: Dd, x: &[Cdd; 4], sg: Cdd) -> Cdd {
+    let (a, b) = (x[0].mul(x[1]), x[2].mul(x[3]));
+    let dg = x[0].add(x[1]).mul(b).add(a.mul(x[2].add(x[3])));
+    dp_dd(lv, x).add(dg.mul_dd(h0).div(sg))
+}
