@@ -9,7 +9,8 @@
 //! union region has ~30% more terms than one ellipsoid; the extra terms are
 //! genuine terms of the series, so accuracy is unchanged.
 
-use super::{split, sum, ThetaPlan};
+use super::{sum, ThetaPlan};
+use crate::numeric::compensated::split;
 use num_complex::Complex64;
 
 /// Points per chunk.
@@ -97,7 +98,7 @@ pub(super) struct ChunkIn {
 impl ChunkIn {
     /// Lane `p` from the reduced point `red`.
     #[inline(always)]
-    pub(super) fn set(&mut self, p: usize, red: &super::Reduced) {
+    pub(super) fn set(&mut self, p: usize, red: &super::reduce::Reduced) {
         for i in 0..2 {
             self.zre[i][p] = red.zr[i].re;
             self.zim[i][p] = red.zr[i].im;

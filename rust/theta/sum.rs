@@ -53,178 +53,69 @@ impl ThetaPlan {
     /// all updated by constant factors `q_kl = exp(iπ τ'_kl/2)`; each row is then
     /// swept up and down from its centre. Starting at the centre of the
     /// ellipsoid keeps the one directly computed term (and its phase) small.
+    ///
+    /// The hot loop of the per-point path; its steps ([`G2Rows`],
+    /// [`ThetaPlan::walk_g2`], [`row_sums`], [`add_row`]) are inlined into it.
     pub(super) fn sum_g2<const ORDER: usize>(&self, zr: &[C], wr: &[f64], ws: &mut Workspace) {
-        let (d1, d2, l21) = (self.ldl_d[0], self.ldl_d[1], self.ldl_l[2]);
-        let rq = self.rq;
+        let rows = G2Rows::new(self, wr);
+        let q11 = self.qmat[0];
+        let kc = round_i64(rows.row(rows.j1c).0);
+        let start = [rows.j1c, kc];
+        let e0 = self.log_term(&start, zr, wr).exp();
+        let a0 = self.ratio(1, &start, zr);
+        let bup = self.ratio(0, &start, zr);
+        let up = G2Cursor {
+            j1: rows.j1c,
+            k: kc,
+            e: e0,
+            a: a0,
+            ainv: self.qmat[3] / a0,
+            bs: bup,
+        };
+        self.walk_g2::<ORDER>(1, &rows, up, ws);
+        let mut down = G2Cursor {
+            bs: q11 / bup,
+            ..up
+        };
+        // the first row of the downward pass is j1c - 1
+        down.next_row(q11, self.qinv[1], self.qmat[1], -1);
+        self.walk_g2::<ORDER>(-1, &rows, down, ws);
+    }
+
+    /// One pass of [`ThetaPlan::sum_g2`] over the rows from the cursor's on,
+    /// upward (`dir = 1`) or downward (`dir = -1`).
+    #[inline(always)]
+    fn walk_g2<const ORDER: usize>(
+        &self,
+        dir: i64,
+        rows: &G2Rows,
+        mut cur: G2Cursor,
+        ws: &mut Workspace,
+    ) {
         let (q11, q12, q22) = (self.qmat[0], self.qmat[1], self.qmat[3]);
         let (q12i, q22i) = (self.qinv[1], self.qinv[3]);
-        let h1 = (rq / d1).sqrt();
-        let j1min = ceil_i64(2.0 * (-h1 - wr[0]));
-        let j1max = floor_i64(2.0 * (h1 - wr[0]));
-        let j1c = round_i64(-2.0 * wr[0]).clamp(j1min.min(j1max), j1max.max(j1min));
-        // centre and half-width (in j2 units) of row j1
-        let row = |j1: i64| -> (f64, f64) {
-            let u1 = 0.5 * j1 as f64 + wr[0];
-            let rem = rq - d1 * u1 * u1;
-            let c = 2.0 * (-l21 * u1 - wr[1]);
-            (
-                c,
-                if rem >= 0.0 {
-                    2.0 * (rem / d2).sqrt()
-                } else {
-                    -1.0
-                },
-            )
-        };
-        // (cursor target, lo, hi) of row j1; empty rows have lo > hi.
-        let bounds_of = |j1: i64| -> (i64, i64, i64) {
-            let (c, hw) = row(j1);
-            if hw < 0.0 {
-                (0, 1, 0)
-            } else {
-                (round_i64(c), ceil_i64(c - hw), floor_i64(c + hw))
-            }
-        };
-        // Rows are short (~10 terms): computing all bounds first lets the square
-        // roots overlap instead of sitting on each row's critical path.
-        const MAX_ROWS: usize = 96;
-        let nrows = (j1max - j1min + 1).max(0) as usize;
-        let mut table = [(0i64, 1i64, 0i64); MAX_ROWS];
-        let precomputed = nrows <= MAX_ROWS;
-        if precomputed {
-            for (r, slot) in table[..nrows].iter_mut().enumerate() {
-                *slot = bounds_of(j1min + r as i64);
-            }
-        }
-        let bounds = |j1: i64| {
-            if precomputed {
-                table[(j1 - j1min) as usize]
-            } else {
-                bounds_of(j1)
-            }
-        };
-        let kc = round_i64(row(j1c).0);
-        let e0 = self.log_term(&[j1c, kc], zr, wr).exp();
-        let a0 = self.ratio(1, &[j1c, kc], zr);
-        let ainv0 = q22 / a0;
-        let bup = self.ratio(0, &[j1c, kc], zr);
-        let bdown = q11 / bup;
-
-        for dir in [1i64, -1] {
-            let (q12s, q12si) = if dir == 1 { (q12, q12i) } else { (q12i, q12) };
-            let (mut e, mut a, mut ainv, mut bs) =
-                (e0, a0, ainv0, if dir == 1 { bup } else { bdown });
-            let mut k = kc;
-            let mut j1 = j1c;
-            if dir == -1 {
-                // first row of the downward pass is j1c - 1
-                e *= bs;
-                bs *= q11;
-                a *= q12s;
-                ainv *= q12si;
-                j1 -= 1;
-            }
-            while (dir == 1 && j1 <= j1max) || (dir == -1 && j1 >= j1min) {
-                let (target, lo, hi) = bounds(j1);
-                if lo <= hi {
-                    while k < target {
-                        e *= a;
-                        a *= q22;
-                        ainv *= q22i;
-                        bs *= q12s;
-                        k += 1;
-                    }
-                    while k > target {
-                        e *= ainv;
-                        a *= q22i;
-                        ainv *= q22;
-                        bs *= q12si;
-                        k -= 1;
-                    }
-                    let mut r0 = [C::new(0.0, 0.0); 4];
-                    let mut r1 = [C::new(0.0, 0.0); 4];
-                    let mut r2 = [C::new(0.0, 0.0); 4];
-                    // Upward sweep k..=hi and downward sweep k-1..=lo run interleaved:
-                    // two independent product chains hide the multiply latency.
-                    if ORDER == 0 {
-                        // Unrolled by 4 so that the class of every term is static:
-                        // accu[i] collects offsets ≡ i (mod 4) from k, accd[i] from k-1 down.
-                        let (nu, nd) = (hi - k + 1, k - lo);
-                        let (mut tu, mut au) = (e, a);
-                        let (mut td, mut ad) = (e * ainv, ainv * q22);
-                        let mut accu = [C::new(0.0, 0.0); 4];
-                        let mut accd = [C::new(0.0, 0.0); 4];
-                        let both4 = (nu.min(nd).max(0) / 4) * 4;
-                        let mut i = 0;
-                        while i < both4 {
-                            for slot in 0..4 {
-                                accu[slot] += tu;
-                                accd[slot] += td;
-                                tu *= au;
-                                au *= q22;
-                                td *= ad;
-                                ad *= q22;
-                            }
-                            i += 4;
-                        }
-                        sweep_tail(&mut accu, tu, au, q22, nu - both4);
-                        sweep_tail(&mut accd, td, ad, q22, nd - both4);
-                        for slot in 0..4 {
-                            r0[((k + slot as i64) & 3) as usize] += accu[slot];
-                            r0[((k - 1 - slot as i64) & 3) as usize] += accd[slot];
-                        }
-                    } else {
-                        let (mut tu, mut au, mut ju) = (e, a, k);
-                        let (mut td, mut ad, mut jd) = (e * ainv, ainv * q22, k - 1);
-                        let both = (hi - k + 1).min(k - lo);
-                        for _ in 0..both {
-                            accumulate::<ORDER>(&mut r0, &mut r1, &mut r2, tu, ju);
-                            accumulate::<ORDER>(&mut r0, &mut r1, &mut r2, td, jd);
-                            tu *= au;
-                            au *= q22;
-                            td *= ad;
-                            ad *= q22;
-                            ju += 1;
-                            jd -= 1;
-                        }
-                        while ju <= hi {
-                            accumulate::<ORDER>(&mut r0, &mut r1, &mut r2, tu, ju);
-                            tu *= au;
-                            au *= q22;
-                            ju += 1;
-                        }
-                        while jd >= lo {
-                            accumulate::<ORDER>(&mut r0, &mut r1, &mut r2, td, jd);
-                            td *= ad;
-                            ad *= q22;
-                            jd -= 1;
-                        }
-                    }
-                    let base = ((j1 & 3) as usize) * 4;
-                    let j1f = j1 as f64;
-                    for cls in 0..4 {
-                        let r = base + cls;
-                        ws.s0[r] += r0[cls];
-                        if ORDER >= 1 {
-                            ws.s1[2 * r] += r0[cls] * j1f;
-                            ws.s1[2 * r + 1] += r1[cls];
-                            if ORDER >= 2 {
-                                ws.s2[4 * r] += r0[cls] * (j1f * j1f);
-                                let mixed = r1[cls] * j1f;
-                                ws.s2[4 * r + 1] += mixed;
-                                ws.s2[4 * r + 2] += mixed;
-                                ws.s2[4 * r + 3] += r2[cls];
-                            }
-                        }
-                    }
+        let (q12s, q12si) = if dir == 1 { (q12, q12i) } else { (q12i, q12) };
+        while (dir == 1 && cur.j1 <= rows.j1max) || (dir == -1 && cur.j1 >= rows.j1min) {
+            let (target, lo, hi) = rows.bounds(cur.j1);
+            if lo <= hi {
+                while cur.k < target {
+                    cur.e *= cur.a;
+                    cur.a *= q22;
+                    cur.ainv *= q22i;
+                    cur.bs *= q12s;
+                    cur.k += 1;
                 }
-                // step to the next row
-                e *= bs;
-                bs *= q11;
-                a *= q12s;
-                ainv *= q12si;
-                j1 += dir;
+                while cur.k > target {
+                    cur.e *= cur.ainv;
+                    cur.a *= q22i;
+                    cur.ainv *= q22;
+                    cur.bs *= q12si;
+                    cur.k -= 1;
+                }
+                let r = row_sums::<ORDER>(cur.e, cur.a, cur.ainv, q22, cur.k, lo, hi);
+                add_row::<ORDER>(ws, cur.j1, &r);
             }
+            cur.next_row(q11, q12s, q12si, dir);
         }
     }
 
@@ -311,6 +202,217 @@ impl ThetaPlan {
                     }
                     ws.s2[(r * g + g - 1) * g + g - 1] += r2[cls];
                 }
+            }
+        }
+    }
+}
+
+/// The rows of the genus-2 ellipsoid `Q(j/2 + w_r) < R²/π`: the range of
+/// `j1`, the start row, and per row the cursor target and the range of `j2`.
+struct G2Rows {
+    rq: f64,
+    d1: f64,
+    d2: f64,
+    l21: f64,
+    w: [f64; 2],
+    j1min: i64,
+    j1max: i64,
+    j1c: i64,
+    /// `bounds_of(j1min + r)`, when there are at most [`G2_MAX_ROWS`] rows.
+    table: [(i64, i64, i64); G2_MAX_ROWS],
+    precomputed: bool,
+}
+
+/// Rows are short (~10 terms): computing all bounds first lets the square
+/// roots overlap instead of sitting on each row's critical path.
+const G2_MAX_ROWS: usize = 96;
+
+impl G2Rows {
+    #[inline(always)]
+    fn new(plan: &ThetaPlan, wr: &[f64]) -> G2Rows {
+        let (d1, d2, l21) = (plan.ldl_d[0], plan.ldl_d[1], plan.ldl_l[2]);
+        let rq = plan.rq;
+        let h1 = (rq / d1).sqrt();
+        let j1min = ceil_i64(2.0 * (-h1 - wr[0]));
+        let j1max = floor_i64(2.0 * (h1 - wr[0]));
+        let j1c = round_i64(-2.0 * wr[0]).clamp(j1min.min(j1max), j1max.max(j1min));
+        let nrows = (j1max - j1min + 1).max(0) as usize;
+        let mut rows = G2Rows {
+            rq,
+            d1,
+            d2,
+            l21,
+            w: [wr[0], wr[1]],
+            j1min,
+            j1max,
+            j1c,
+            table: [(0i64, 1i64, 0i64); G2_MAX_ROWS],
+            precomputed: nrows <= G2_MAX_ROWS,
+        };
+        if rows.precomputed {
+            for r in 0..nrows {
+                rows.table[r] = rows.bounds_of(j1min + r as i64);
+            }
+        }
+        rows
+    }
+
+    /// Centre and half-width (in `j2` units) of row `j1`; a negative width for
+    /// a row outside the ellipsoid.
+    #[inline(always)]
+    fn row(&self, j1: i64) -> (f64, f64) {
+        let u1 = 0.5 * j1 as f64 + self.w[0];
+        let rem = self.rq - self.d1 * u1 * u1;
+        let c = 2.0 * (-self.l21 * u1 - self.w[1]);
+        (
+            c,
+            if rem >= 0.0 {
+                2.0 * (rem / self.d2).sqrt()
+            } else {
+                -1.0
+            },
+        )
+    }
+
+    /// (cursor target, lo, hi) of row `j1`; empty rows have `lo > hi`.
+    #[inline(always)]
+    fn bounds_of(&self, j1: i64) -> (i64, i64, i64) {
+        let (c, hw) = self.row(j1);
+        if hw < 0.0 {
+            (0, 1, 0)
+        } else {
+            (round_i64(c), ceil_i64(c - hw), floor_i64(c + hw))
+        }
+    }
+
+    #[inline(always)]
+    fn bounds(&self, j1: i64) -> (i64, i64, i64) {
+        if self.precomputed {
+            self.table[(j1 - self.j1min) as usize]
+        } else {
+            self.bounds_of(j1)
+        }
+    }
+}
+
+/// The cursor of the genus-2 walk at `(j1, k)`: `E`, `A`, `Ainv` and the
+/// row-step ratio `bs`.
+#[derive(Clone, Copy)]
+struct G2Cursor {
+    j1: i64,
+    k: i64,
+    e: C,
+    a: C,
+    ainv: C,
+    bs: C,
+}
+
+impl G2Cursor {
+    /// Steps to row `j1 + dir` (same `k`).
+    #[inline(always)]
+    fn next_row(&mut self, q11: C, q12s: C, q12si: C, dir: i64) {
+        self.e *= self.bs;
+        self.bs *= q11;
+        self.a *= q12s;
+        self.ainv *= q12si;
+        self.j1 += dir;
+    }
+}
+
+/// The class sums of one row `lo ..= hi` with the cursor at `k` (term `e`,
+/// ratios `a` up and `ainv` down): `r[0][c] = Σ E`, `r[1][c] = Σ j2 E`,
+/// `r[2][c] = Σ j2² E` over `j2 ≡ c (mod 4)`. The upward sweep `k ..= hi`
+/// and the downward sweep `k − 1 ..= lo` run interleaved: two independent
+/// product chains hide the multiply latency.
+#[inline(always)]
+fn row_sums<const ORDER: usize>(
+    e: C,
+    a: C,
+    ainv: C,
+    q22: C,
+    k: i64,
+    lo: i64,
+    hi: i64,
+) -> [[C; 4]; 3] {
+    let mut r0 = [C::new(0.0, 0.0); 4];
+    let mut r1 = [C::new(0.0, 0.0); 4];
+    let mut r2 = [C::new(0.0, 0.0); 4];
+    if ORDER == 0 {
+        // Unrolled by 4 so that the class of every term is static:
+        // accu[i] collects offsets ≡ i (mod 4) from k, accd[i] from k-1 down.
+        let (nu, nd) = (hi - k + 1, k - lo);
+        let (mut tu, mut au) = (e, a);
+        let (mut td, mut ad) = (e * ainv, ainv * q22);
+        let mut accu = [C::new(0.0, 0.0); 4];
+        let mut accd = [C::new(0.0, 0.0); 4];
+        let both4 = (nu.min(nd).max(0) / 4) * 4;
+        let mut i = 0;
+        while i < both4 {
+            for slot in 0..4 {
+                accu[slot] += tu;
+                accd[slot] += td;
+                tu *= au;
+                au *= q22;
+                td *= ad;
+                ad *= q22;
+            }
+            i += 4;
+        }
+        sweep_tail(&mut accu, tu, au, q22, nu - both4);
+        sweep_tail(&mut accd, td, ad, q22, nd - both4);
+        for slot in 0..4 {
+            r0[((k + slot as i64) & 3) as usize] += accu[slot];
+            r0[((k - 1 - slot as i64) & 3) as usize] += accd[slot];
+        }
+    } else {
+        let (mut tu, mut au, mut ju) = (e, a, k);
+        let (mut td, mut ad, mut jd) = (e * ainv, ainv * q22, k - 1);
+        let both = (hi - k + 1).min(k - lo);
+        for _ in 0..both {
+            accumulate::<ORDER>(&mut r0, &mut r1, &mut r2, tu, ju);
+            accumulate::<ORDER>(&mut r0, &mut r1, &mut r2, td, jd);
+            tu *= au;
+            au *= q22;
+            td *= ad;
+            ad *= q22;
+            ju += 1;
+            jd -= 1;
+        }
+        while ju <= hi {
+            accumulate::<ORDER>(&mut r0, &mut r1, &mut r2, tu, ju);
+            tu *= au;
+            au *= q22;
+            ju += 1;
+        }
+        while jd >= lo {
+            accumulate::<ORDER>(&mut r0, &mut r1, &mut r2, td, jd);
+            td *= ad;
+            ad *= q22;
+            jd -= 1;
+        }
+    }
+    [r0, r1, r2]
+}
+
+/// Adds the class sums `r` of row `j1` ([`row_sums`]) to the workspace, with
+/// the weights `j1`, `j1²`, `j1 j2` of the derivatives.
+#[inline(always)]
+fn add_row<const ORDER: usize>(ws: &mut Workspace, j1: i64, r: &[[C; 4]; 3]) {
+    let [r0, r1, r2] = r;
+    let base = ((j1 & 3) as usize) * 4;
+    let j1f = j1 as f64;
+    for cls in 0..4 {
+        let r = base + cls;
+        ws.s0[r] += r0[cls];
+        if ORDER >= 1 {
+            ws.s1[2 * r] += r0[cls] * j1f;
+            ws.s1[2 * r + 1] += r1[cls];
+            if ORDER >= 2 {
+                ws.s2[4 * r] += r0[cls] * (j1f * j1f);
+                let mixed = r1[cls] * j1f;
+                ws.s2[4 * r + 1] += mixed;
+                ws.s2[4 * r + 2] += mixed;
+                ws.s2[4 * r + 3] += r2[cls];
             }
         }
     }

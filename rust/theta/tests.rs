@@ -1,4 +1,5 @@
 use super::*;
+use crate::error::Error;
 use proptest::prelude::*;
 
 type C = Complex64;
