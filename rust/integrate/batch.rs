@@ -42,8 +42,10 @@
 #![allow(clippy::needless_range_loop)]
 
 use super::dop853::{A as DA, B as DB, BHH, ER};
+use super::explicit::{scaled, starting_step, too_many_steps};
+use super::gauss::reuse_stages;
 use super::gauss_tables::{B8, E8, MU8};
-use super::{scaled, starting_step, substeps, StopRule};
+use super::{substeps, StopRule};
 use crate::error::{Error, Result};
 use crate::numeric::cancel::{Cancel, CHECK_EVERY};
 use crate::numeric::tol::min_step;
@@ -257,7 +259,7 @@ fn gauss16_step<L: Lanes>(c: &[f64; 6], g: &mut Gauss16Lanes, h: f64) -> Result<
     for i in 0..S {
         hb[i] = h * B8[i];
     }
-    if !super::reuse_stages(g.last_h, h) {
+    if !reuse_stages(g.last_h, h) {
         let mut f0 = [[0.0; W]; M];
         vector_field4_lanes(c, &g.y, &mut f0);
         for i in 0..S {
@@ -733,7 +735,7 @@ fn dop853_group_body(
                 hcur[w] = hh[w] / fac.max(1.0);
             }
             if taken[w] > o.max_steps {
-                return Err(super::too_many_steps(o.max_steps));
+                return Err(too_many_steps(o.max_steps));
             }
         }
         if accepted {

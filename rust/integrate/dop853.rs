@@ -13,10 +13,12 @@
 #![allow(clippy::needless_range_loop)]
 #![allow(clippy::excessive_precision)]
 
-use super::{scaled, starting_step, VectorField};
-use crate::error::{Error, Result};
-use crate::numeric::cancel::{Cancel, CHECK_EVERY};
-use crate::numeric::tol::min_step;
+use super::explicit::{
+    check_error_norm, next_attempt, scaled, starting_step, too_many_steps, Explicit,
+};
+use super::VectorField;
+use crate::error::Result;
+use crate::numeric::cancel::Cancel;
 
 /// Nodes `c_i`. The vector field is autonomous, so only the order-condition
 /// tests use them.
@@ -231,7 +233,7 @@ pub(super) struct Dop853 {
     ynew: Vec<f64>,
     h: f64,
     k1_valid: bool,
-    pub(super) evals: u64,
+    evals: u64,
     rtol: f64,
     atol: f64,
 }
@@ -250,10 +252,12 @@ impl Dop853 {
             atol,
         }
     }
+}
 
+impl Explicit for Dop853 {
     /// Advances `y` from `t` to exactly `t_target`; returns the number of accepted steps,
     /// failing once more than `budget` are needed.
-    pub(super) fn advance<F: VectorField>(
+    fn advance<F: VectorField>(
         &mut self,
         f: &F,
         y: &mut [f64],
@@ -274,21 +278,15 @@ impl Dop853 {
             self.h = starting_step(y, &self.k[0..m], self.atol, self.rtol);
         }
         while *t < t_target {
-            let remaining = t_target - *t;
-            let last = self.h >= remaining;
-            let h = if last { remaining } else { self.h };
-            attempts = attempts.wrapping_add(1);
-            if attempts % CHECK_EVERY == 0 {
-                cancel.check()?;
-            }
-            if h <= min_step(*t) && !last {
-                return Err(Error::NoConvergence {
-                    what: "dop853 step size underflow",
-                    tol: self.rtol,
-                    reached: h,
-                    iterations: steps as usize,
-                });
-            }
+            let (h, last) = next_attempt(
+                "dop853 step size underflow",
+                self.h,
+                *t,
+                t_target,
+                (self.rtol, steps),
+                &mut attempts,
+                cancel,
+            )?;
             for st in 1..12 {
                 for i in 0..m {
                     let mut acc = 0.0;
@@ -325,14 +323,7 @@ impl Dop853 {
                 1.0
             };
             let err = h.abs() * err5 * (1.0 / (m as f64 * deno)).sqrt();
-            if !err.is_finite() {
-                return Err(Error::NoConvergence {
-                    what: "dop853 (state became non-finite)",
-                    tol: self.rtol,
-                    reached: err,
-                    iterations: steps as usize,
-                });
-            }
+            check_error_norm("dop853 (state became non-finite)", err, self.rtol, steps)?;
             // hnew = h / fac, fac = err^(1/8) / 0.9 limited to [1/6, 3] (HNW I, II.4 and dop853).
             let fac = (err.powf(0.125) / 0.9).clamp(1.0 / 6.0, 3.0);
             if err <= 1.0 {
@@ -348,10 +339,14 @@ impl Dop853 {
                 self.h = h / fac.max(1.0);
             }
             if steps > budget {
-                return Err(super::too_many_steps(budget));
+                return Err(too_many_steps(budget));
             }
         }
         Ok(steps)
+    }
+
+    fn evals(&self) -> u64 {
+        self.evals
     }
 }
 

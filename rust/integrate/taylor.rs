@@ -387,7 +387,7 @@ fn taylor_group_body<L: Lanes>(
             }
             taken[w] += 1;
             if taken[w] > o.max_steps {
-                return Err(super::too_many_steps(o.max_steps));
+                return Err(super::explicit::too_many_steps(o.max_steps));
             }
         }
     }
