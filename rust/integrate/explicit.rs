@@ -61,6 +61,7 @@ pub(super) fn too_many_steps(budget: u64) -> Error {
 /// attempts (counted in `attempts`) and refuses a step below
 /// [`min_step`] that is not the last one (`what` names the method's
 /// underflow; `rtol` and `steps` go into the error).
+#[inline(always)]
 pub(super) fn next_attempt(
     what: &'static str,
     h_ctl: f64,
@@ -90,6 +91,7 @@ pub(super) fn next_attempt(
 
 /// Refuses a non-finite error norm `err` (the state overflowed or became
 /// NaN): `what` names the method.
+#[inline(always)]
 pub(super) fn check_error_norm(what: &'static str, err: f64, rtol: f64, steps: u64) -> Result<()> {
     if !err.is_finite() {
         return Err(Error::NoConvergence {

@@ -134,23 +134,13 @@ impl<const S: usize, const M: usize> GaussFixed<S, M> {
     }
 }
 
-impl<const S: usize, const M: usize> Stepper for GaussFixed<S, M> {
-    fn evals(&self) -> u64 {
-        self.evals
-    }
-
-    #[inline]
-    fn step<F: VectorField>(&mut self, f: &F, y: &mut [f64], h: f64) -> Result<()> {
-        let len = y.len();
-        let y: &mut [f64; M] = y.try_into().map_err(|_| Error::Shape {
-            what: "state",
-            expected: format!("({M},)"),
-            got: format!("({len},)"),
-        })?;
-        let mut hb = [0.0; S];
-        for i in 0..S {
-            hb[i] = h * self.b[i];
-        }
+impl<const S: usize, const M: usize> GaussFixed<S, M> {
+    /// The stages' starting guess: `f(y)` on the first step (or after a step
+    /// size that cannot be rescaled), the previous step's collocation
+    /// polynomial extrapolated when `h` repeats, else the previous stages
+    /// rescaled by `h / last_h`.
+    #[inline(always)]
+    fn start_stages<F: VectorField>(&mut self, f: &F, y: &[f64; M], h: f64, hb: &[f64; S]) {
         if !reuse_stages(self.last_h, h) {
             // First step: every stage starts from f(y).
             let mut fbuf = [0.0; M];
@@ -189,6 +179,27 @@ impl<const S: usize, const M: usize> Stepper for GaussFixed<S, M> {
                 }
             }
         }
+    }
+}
+
+impl<const S: usize, const M: usize> Stepper for GaussFixed<S, M> {
+    fn evals(&self) -> u64 {
+        self.evals
+    }
+
+    #[inline]
+    fn step<F: VectorField>(&mut self, f: &F, y: &mut [f64], h: f64) -> Result<()> {
+        let len = y.len();
+        let y: &mut [f64; M] = y.try_into().map_err(|_| Error::Shape {
+            what: "state",
+            expected: format!("({M},)"),
+            got: format!("({len},)"),
+        })?;
+        let mut hb = [0.0; S];
+        for i in 0..S {
+            hb[i] = h * self.b[i];
+        }
+        self.start_stages(f, y, h, &hb);
         self.last_h = h;
         let ymax = y.iter().fold(0.0f64, |acc, v| acc.max(v.abs()));
         let mut rule = StopRule::new();
