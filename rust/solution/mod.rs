@@ -44,7 +44,18 @@ use crate::riemann::HyperellipticCurve;
 use crate::so4;
 use crate::theta::{char_index, LatticeLanes, SelectedBlock, ThetaJet, ThetaPlan, BLOCK};
 
+mod level_set;
+mod setup;
 pub mod velocity;
+
+pub use level_set::{a_periods_of, level_set_curve, LevelSetCurve};
+pub use setup::{INCONSISTENT, QUOTIENT_RESIDUAL_RTOL};
+
+use level_set::{abel_of_point, eps41, map_coinciding};
+use setup::{
+    aux_constants_squared, check_velocity_fit, quotient_weights, signed_constants, ThetaAtV0,
+    VelocitySystem,
+};
 
 type C = Complex64;
 
@@ -55,11 +66,6 @@ pub const THETA_TOL: f64 = 1e-16;
 /// The divisor of `l0` contains ∞ (the `P_L` have poles) when `θ(v0)` is
 /// this small relative to the largest `|θ[χ](v0)|`.
 pub const DIVISOR_AT_INFINITY_RTOL: f64 = 1e-10;
-
-/// The estimate of the `C_L²` at `v0` takes part in the consensus of
-/// [`aux_constants_squared`] when every needed `|θ[χ](v0)|` is at least this
-/// fraction of the largest (below, the quotient `P_L θ/θ_L` loses digits).
-const AUX_V0_MIN: f64 = 1e-3;
 
 /// Times per work unit between two cancellation checks (~2 ms on one core).
 const CHUNK: usize = 8192;
@@ -142,13 +148,11 @@ impl Solution {
         let plan = ThetaPlan::new(&tau, 2, THETA_TOL, 1)?.with_parallel(false);
         let rcv = curve.try_riemann_constant()?;
         let rc = [rcv[0], rcv[1]];
-
         let mut idx = [0usize; 8];
         idx[0] = char_index(&[0, 0], &[0, 0])?;
         for (m, ch) in chars.iter().enumerate() {
             idx[m + 1] = char_index(&ch.0, &ch.1)?;
         }
-
         // The divisor of l0 and v0 = u(P1) + u(P2) + K.
         let pts = &state0.points;
         let ua = abel_of_point(&curve, pts.z1, pts.y1, &pts.zd1)?;
@@ -156,89 +160,15 @@ impl Solution {
         let u0 = [ua[0] + ub[0], ua[1] + ub[1]];
         let v0 = [u0[0] + rc[0], u0[1] + rc[1]];
         let jet = plan.jet(&v0, 1)?;
-        let big = jet.values.iter().fold(0.0f64, |m, v| m.max(v.norm()));
-        let th0 = jet.values[idx[0]];
-        if th0.norm() <= DIVISOR_AT_INFINITY_RTOL * big {
-            return Err(singular(
-                SingularKind::DivisorAtInfinity,
-                format!(
-                    "the divisor of l0 contains the point at infinity of the curve (8) \
-                 (|theta(v0)| = {:e} of max |theta[chi](v0)|): the P_L (34) have poles there; \
-                 the solution exists (take l0 at another time of the same trajectory)",
-                    th0.norm() / big
-                ),
-            ));
-        }
-
-        // P_L at l0 in the branch of the reduction: (37) inverted with the
-        // reduction's g ((30a), sign fixed by the corrected (42)), P_0 from (31b).
+        let at_v0 = ThetaAtV0::new(&jet, &idx)?;
         let sc = state0.curve.c().map(sqrt_principal);
         let eps = eps41(&kotter);
-        let g = state0.points.g;
-        let mut p_at0 = [C::new(0.0, 0.0); 7];
-        p_at0[0] = state0.p0;
-        for j in 0..3 {
-            p_at0[1 + j] = state0.xi[j] / (sc[j] * g);
-            p_at0[4 + j] = state0.eta[j] / (sc[j] * g);
-        }
-        // C_L² by consensus of auxiliary divisors, in which the estimate at v0
-        // votes unless a θ[χ_L](v0) is too small to divide by; the sign from l0.
-        let est: [C; 7] = std::array::from_fn(|m| p_at0[m] * th0 / jet.values[idx[m + 1]]);
-        let qv0 = idx
-            .iter()
-            .map(|&i| jet.values[i].norm() / big)
-            .fold(f64::INFINITY, f64::min);
-        let est0 = (qv0 > AUX_V0_MIN).then(|| est.map(|r| r * r));
+        let est = at_v0.estimates(&state0, &sc);
+        let est0 = at_v0.votes().then(|| est.map(|r| r * r));
         let c2 = aux_constants_squared(&curve, &state0.curve, &plan, &idx, &rc, est0)?;
-        let mut cl = [C::new(0.0, 0.0); 7];
-        let mut calibration = [0.0; 7];
-        for m in 0..7 {
-            let root = sqrt_principal(c2[m]);
-            let (plus, minus) = ((est[m] - root).norm(), (est[m] + root).norm());
-            cl[m] = if plus <= minus { root } else { -root };
-            calibration[m] = plus.min(minus) / root.norm();
-        }
-        // G = g (1 − ε P_0) at v0 from the theta side: the P_L(v0) of the
-        // calibrated (34), g by least squares from the six equations (37)
-        // `(ξ_j, η_j) = √c_j g P_L(v0)`. The reduction's own g, P_0 ((30a), (31b))
-        // are sums that cancel when the |d_j| spread over many orders of
-        // magnitude (P_0 loses up to 1e-6 there); the fit keeps l(v0) = l0.
-        let p_th: [C; 7] = std::array::from_fn(|m| cl[m] * jet.values[idx[m + 1]] / th0);
-        let (mut num_g, mut den_g) = (C::new(0.0, 0.0), 0.0);
-        for j in 0..3 {
-            for (w, r) in [
-                (sc[j] * p_th[1 + j], state0.xi[j]),
-                (sc[j] * p_th[4 + j], state0.eta[j]),
-            ] {
-                num_g += w.conj() * r;
-                den_g += w.norm_sqr();
-            }
-        }
-        let g_fit = if den_g > 0.0 { num_g / den_g } else { g };
-        let big_g = g_fit * (C::new(1.0, 0.0) - eps * p_th[0]);
-
-        // (37), (42), (23): l_q = N_q / D.
-        let mut den = [C::new(0.0, 0.0); 8];
-        den[0] = C::new(1.0, 0.0);
-        den[1] = -eps * cl[0];
-        let mut xi_w = [[C::new(0.0, 0.0); 8]; 3];
-        let mut eta_w = [[C::new(0.0, 0.0); 8]; 3];
-        for j in 0..3 {
-            xi_w[j][2 + j] = sc[j] * big_g * cl[1 + j];
-            eta_w[j][5 + j] = sc[j] * big_g * cl[4 + j];
-        }
-        let mut mw = [[C::new(0.0, 0.0); 8]; 3];
-        let mut nw = [[C::new(0.0, 0.0); 8]; 3];
-        for j in 0..3 {
-            for s in 0..8 {
-                mw[j][s] = kotter.alpha[j] * xi_w[j][s] + kotter.beta[j] * eta_w[j][s];
-                nw[j][s] = kotter.gamma[j] * xi_w[j][s] + kotter.delta[j] * eta_w[j][s];
-            }
-        }
-        let neg = |w: [C; 8]| w.map(|v| -v);
-        // l = (m3, −m2, n1, m1, n2, n3)
-        let num = [mw[2], neg(mw[1]), nw[0], mw[0], nw[1], nw[2]];
-
+        let (cl, calibration) = signed_constants(&c2, &est);
+        let big_g = at_v0.big_g(&state0, &sc, &cl, eps);
+        let (num, den) = quotient_weights(&kotter, &sc, eps, big_g, &cl);
         // U from (1) by least squares at v0 (see [`VelocitySystem`]); a set-up
         // whose quotients fit (1) for no velocity is refused.
         let (rate, residual) = VelocitySystem::at(&jet, &idx, &num, &den)?.rate(&c4, "U")?;
@@ -581,392 +511,6 @@ impl Solution {
         self.l_batch(&[t], &mut out, &Cancel::never())?;
         Ok(out)
     }
-}
-
-/// Relative least-squares residual of the velocity equations
-/// `(∇N_q − l_q ∇D)·U = l̇_q D` above which the theta quotients at `v0` solve
-/// Frahm's equations (1) for no velocity: the set-up is wrong, and the
-/// solution is refused rather than returned. Consistent set-ups leave ~1e-13
-/// (≤ 1e-10 on near_degenerate); the set-ups that took the wrong combination
-/// of (41) left 1e-2 … 1.
-pub const QUOTIENT_RESIDUAL_RTOL: f64 = 1e-6;
-
-/// `what` of the error for quotients that solve (1) for no velocity.
-pub const INCONSISTENT: &str = "theta quotients at v0";
-
-/// The velocity equations at `v0`: `l_q = N_q(v)/D(v)` gives
-/// `(∇N_q − l_q ∇D)·U = l̇_q D`, six complex equations for `U ∈ C²`, with the
-/// gradients from the theta jet at `v0`. The rows are the components of `l`
-/// themselves, unscaled (they share the scale `|l|`), and `l̇` is (1) at the
-/// quotient's own value `l_q(v0)` (it differs from `l0` by the rounding of the
-/// constants, ~1e-13): `U` is then the rate of the theta quotient's own flow.
-/// On tops with a nearly symmetric pair `a_i ≈ a_j` (`|U|` ~ 100) this keeps
-/// `U` to ~1e-14, where rows in `ξ, η` scaled to unit size lost up to 1e-12 of
-/// `U` (1e-9 of `l` at `t = 20`).
-struct VelocitySystem {
-    amat: DMatrix<C>,
-    svd: nalgebra::SVD<C, nalgebra::Dyn, nalgebra::Dyn>,
-    lq: [f64; 6],
-    dval: C,
-}
-
-impl VelocitySystem {
-    /// Errors: [`SingularKind::DegenerateGradients`] when the two singular
-    /// values differ by more than 1e12 (`U` is not determined).
-    fn at(jet: &ThetaJet, idx: &[usize; 8], num: &[[C; 8]; 6], den: &[C; 8]) -> Result<Self> {
-        let theta = |m: usize| jet.values[idx[m]];
-        let grad = |m: usize, k: usize| jet.gradient[idx[m] * 2 + k];
-        let dval: C = (0..8).map(|m| den[m] * theta(m)).sum();
-        let dgrad: [C; 2] = std::array::from_fn(|k| (0..8).map(|m| den[m] * grad(m, k)).sum());
-        let lq: [C; 6] =
-            std::array::from_fn(|q| (0..8).map(|m| num[q][m] * theta(m)).sum::<C>() / dval);
-        let mut amat = DMatrix::<C>::zeros(6, 2);
-        for (q, w) in num.iter().enumerate() {
-            for k in 0..2 {
-                let ng: C = (0..8).map(|m| w[m] * grad(m, k)).sum();
-                amat[(q, k)] = ng - lq[q] * dgrad[k];
-            }
-        }
-        let svd = amat.clone().svd(true, true);
-        let sv = &svd.singular_values;
-        if sv[1].is_nan() || sv[1] <= 1e-12 * sv[0] {
-            return Err(Error::Singular {
-                what: "state l0",
-                kind: SingularKind::DegenerateGradients,
-                reason: format!(
-                    "the theta-quotient gradients at v0 are degenerate (singular values {:e}, {:e}): \
-                     U is not determined",
-                    sv[0], sv[1]
-                ),
-            });
-        }
-        Ok(VelocitySystem {
-            amat,
-            svd,
-            lq: lq.map(|z| z.re),
-            dval,
-        })
-    }
-
-    /// The velocity of the flow with coefficients `c4` and the relative
-    /// residual `|A U − r| / |r|` of its fit.
-    fn rate(&self, c4: &[f64; 6], what: &'static str) -> Result<([C; 2], f64)> {
-        let ldot = so4::vector_field4(c4, &self.lq);
-        let rhs = DVector::<C>::from_fn(6, |q, _| ldot[q] * self.dval);
-        let x = self
-            .svd
-            .solve(&rhs, 0.0)
-            .map_err(|e| Error::InvalidArgument {
-                what,
-                reason: e.to_string(),
-            })?;
-        let u = [x[0], x[1]];
-        if !u.iter().all(|v| v.re.is_finite() && v.im.is_finite()) {
-            return Err(Error::NonFinite { what, index: 0 });
-        }
-        let res = (&self.amat * &x - &rhs).norm() / rhs.norm().max(f64::MIN_POSITIVE);
-        Ok((u, res))
-    }
-}
-
-/// Refuses a set-up whose quotients fit (1) for no velocity (least-squares
-/// residual above [`QUOTIENT_RESIDUAL_RTOL`]): a guard against a wrong
-/// constant or branch, which reproduces `l0` at `t = 0` and is O(1) wrong later.
-fn check_velocity_fit(res: f64) -> Result<()> {
-    if res.is_nan() || res > QUOTIENT_RESIDUAL_RTOL {
-        return Err(Error::InvalidArgument {
-            what: INCONSISTENT,
-            reason: format!(
-                "the theta quotients (9)-(10) at v0 satisfy Frahm's equations (1) for no \
-                 velocity (least-squares residual {res:e} > {QUOTIENT_RESIDUAL_RTOL:e}): a \
-                 constant or branch of the set-up is wrong at this state; please report it"
-            ),
-        });
-    }
-    Ok(())
-}
-
-/// `ε` by the corrected (41), in root differences of `F`: with
-/// `Y = √((s2−s3)(s1−s4))`, `W = √((s1−s3)(s2−s4))`, `Z = √((s1−s2)(s3−s4))`
-/// the two combinations `(Y ∓ W)/(√d_4 Z)` are `ε` and `−1/(d_4 ε)`
-/// (`Y² − W² = −Z²`), and principal roots do not tell which is which; the
-/// one (and the sign) nearest the reduction's `ε` (corrected (40)) is taken.
-/// (41) serves because it keeps its digits where (40)'s sums cancel.
-fn eps41(k: &KotterConstants) -> C {
-    let s = k.s;
-    let sq = sqrt_principal;
-    let sd4 = k.sqrt_d[0] * k.sqrt_d[1] * k.sqrt_d[2];
-    let y = sq((s[1] - s[2]) * (s[0] - s[3]));
-    let w = sq((s[0] - s[2]) * (s[1] - s[3]));
-    let den = sd4 * sq((s[0] - s[1]) * (s[2] - s[3]));
-    [(y - w) / den, (y + w) / den]
-        .into_iter()
-        .flat_map(|e| [e, -e])
-        .min_by(|p, q| (p - k.eps).norm().total_cmp(&(q - k.eps).norm()))
-        .unwrap_or(k.eps)
-}
-
-/// The Abel map takes the route from the nearest branch point `d_b` with the
-/// reduction's offset `z − d_b` when that offset is below this fraction of
-/// `|z|`: the double `z` fixes `z − d_b` only to `u |z|` absolute (u the unit
-/// roundoff), so below it the local parameter `√(z − d_b)` would lose
-/// `u |z| / |z − d_b|` of its digits; the offset keeps them.
-const NEAR_BRANCH_FRACTION: f64 = 0.1;
-
-/// The Abel map of a point of the divisor: from its offsets `zd[j] = z − d_j`
-/// (full relative accuracy, [`crate::curve::WurzelPoints`]) when it is near a
-/// branch point ([`HyperellipticCurve::abel_near_branch`]), else of `z`. The
-/// two routes give the Abel map modulo the lattice, so a state moving across
-/// the threshold may see its image jump by a lattice vector (the solution's
-/// `u0` is computed once; `sol.abel` is documented modulo the lattice).
-fn abel_of_point(curve: &HyperellipticCurve, z: C, y: C, zd: &[C; 5]) -> Result<Vec<C>> {
-    let b = (0..5)
-        .min_by(|&i, &j| zd[i].norm().total_cmp(&zd[j].norm()))
-        .unwrap_or(0);
-    if zd[b].norm() < NEAR_BRANCH_FRACTION * z.norm() {
-        curve.abel_near_branch(b, zd[b], y)
-    } else {
-        curve.abel(z, y)
-    }
-}
-
-/// The a-period matrix `A_ij = ∮_{a_j} x^i dx/y` of the curve, row-major.
-pub fn a_periods_of(curve: &HyperellipticCurve) -> [C; 4] {
-    let (a, _) = curve.periods();
-    [a[(0, 0)], a[(0, 1)], a[(1, 0)], a[(1, 1)]]
-}
-
-/// The level set of a state as the reduction and the Riemann-surface layer
-/// see it: Kötter's constants, the curve (8) in both forms, and the
-/// characteristics `χ_L` of [`LABELS`] in the curve's homology basis.
-#[derive(Debug, Clone)]
-pub struct LevelSetCurve {
-    /// Kötter's constants of the level set ([`kotter_constants`]).
-    pub kotter: KotterConstants,
-    /// The curve (8) with the Wurzelfunktionen.
-    pub kcurve: KotterCurve,
-    /// The same curve with periods, Abel map and theta characteristics
-    /// (branch points passed as `(d_0, …, d_4)`).
-    pub curve: HyperellipticCurve,
-    /// `χ_0 = η(d_0)`, `χ_kl = η(d_k) + η(d_l)`, `χ_j4 = η(d_j) + η(d_4)` for
-    /// the labels `P0, P23, P31, P12, P14, P24, P34`.
-    pub chars: [([u8; 2], [u8; 2]); 7],
-}
-
-/// The checks of `l0` that precede the reduction, and the reduction's
-/// level-set objects: refuses `l0 = 0`, `h0 = 0`, `h1² = 4h0²` (relative to
-/// [`SINGULAR_SET_RTOL`]) and coinciding branch points with a
-/// [`Error::Singular`] that names the reason.
-pub fn level_set_curve(a: &[f64; 4], l0: &[f64; 6]) -> Result<LevelSetCurve> {
-    crate::error::check_finite("l0", l0)?;
-    let size = l0.iter().fold(0.0f64, |m, v| m.max(v.abs()));
-    if size == 0.0 {
-        return Err(singular(
-            SingularKind::ZeroState,
-            "l0 = 0: the rest state; the solution is l(t) = 0, there is no curve (8)".into(),
-        ));
-    }
-    let h = so4::integrals4(a, l0);
-    let s2 = size * size;
-    if h[0].abs() <= SINGULAR_SET_RTOL * s2 {
-        return Err(singular(
-            SingularKind::VanishingH0,
-            format!(
-                "h0 = {:e} vanishes: the branch points d_0 = 0 and d_j coincide (F (19) has double \
-                 roots), the curve (8) degenerates; the solution exists in a limiting sense \
-                 (genus < 2, elementary functions), not as a genus-2 theta quotient",
-                h[0]
-            ),
-        ));
-    }
-    let disc = h[1] * h[1] - 4.0 * h[0] * h[0];
-    if disc.abs() <= SINGULAR_SET_RTOL * (h[1] * h[1] + 4.0 * h[0] * h[0]) {
-        return Err(singular(
-            SingularKind::SelfDual,
-            format!(
-                "h1^2 - 4 h0^2 = {disc:e} vanishes (m = ±n, a self-dual state): F (19) is not \
-                 defined; the motion reduces to an so(3) top (elliptic functions), the \
-                 genus-2 solution exists only as a limit"
-            ),
-        ));
-    }
-    let kotter = kotter_constants(a, l0).map_err(map_coinciding)?;
-    let [d1, d2, d3] = kotter.d;
-    let kcurve = KotterCurve::new(d1, d2, d3).map_err(map_coinciding)?;
-    let curve = HyperellipticCurve::new(&kcurve.branch_points()).map_err(map_coinciding)?;
-    // χ_j = η(d_j) (index j of the branch points passed), χ_jk = χ_j + χ_k mod 2.
-    let mut eta = [([0u8; 2], [0u8; 2]); 5];
-    for (j, e) in eta.iter_mut().enumerate() {
-        let (ca, cb) = curve.try_branch_char(j)?;
-        *e = ([ca[0], ca[1]], [cb[0], cb[1]]);
-    }
-    let sum = |p: usize, q: usize| {
-        (
-            [
-                (eta[p].0[0] + eta[q].0[0]) % 2,
-                (eta[p].0[1] + eta[q].0[1]) % 2,
-            ],
-            [
-                (eta[p].1[0] + eta[q].1[0]) % 2,
-                (eta[p].1[1] + eta[q].1[1]) % 2,
-            ],
-        )
-    };
-    let mut chars = [([0u8; 2], [0u8; 2]); 7];
-    chars[0] = eta[0];
-    for (j, &(_, k, l)) in CYCLIC.iter().enumerate() {
-        chars[1 + j] = sum(k, l);
-        chars[4 + j] = sum(j + 1, 4);
-    }
-    Ok(LevelSetCurve {
-        kotter,
-        kcurve,
-        curve,
-        chars,
-    })
-}
-
-fn map_coinciding(e: Error) -> Error {
-    match e {
-        Error::RepeatedBranchPoints { i, j, value } => coinciding(i, j, value),
-        other => other,
-    }
-}
-
-fn coinciding(i: usize, j: usize, value: C) -> Error {
-    let reason = format!(
-        "branch points d{i} and d{j} of the curve (8) coincide (= {value}){}: the genus drops, \
-         the motion is degenerate (the solution exists as a limit in lower-genus functions)",
-        if i == 0 || j == 0 {
-            ", i.e. h0 = 0 or a vanishing d_j"
-        } else {
-            ""
-        }
-    );
-    Error::Singular {
-        what: "state l0",
-        kind: SingularKind::CoincidingBranchPoints,
-        reason,
-    }
-}
-
-/// Relative agreement of two estimates of the `C_L²` that counts as a vote
-/// in [`aux_constants_squared`]: estimates from well-conditioned divisors
-/// agree to ~1e-14, a poorly conditioned one misses by 1e-10 … 1e-5.
-const AUX_AGREE_RTOL: f64 = 1e-12;
-
-/// `C_L² = P_L² θ(v)²/θ_L(v)²` by consensus over a few fixed divisors and the
-/// estimate `est0` at `v0` (`None` where a `θ_L(v0)` is too small to divide by).
-///
-/// A single divisor is not enough: where the branch points span many orders
-/// of magnitude (`|d_4| / |d_3|` up to 1e10 when two `a_j` nearly coincide), a
-/// divisor at the scale of the largest one loses up to 1e-9 of `C_L²` (a
-/// common factor in all seven), while divisors at the geometric mean of the
-/// scales keep roundoff. So four divisors are placed at the geometric-mean
-/// scale, four more at the outer scale only if fewer than three estimates
-/// agree, each gives an estimate, and the estimate that agrees
-/// ([`AUX_AGREE_RTOL`]) with the most others wins; ties go to the divisor whose smallest needed `|θ[χ](v)|` is
-/// largest relative to the largest.
-fn aux_constants_squared(
-    curve: &HyperellipticCurve,
-    kc: &KotterCurve,
-    plan: &ThetaPlan,
-    idx: &[usize; 8],
-    rc: &[C; 2],
-    est0: Option<[C; 7]>,
-) -> Result<[C; 7]> {
-    let bp = kc.branch_points();
-    let center: C = bp.iter().sum::<C>() / 5.0;
-    let radius = bp
-        .iter()
-        .fold(0.0f64, |m, d| m.max((d - center).norm()))
-        .max(f64::MIN_POSITIVE);
-    // Geometric mean of the non-zero |d_j|: a point at that modulus is, in
-    // ratio, far from every branch point, whatever their spread.
-    let (log_sum, count) = bp
-        .iter()
-        .filter(|d| d.norm() > 0.0)
-        .fold((0.0f64, 0u32), |(s, n), d| (s + d.norm().ln(), n + 1));
-    let geo = if count > 0 {
-        (log_sum / f64::from(count)).exp()
-    } else {
-        radius
-    };
-    // Fixed generic offsets (off the real axis, both sheets).
-    const W: [(f64, f64, f64, f64); 4] = [
-        (0.37, 0.61, -0.53, -0.29),
-        (-0.71, 0.43, 0.58, 0.47),
-        (0.12, -0.77, -0.41, 0.66),
-        (0.83, 0.21, -0.19, -0.88),
-    ];
-    let mut cands: Vec<(f64, [C; 7])> = Vec::with_capacity(9);
-    if let Some(e) = est0 {
-        cands.push((0.0, e));
-    }
-    let agree = |x: &[C; 7], y: &[C; 7]| {
-        x.iter()
-            .zip(y)
-            .all(|(p, q)| (p - q).norm() <= AUX_AGREE_RTOL * p.norm().max(q.norm()))
-    };
-    // (votes, q, index) of the best-supported candidate.
-    let best = |cands: &[(f64, [C; 7])]| {
-        cands
-            .iter()
-            .enumerate()
-            .map(|(i, (q, x))| (cands.iter().filter(|(_, y)| agree(x, y)).count(), *q, i))
-            .max_by(|a, b| a.0.cmp(&b.0).then(a.1.total_cmp(&b.1)))
-    };
-    // The geometric-mean scale first; the outer scale only when fewer than
-    // three estimates agree there (a clustered curve: the two scales coincide).
-    for (origin, scale) in [(C::new(0.0, 0.0), geo), (center, 1.3 * radius)] {
-        if best(&cands).is_some_and(|(votes, _, _)| votes >= 3) {
-            break;
-        }
-        for (k, &(a1, b1, a2, b2)) in W.iter().enumerate() {
-            let x1 = origin + C::new(a1, b1) * scale;
-            let x2 = origin + C::new(a2, b2) * scale;
-            let y1 = curve.y(x1, 1);
-            let y2 = curve.y(x2, if k % 2 == 0 { -1 } else { 1 });
-            let ua = curve.abel(x1, y1)?;
-            let ub = curve.abel(x2, y2)?;
-            let v = [ua[0] + ub[0] + rc[0], ua[1] + ub[1] + rc[1]];
-            let (vals, _) = plan.theta_all(&v)?;
-            let big = vals.iter().fold(0.0f64, |m, z| m.max(z.norm()));
-            let q = idx
-                .iter()
-                .map(|&i| vals[i].norm() / big)
-                .fold(f64::INFINITY, f64::min);
-            if q.is_nan() || q <= 0.0 {
-                continue;
-            }
-            let Ok(w) = kc.wurzel(x1, y1, x2, y2, None) else {
-                continue;
-            };
-            let p: [C; 7] = [
-                w.p[0],
-                w.pjk[2][3],
-                w.pjk[3][1],
-                w.pjk[1][2],
-                w.pjk[1][4],
-                w.pjk[2][4],
-                w.pjk[3][4],
-            ];
-            let th = vals[idx[0]];
-            let c2: [C; 7] = std::array::from_fn(|m| {
-                let r = p[m] * th / vals[idx[m + 1]];
-                r * r
-            });
-            if c2.iter().all(|z| z.re.is_finite() && z.im.is_finite()) {
-                cands.push((q, c2));
-            }
-        }
-    }
-    best(&cands)
-        .map(|(_, _, i)| cands[i].1)
-        .ok_or(Error::InvalidArgument {
-            what: "curve",
-            reason: "no auxiliary divisor gives finite Wurzelfunktionen".into(),
-        })
 }
 
 #[cfg(test)]
