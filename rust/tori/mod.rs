@@ -224,134 +224,15 @@ pub fn real_torus(
         return Err(TorusFailure::NonFinite);
     }
     let g = Metric::new(tau).ok_or(TorusFailure::ImagTauNotPositive)?;
-
-    // Orthonormal basis (e1, e2) of the plane P, then (q1, q2) of its complement.
-    let (p1, p2) = (real4(u), real4(u2));
-    let n1 = g.norm2(&p1).sqrt();
-    let n2 = g.norm2(&p2).sqrt();
-    if !(n1 > 0.0 && n2 > 0.0) {
-        return Err(TorusFailure::DegeneratePlane { sin_angle: 0.0 });
-    }
-    let e1 = p1.map(|v| v / n1);
-    let r2 = reject(&g, &[e1], &p2);
-    let sin_angle = g.norm2(&r2).sqrt() / n2;
-    if sin_angle.is_nan() || sin_angle <= PLANE_TOL {
-        return Err(TorusFailure::DegeneratePlane { sin_angle });
-    }
-    let e2 = r2.map(|v| v / (sin_angle * n2));
-    let mut basis = vec![e1, e2];
-    for _ in 0..2 {
-        // The unit vector with the largest component off the current span.
-        let best = (0..4)
-            .map(|k| {
-                let mut y = [0.0; 4];
-                y[k] = 1.0;
-                reject(&g, &basis, &y)
-            })
-            .max_by(|a, b| g.norm2(a).total_cmp(&g.norm2(b)))
-            .unwrap_or([0.0; 4]);
-        let nb = g.norm2(&best).sqrt();
-        basis.push(best.map(|v| v / nb));
-    }
-    let (q1, q2) = (basis[2], basis[3]);
-
-    // M (2×4): the components off P of the generators 1, 1, τ·1, τ·2 of Λ.
-    let unit = |k: usize| {
-        let mut x = [0i64; 4];
-        x[k] = 1;
-        x
-    };
-    let gens: [[f64; 4]; 4] = std::array::from_fn(|k| real4(&lattice_point(tau, &unit(k))));
-    let m: [[f64; 4]; 2] = [
-        std::array::from_fn(|k| g.dot(&q1, &gens[k])),
-        std::array::from_fn(|k| g.dot(&q2, &gens[k])),
-    ];
-
-    // Pivot on the best-conditioned pair of columns: x_piv = R x_free.
-    let pairs = [(0, 1), (0, 2), (0, 3), (1, 2), (1, 3), (2, 3)];
-    let minor = |i: usize, j: usize| m[0][i] * m[1][j] - m[0][j] * m[1][i];
-    let &(pi, pj) = pairs
-        .iter()
-        .max_by(|a, b| minor(a.0, a.1).abs().total_cmp(&minor(b.0, b.1).abs()))
-        .unwrap_or(&(0, 1));
-    let free: Vec<usize> = (0..4).filter(|&k| k != pi && k != pj).collect();
-    let (fk, fl) = (free[0], free[1]);
-    let det = minor(pi, pj);
-    if det == 0.0 || !det.is_finite() {
-        return Err(TorusFailure::NoRealLattice {
-            residual: f64::INFINITY,
-        });
-    }
-    // Mp^{-1} = [[m1j, −m0j], [−m1i, m0i]]/det; R = −Mp^{-1} Mf.
-    let r: [[f64; 2]; 2] = std::array::from_fn(|row| {
-        std::array::from_fn(|col| {
-            let f = [fk, fl][col];
-            let (a, b) = (m[0][f], m[1][f]);
-            if row == 0 {
-                -(m[1][pj] * a - m[0][pj] * b) / det
-            } else {
-                -(-m[1][pi] * a + m[0][pi] * b) / det
-            }
-        })
-    });
-
-    // The smallest denominator making R integral.
-    let mut best_res = f64::INFINITY;
-    let mut found = None;
-    for d in 1..=MAX_DENOMINATOR {
-        let res = r
-            .iter()
-            .flatten()
-            .map(|&v| {
-                let dv = d as f64 * v;
-                (dv - dv.round()).abs() / dv.abs().max(1.0)
-            })
-            .fold(0.0f64, f64::max);
-        best_res = best_res.min(res);
-        if res <= RATIONAL_TOL {
-            found = Some(d);
-            break;
-        }
-    }
-    let d = found.ok_or(TorusFailure::NoRealLattice { residual: best_res })?;
-    let ri: [[i64; 2]; 2] = r.map(|row| row.map(|v| (d as f64 * v).round() as i64));
-
-    // x_free ∈ Z² with D | Ri x_free and x ∈ Λ'; the set contains 2D Z².
-    let full = |f: [i64; 2]| -> Option<Coords> {
-        let s0 = ri[0][0] * f[0] + ri[0][1] * f[1];
-        let s1 = ri[1][0] * f[0] + ri[1][1] * f[1];
-        if s0 % d != 0 || s1 % d != 0 {
-            return None;
-        }
-        let mut x = [0i64; 4];
-        x[pi] = s0 / d;
-        x[pj] = s1 / d;
-        x[fk] = f[0];
-        x[fl] = f[1];
-        is_period(chars, &x).then_some(x)
-    };
-    let span = 2 * d;
-    let mut h = Hnf2::new(span);
-    for f0 in 0..span {
-        for f1 in 0..span {
-            if (f0, f1) != (0, 0) && full([f0, f1]).is_some() {
-                h.add([f0, f1]);
-            }
-        }
-    }
-    let [b1, b2] = h.basis();
-    let (x1, x2) = match (full(b1), full(b2)) {
-        (Some(x1), Some(x2)) => (x1, x2),
-        // Unreachable: HNF rows are integer combinations of members.
-        _ => return Err(TorusFailure::NoRealLattice { residual: best_res }),
-    };
-
+    let p1 = real4(u);
+    let (n1, [_, _, q1, q2]) = plane_basis(&g, &p1, &real4(u2))?;
+    let k = Kernel::new(tau, &g, &q1, &q2)?;
+    let (x1, x2) = k.lattice_basis(chars)?;
     let (mut a, mut b) = (
         (x1, real4(&lattice_point(tau, &x1))),
         (x2, real4(&lattice_point(tau, &x2))),
     );
     gauss_reduce(&g, &mut a, &mut b);
-
     // U = ν1 λ1 + ν2 λ2 by the normal equations in the metric.
     let (g11, g12, g22) = (g.norm2(&a.1), g.dot(&a.1, &b.1), g.norm2(&b.1));
     let (r1, r2) = (g.dot(&a.1, &p1), g.dot(&b.1, &p1));
@@ -374,6 +255,177 @@ pub fn real_torus(
         coords: [c1, c2],
         nu,
     })
+}
+
+/// `‖p1‖` and an orthonormal basis `(e1, e2, q1, q2)` of `R⁴` in the metric
+/// `g`: `(e1, e2)` of the plane `P` of the flows `p1`, `p2`, `(q1, q2)` of its
+/// complement.
+///
+/// Errors: the flows do not span a plane (sin of their angle ≤ [`PLANE_TOL`]).
+fn plane_basis(
+    g: &Metric,
+    p1: &[f64; 4],
+    p2: &[f64; 4],
+) -> std::result::Result<(f64, [[f64; 4]; 4]), TorusFailure> {
+    let n1 = g.norm2(p1).sqrt();
+    let n2 = g.norm2(p2).sqrt();
+    if !(n1 > 0.0 && n2 > 0.0) {
+        return Err(TorusFailure::DegeneratePlane { sin_angle: 0.0 });
+    }
+    let e1 = p1.map(|v| v / n1);
+    let r2 = reject(g, &[e1], p2);
+    let sin_angle = g.norm2(&r2).sqrt() / n2;
+    if sin_angle.is_nan() || sin_angle <= PLANE_TOL {
+        return Err(TorusFailure::DegeneratePlane { sin_angle });
+    }
+    let e2 = r2.map(|v| v / (sin_angle * n2));
+    let mut basis = vec![e1, e2];
+    for _ in 0..2 {
+        // The unit vector with the largest component off the current span.
+        let best = (0..4)
+            .map(|k| {
+                let mut y = [0.0; 4];
+                y[k] = 1.0;
+                reject(g, &basis, &y)
+            })
+            .max_by(|a, b| g.norm2(a).total_cmp(&g.norm2(b)))
+            .unwrap_or([0.0; 4]);
+        let nb = g.norm2(&best).sqrt();
+        basis.push(best.map(|v| v / nb));
+    }
+    Ok((n1, [basis[0], basis[1], basis[2], basis[3]]))
+}
+
+/// The integer kernel of the projection of `Λ` off the plane: the lattice
+/// points `x` whose image lies in `P` satisfy `x_piv = R x_free` (pivot on
+/// the best-conditioned pair of columns of `M`, the components off `P` of the
+/// generators `1, 1, τ·1, τ·2`), with `R = Ri / d` rational.
+struct Kernel {
+    pi: usize,
+    pj: usize,
+    fk: usize,
+    fl: usize,
+    d: i64,
+    ri: [[i64; 2]; 2],
+    /// The smallest residual of `d R` from integers over the denominators tried.
+    best_res: f64,
+}
+
+impl Kernel {
+    /// Errors: no denominator `≤ MAX_DENOMINATOR` makes `R` integral to
+    /// [`RATIONAL_TOL`] (or the projection is singular).
+    fn new(
+        tau: &Tau,
+        g: &Metric,
+        q1: &[f64; 4],
+        q2: &[f64; 4],
+    ) -> std::result::Result<Kernel, TorusFailure> {
+        let unit = |k: usize| {
+            let mut x = [0i64; 4];
+            x[k] = 1;
+            x
+        };
+        let gens: [[f64; 4]; 4] = std::array::from_fn(|k| real4(&lattice_point(tau, &unit(k))));
+        let m: [[f64; 4]; 2] = [
+            std::array::from_fn(|k| g.dot(q1, &gens[k])),
+            std::array::from_fn(|k| g.dot(q2, &gens[k])),
+        ];
+        let pairs = [(0, 1), (0, 2), (0, 3), (1, 2), (1, 3), (2, 3)];
+        let minor = |i: usize, j: usize| m[0][i] * m[1][j] - m[0][j] * m[1][i];
+        let &(pi, pj) = pairs
+            .iter()
+            .max_by(|a, b| minor(a.0, a.1).abs().total_cmp(&minor(b.0, b.1).abs()))
+            .unwrap_or(&(0, 1));
+        let free: Vec<usize> = (0..4).filter(|&k| k != pi && k != pj).collect();
+        let (fk, fl) = (free[0], free[1]);
+        let det = minor(pi, pj);
+        if det == 0.0 || !det.is_finite() {
+            return Err(TorusFailure::NoRealLattice {
+                residual: f64::INFINITY,
+            });
+        }
+        // Mp^{-1} = [[m1j, −m0j], [−m1i, m0i]]/det; R = −Mp^{-1} Mf.
+        let r: [[f64; 2]; 2] = std::array::from_fn(|row| {
+            std::array::from_fn(|col| {
+                let f = [fk, fl][col];
+                let (a, b) = (m[0][f], m[1][f]);
+                if row == 0 {
+                    -(m[1][pj] * a - m[0][pj] * b) / det
+                } else {
+                    -(-m[1][pi] * a + m[0][pi] * b) / det
+                }
+            })
+        });
+        // The smallest denominator making R integral.
+        let mut best_res = f64::INFINITY;
+        let mut found = None;
+        for d in 1..=MAX_DENOMINATOR {
+            let res = r
+                .iter()
+                .flatten()
+                .map(|&v| {
+                    let dv = d as f64 * v;
+                    (dv - dv.round()).abs() / dv.abs().max(1.0)
+                })
+                .fold(0.0f64, f64::max);
+            best_res = best_res.min(res);
+            if res <= RATIONAL_TOL {
+                found = Some(d);
+                break;
+            }
+        }
+        let d = found.ok_or(TorusFailure::NoRealLattice { residual: best_res })?;
+        let ri: [[i64; 2]; 2] = r.map(|row| row.map(|v| (d as f64 * v).round() as i64));
+        Ok(Kernel {
+            pi,
+            pj,
+            fk,
+            fl,
+            d,
+            ri,
+            best_res,
+        })
+    }
+
+    /// The lattice point with free coordinates `f`, if it is integral and a
+    /// period of the quotients (`chars`).
+    fn full(&self, chars: &[Char], f: [i64; 2]) -> Option<Coords> {
+        let (ri, d) = (&self.ri, self.d);
+        let s0 = ri[0][0] * f[0] + ri[0][1] * f[1];
+        let s1 = ri[1][0] * f[0] + ri[1][1] * f[1];
+        if s0 % d != 0 || s1 % d != 0 {
+            return None;
+        }
+        let mut x = [0i64; 4];
+        x[self.pi] = s0 / d;
+        x[self.pj] = s1 / d;
+        x[self.fk] = f[0];
+        x[self.fl] = f[1];
+        is_period(chars, &x).then_some(x)
+    }
+
+    /// A basis of `Λ' ∩ P`: the free coordinates `x_free ∈ Z²` with
+    /// `D | Ri x_free` and `x ∈ Λ'` form a lattice containing `2D Z²`, reduced
+    /// to Hermite normal form.
+    fn lattice_basis(&self, chars: &[Char]) -> std::result::Result<(Coords, Coords), TorusFailure> {
+        let span = 2 * self.d;
+        let mut h = Hnf2::new(span);
+        for f0 in 0..span {
+            for f1 in 0..span {
+                if (f0, f1) != (0, 0) && self.full(chars, [f0, f1]).is_some() {
+                    h.add([f0, f1]);
+                }
+            }
+        }
+        let [b1, b2] = h.basis();
+        match (self.full(chars, b1), self.full(chars, b2)) {
+            (Some(x1), Some(x2)) => Ok((x1, x2)),
+            // Unreachable: HNF rows are integer combinations of members.
+            _ => Err(TorusFailure::NoRealLattice {
+                residual: self.best_res,
+            }),
+        }
+    }
 }
 
 /// Lagrange–Gauss reduction of the pair `(a, b)` (coordinates, real image) in
