@@ -52,6 +52,9 @@ pub enum Error {
         reached: f64,
         iterations: usize,
     },
+    /// No real torus carries the motion (the frequency maps, `crate::tori`):
+    /// `failure` says why. Python sees a `ValueError`.
+    NoRealTorus { failure: TorusFailure },
     /// The computation was cancelled (Ctrl-C in Python; see [`crate::numeric::cancel`]).
     Interrupted,
 }
@@ -69,7 +72,8 @@ pub enum SingularKind {
     VanishingH0,
     /// `h1² = 4h0²` (`m = ±n`): `F` of (19) is undefined.
     SelfDual,
-    /// Two branch points `d_i`, `d_j` of (8) coincide, or a root of `F` (19)
+    /// Two branch points `d_i`, `d_j` of (8) coincide (`d_j = 0` meets
+    /// `d_0`, `d_j = ∞` the branch point at infinity), or a root of `F` (19)
     /// meets an `a_j`: the genus drops.
     CoincidingBranchPoints,
     /// `F(s)` of (19) has a repeated root (a separatrix): the genus drops.
@@ -78,6 +82,31 @@ pub enum SingularKind {
     DivisorAtInfinity,
     /// The theta-quotient gradients at `v0` do not determine `U`.
     DegenerateGradients,
+    /// The solution's theta quotients reproduce `l0` but solve Frahm's
+    /// equations (1) at `v0` for no velocity: its set-up is wrong at this state.
+    InconsistentQuotients,
+    /// The auxiliary divisors of the level-set route (`crate::solution::velocity`)
+    /// do not agree on the velocities; the solution's own route may still succeed.
+    NoVelocityConsensus,
+}
+
+/// Why no real torus carries a motion ([`Error::NoRealTorus`]); the frequency
+/// maps turn it into a status code. The message (`Display`) is in
+/// `crate::tori`, beside the tolerances it cites.
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[non_exhaustive]
+pub enum TorusFailure {
+    /// A non-finite entry in `τ`, `U` or `U'`.
+    NonFinite,
+    /// `Im τ` is not positive definite.
+    ImagTauNotPositive,
+    /// `U` and `U'` are (nearly) R-linearly dependent: `sin_angle` between them.
+    DegeneratePlane { sin_angle: f64 },
+    /// The integer kernel of the projection could not be recognised: no
+    /// denominator `≤ tori::MAX_DENOMINATOR` makes it integral to
+    /// `tori::RATIONAL_TOL` (`residual` at the best one). The orbit is then not
+    /// on a compact real 2-torus (or `U'` is not a flow of the same family).
+    NoRealLattice { residual: f64 },
 }
 
 /// `Result` with the crate's [`Error`].
@@ -123,6 +152,7 @@ impl fmt::Display for Error {
                 f,
                 "{what} did not converge: tolerance {tol:e}, reached {reached:e} after {iterations} iterations"
             ),
+            Error::NoRealTorus { failure } => write!(f, "invalid real torus: {failure}"),
             Error::Interrupted => write!(f, "interrupted"),
         }
     }

@@ -28,7 +28,7 @@ pub mod solution;
 pub mod theta;
 pub mod tori;
 
-pub use error::{Error, Result, SingularKind};
+pub use error::{Error, Result, SingularKind, TorusFailure};
 
 #[cfg(feature = "python")]
 mod python;

@@ -54,7 +54,7 @@ pub struct KotterConstants {
     /// `d_j` (26), the constants of Kötter's quadrics (11) and of the curve (8).
     pub d: [C; 3],
     /// The rounding errors of `d`: `d + d_lo` is `d_j` to double-double
-    /// accuracy. [`kotter_with`] starts the inverse map of (37) from the closed
+    /// accuracy. [`kotter_with`](super::kotter_with) starts the inverse map of (37) from the closed
     /// form (30) on this unrounded curve: near the singular set the closed form
     /// cancels by `|d_4|/|z|` (docs/kotter.md, "Near the singular set").
     pub d_lo: [C; 3],
@@ -276,15 +276,26 @@ fn coefficients_20(a: &[f64; 4], roots: &[PolishedRoot]) -> Result<([[Cdd; 3]; 4
     for p in 0..4 {
         let sqrt_fp = roots[p].sqrt_fprime.to_c();
         if !(sqrt_fp.norm().is_finite() && sqrt_fp.norm() > 0.0) {
-            return Err(Error::InvalidArgument {
-                what: "state l",
-                reason: format!(
-                    "F'(s_{}) = {} (19) at the root s_{} = {} is zero or not finite",
-                    p + 1,
-                    roots[p].fprime,
-                    p + 1,
-                    s[p]
-                ),
+            let reason = format!(
+                "F'(s_{}) = {} (19) at the root s_{} = {} is zero or not finite",
+                p + 1,
+                roots[p].fprime,
+                p + 1,
+                s[p]
+            );
+            // F'(s_p) = 0 is a repeated root of F, as in `check_repeated`; an
+            // overflow is not a property of the state.
+            return Err(if sqrt_fp.norm() == 0.0 {
+                Error::Singular {
+                    what: "state l",
+                    kind: SingularKind::RepeatedRoot,
+                    reason,
+                }
+            } else {
+                Error::InvalidArgument {
+                    what: "state l",
+                    reason,
+                }
             });
         }
         for (j, &aj) in a.iter().enumerate() {
@@ -373,8 +384,11 @@ impl BranchConstants {
             let size = (u[0][j].to_c().norm() + v[0][j].to_c().norm())
                 * (u[1][j].to_c().norm() + v[1][j].to_c().norm());
             if d3.to_c().norm() <= 1e-12 * size {
-                return Err(Error::InvalidArgument {
+                // √d_j = (Δ1 − iΔ2)/Δ3: d_j at infinity, where the curve (8)
+                // has its own branch point.
+                return Err(Error::Singular {
                     what: "state l",
+                    kind: SingularKind::CoincidingBranchPoints,
                     reason: format!(
                         "Delta_{}^(3) (25) vanishes: l_j^(1), l_j^(2) do not determine m_j, n_j",
                         j + 1
@@ -403,8 +417,11 @@ impl BranchConstants {
             bc.abgd_dd[3][j] = u2.sub(u1.mul_i()).div(two_d3).neg();
             bc.d_dd[j] = dj;
             if bc.d[j].norm() == 0.0 || !bc.d[j].norm().is_finite() {
-                return Err(Error::InvalidArgument {
+                // d_j = 0 meets the branch point d_0 = 0 of (8), d_j = ∞ the one
+                // at infinity: the genus drops, as for coinciding roots.
+                return Err(Error::Singular {
                     what: "state l",
+                    kind: SingularKind::CoincidingBranchPoints,
                     reason: format!("d_{} = {} (26) is zero or infinite", j + 1, bc.d[j]),
                 });
             }

@@ -302,7 +302,7 @@ pub fn kotter_along(constants: &KotterConstants, rows: &[[f64; 6]]) -> Vec<Resul
 ///
 /// Errors: those of [`KotterCurve::xi_eta_points`] (points off the curve,
 /// offsets inconsistent with `z`, `z1 = z2`, a bad branch) and of
-/// [`l_from_xi_eta`] (a complex state).
+/// [`l_from_xi_eta`](super::l_from_xi_eta) (a complex state).
 pub fn from_kotter(
     coef: &Coefficients23,
     d: [C; 3],

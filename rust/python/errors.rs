@@ -27,7 +27,8 @@ impl From<Error> for PyErr {
             | Error::ImagNotPositiveDefinite { .. }
             | Error::RepeatedBranchPoints { .. }
             | Error::Singular { .. }
-            | Error::InvalidArgument { .. } => PyValueError::new_err(msg),
+            | Error::InvalidArgument { .. }
+            | Error::NoRealTorus { .. } => PyValueError::new_err(msg),
         }
     }
 }

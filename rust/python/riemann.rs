@@ -198,7 +198,7 @@ impl HyperellipticCore {
         let rows = if n % 2 == 1 { n + 1 } else { n };
         let mut flat = Vec::with_capacity(rows * 2 * g);
         for k in 0..rows {
-            let (a, b) = self.curve.try_branch_char(k)?;
+            let (a, b) = self.curve.branch_char(k)?;
             flat.extend(a);
             flat.extend(b);
         }
@@ -208,12 +208,12 @@ impl HyperellipticCore {
     }
 
     fn riemann_constant<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray1<C>>> {
-        let k = py.detach(|| self.curve.try_riemann_constant().map(|k| k.to_vec()))?;
+        let k = py.detach(|| self.curve.riemann_constant().map(|k| k.to_vec()))?;
         Ok(Array1::from(k).into_pyarray(py))
     }
 
     fn riemann_constant_char<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray1<u8>>> {
-        let (a, b) = py.detach(|| self.curve.try_riemann_constant_char())?;
+        let (a, b) = py.detach(|| self.curve.riemann_constant_char())?;
         Ok(Array1::from([a, b].concat()).into_pyarray(py))
     }
 

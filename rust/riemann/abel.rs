@@ -660,20 +660,16 @@ impl HyperellipticCurve {
 
     /// `η(e_k)`: `u(e_k) ≡ (b + τ a)/2` modulo the lattice, for the 0-based
     /// index `k` (`e_{k+1}`); `k = n` is `∞` for odd `n` (`η(∞) = 0`, the base
-    /// point). Empty vectors for an index out of range
-    /// ([`Self::try_branch_char`] gives the error).
-    pub fn branch_char(&self, k: usize) -> (Vec<u8>, Vec<u8>) {
-        self.try_branch_char(k).unwrap_or_default()
-    }
-
-    /// [`Self::branch_char`] with an error for an index out of range.
-    pub fn try_branch_char(&self, k: usize) -> Result<(Vec<u8>, Vec<u8>)> {
+    /// point).
+    ///
+    /// Errors: an index out of range, those of the Abel map.
+    pub fn branch_char(&self, k: usize) -> Result<(Vec<u8>, Vec<u8>)> {
         self.half_period_char(&self.abel_branch_point(k)?)
     }
 
     /// The half period `(b + τa)/2` of `η(e_k)` (reduced representative).
     pub fn branch_half_period(&self, k: usize) -> Result<Vec<C>> {
-        let (a, b) = self.try_branch_char(k)?;
+        let (a, b) = self.branch_char(k)?;
         Ok(self.half_period(&a, &b))
     }
 }

@@ -73,7 +73,7 @@ impl HyperellipticCurve {
             let v: Vec<C> = (0..2).map(|i| u1[i] + u2[i] + k[i]).collect();
             let (vals, _) = plan.theta_all(&v)?;
             for j in 0..5 {
-                let (a, b) = self.try_branch_char(j)?;
+                let (a, b) = self.branch_char(j)?;
                 let idx = crate::theta::char_index(&a, &b)?;
                 let ratio = vals[0] / vals[idx];
                 calib.push(Some((
@@ -150,25 +150,16 @@ impl HyperellipticCurve {
     /// period `(b + τa)/2` with `θ(u(P_1) + … + u(P_{g−1}) + K) = 0` for all
     /// points (g = 2: `θ(u(P) + K) = 0` for every `P`), found among the `4^g`
     /// half periods by evaluating theta at three fixed divisors (built on
-    /// first use). Empty if that search failed; [`Self::try_riemann_constant`]
-    /// gives the error.
-    pub fn riemann_constant(&self) -> &[C] {
-        self.try_riemann_constant().unwrap_or(&[])
-    }
-
-    /// [`Self::riemann_constant`] with the error of the search.
-    pub fn try_riemann_constant(&self) -> Result<&[C]> {
+    /// first use).
+    ///
+    /// Errors: those of the search (no half period qualifies, the theta plan).
+    pub fn riemann_constant(&self) -> Result<&[C]> {
         Ok(&self.derived()?.k)
     }
 
     /// The characteristic `[a; b]` of [`Self::riemann_constant`]
-    /// (`K = (b + τa)/2`); empty vectors if the search failed.
-    pub fn riemann_constant_char(&self) -> (Vec<u8>, Vec<u8>) {
-        self.try_riemann_constant_char().unwrap_or_default()
-    }
-
-    /// [`Self::riemann_constant_char`] with the error of the search.
-    pub fn try_riemann_constant_char(&self) -> Result<(Vec<u8>, Vec<u8>)> {
+    /// (`K = (b + τa)/2`); its errors.
+    pub fn riemann_constant_char(&self) -> Result<(Vec<u8>, Vec<u8>)> {
         Ok(self.derived()?.k_char.clone())
     }
 

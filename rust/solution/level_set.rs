@@ -116,7 +116,7 @@ pub fn level_set_curve(a: &[f64; 4], l0: &[f64; 6]) -> Result<LevelSetCurve> {
     // χ_j = η(d_j) (index j of the branch points passed), χ_jk = χ_j + χ_k mod 2.
     let mut eta = [([0u8; 2], [0u8; 2]); 5];
     for (j, e) in eta.iter_mut().enumerate() {
-        let (ca, cb) = curve.try_branch_char(j)?;
+        let (ca, cb) = curve.branch_char(j)?;
         *e = ([ca[0], ca[1]], [cb[0], cb[1]]);
     }
     let sum = |p: usize, q: usize| {

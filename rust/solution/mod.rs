@@ -146,7 +146,7 @@ impl Solution {
         let tau_rm = curve.tau_row_major();
         let tau: [C; 4] = [tau_rm[0], tau_rm[1], tau_rm[2], tau_rm[3]];
         let plan = ThetaPlan::new(&tau, 2, THETA_TOL, 1)?.with_parallel(false);
-        let rcv = curve.try_riemann_constant()?;
+        let rcv = curve.riemann_constant()?;
         let rc = [rcv[0], rcv[1]];
         let mut idx = [0usize; 8];
         idx[0] = char_index(&[0, 0], &[0, 0])?;
@@ -290,8 +290,9 @@ impl Solution {
             .max((u[1] - reference[1]).norm());
         let scale = reference[0].norm().max(reference[1].norm());
         if dev.is_nan() || dev > QUOTIENT_RESIDUAL_RTOL * scale {
-            return Err(Error::InvalidArgument {
+            return Err(Error::Singular {
                 what: INCONSISTENT,
+                kind: SingularKind::InconsistentQuotients,
                 reason: format!(
                     "the velocity by the chain rule at auxiliary divisors differs from the \
                      theta quotients' at v0 by {dev:e} (|U| = {scale:e})"

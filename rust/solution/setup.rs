@@ -106,8 +106,9 @@ impl VelocitySystem {
 /// constant or branch, which reproduces `l0` at `t = 0` and is O(1) wrong later.
 pub(super) fn check_velocity_fit(res: f64) -> Result<()> {
     if res.is_nan() || res > QUOTIENT_RESIDUAL_RTOL {
-        return Err(Error::InvalidArgument {
+        return Err(Error::Singular {
             what: INCONSISTENT,
+            kind: SingularKind::InconsistentQuotients,
             reason: format!(
                 "the theta quotients (9)-(10) at v0 satisfy Frahm's equations (1) for no \
                  velocity (least-squares residual {res:e} > {QUOTIENT_RESIDUAL_RTOL:e}): a \

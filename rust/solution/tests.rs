@@ -178,7 +178,11 @@ fn velocity_fit_guard_refuses_an_inconsistent_fit() {
     assert!(check_velocity_fit(1e-13).is_ok());
     for res in [1e-2, f64::NAN] {
         match check_velocity_fit(res) {
-            Err(Error::InvalidArgument { what, reason }) => {
+            Err(Error::Singular {
+                what,
+                kind: SingularKind::InconsistentQuotients,
+                reason,
+            }) => {
                 assert_eq!(what, INCONSISTENT);
                 assert!(reason.contains("for no velocity"), "{reason}");
             }

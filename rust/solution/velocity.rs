@@ -43,7 +43,7 @@ use nalgebra::{Matrix2, Vector2};
 use num_complex::Complex64;
 
 use crate::curve::{KotterCurve, CYCLIC};
-use crate::error::{Error, Result};
+use crate::error::{Error, Result, SingularKind};
 use crate::kotter::KotterConstants;
 use crate::numeric::complex::sqrt_principal;
 use crate::so4::PAIRS4;
@@ -331,15 +331,17 @@ fn best_supported(cands: &[Candidate]) -> Option<(usize, usize)> {
 /// least [`MIN_SUPPORT`]; otherwise the error naming [`NO_CONSENSUS`] and
 /// whether no candidate or too few agreeing ones were found.
 fn supporters(cands: &[Candidate]) -> Result<Vec<&Candidate>> {
-    let (votes, i) = best_supported(cands).ok_or(Error::InvalidArgument {
+    let (votes, i) = best_supported(cands).ok_or(Error::Singular {
         what: NO_CONSENSUS,
+        kind: SingularKind::NoVelocityConsensus,
         reason: "no auxiliary divisor gives a consistent state on the level set: the \
                  reduction's constants are inconsistent"
             .into(),
     })?;
     if votes < MIN_SUPPORT {
-        return Err(Error::InvalidArgument {
+        return Err(Error::Singular {
             what: NO_CONSENSUS,
+            kind: SingularKind::NoVelocityConsensus,
             reason: format!(
                 "only {votes} of {} auxiliary divisors agree on the velocity (at least \
                  {MIN_SUPPORT} must, to {AGREE_RTOL:e})",
@@ -367,7 +369,7 @@ fn supporters(cands: &[Candidate]) -> Result<Vec<&Candidate>> {
 ///
 /// Errors: `c4s` empty or not finite, a singular `a_periods`
 /// ([`Error::InvalidArgument`]); fewer than [`MIN_SUPPORT`] divisors agree
-/// ([`Error::InvalidArgument`] with `what` = [`NO_CONSENSUS`]).
+/// ([`Error::Singular`] of kind [`SingularKind::NoVelocityConsensus`], `what` = [`NO_CONSENSUS`]).
 pub fn algebraic_rates(
     k: &KotterConstants,
     curve: &KotterCurve,
@@ -642,7 +644,11 @@ mod tests {
         let mut bad = k.clone();
         bad.alpha[0] *= 1.0 + 1e-6;
         match algebraic_rates(&bad, &curve, &ap, &[c4]) {
-            Err(Error::InvalidArgument { what, reason }) => {
+            Err(Error::Singular {
+                what,
+                kind: SingularKind::NoVelocityConsensus,
+                reason,
+            }) => {
                 assert_eq!(what, NO_CONSENSUS, "{reason}");
                 assert!(reason.contains("no auxiliary divisor"), "{reason}");
             }
@@ -663,7 +669,11 @@ mod tests {
             chain: 1e-15,
         };
         let reason = |r: Result<Vec<&Candidate>>| match r {
-            Err(Error::InvalidArgument { what, reason }) => {
+            Err(Error::Singular {
+                what,
+                kind: SingularKind::NoVelocityConsensus,
+                reason,
+            }) => {
                 assert_eq!(what, NO_CONSENSUS);
                 reason
             }

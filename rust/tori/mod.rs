@@ -34,6 +34,8 @@ pub mod solve;
 #[cfg(test)]
 mod tests;
 
+use std::fmt;
+
 use num_complex::Complex64;
 use rayon::prelude::*;
 
@@ -74,39 +76,29 @@ pub const PLANE_TOL: f64 = 1e-8;
 /// non-finite or inconsistent input).
 pub const RESIDUAL_TOL: f64 = 1e-9;
 
-/// Why a real torus could not be found.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub enum TorusFailure {
-    /// A non-finite entry in `τ`, `U` or `U'`.
-    NonFinite,
-    /// `Im τ` is not positive definite.
-    ImagTauNotPositive,
-    /// `U` and `U'` are (nearly) R-linearly dependent: `sin_angle` between them.
-    DegeneratePlane { sin_angle: f64 },
-    /// The integer kernel of the projection could not be recognised: no
-    /// denominator `≤ MAX_DENOMINATOR` makes it integral to `RATIONAL_TOL`
-    /// (`residual` at the best one). The orbit is then not on a compact
-    /// real 2-torus (or `U'` is not a flow of the same family).
-    NoRealLattice { residual: f64 },
-}
+pub use crate::error::TorusFailure;
 
-impl From<TorusFailure> for Error {
-    fn from(f: TorusFailure) -> Error {
-        let reason = match f {
-            TorusFailure::NonFinite => "tau, U or U' is not finite".to_string(),
-            TorusFailure::ImagTauNotPositive => "Im tau is not positive definite".to_string(),
-            TorusFailure::DegeneratePlane { sin_angle } => {
-                format!("the two flows do not span a real plane (sin of their angle {sin_angle:e})")
-            }
-            TorusFailure::NoRealLattice { residual } => format!(
+impl fmt::Display for TorusFailure {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match *self {
+            TorusFailure::NonFinite => write!(f, "tau, U or U' is not finite"),
+            TorusFailure::ImagTauNotPositive => write!(f, "Im tau is not positive definite"),
+            TorusFailure::DegeneratePlane { sin_angle } => write!(
+                f,
+                "the two flows do not span a real plane (sin of their angle {sin_angle:e})"
+            ),
+            TorusFailure::NoRealLattice { residual } => write!(
+                f,
                 "the lattice of periods meets the real plane of the flows in no rank-2 lattice \
                  (kernel not rational: residual {residual:e} at denominators <= {MAX_DENOMINATOR})"
             ),
-        };
-        Error::InvalidArgument {
-            what: "real torus",
-            reason,
         }
+    }
+}
+
+impl From<TorusFailure> for Error {
+    fn from(failure: TorusFailure) -> Error {
+        Error::NoRealTorus { failure }
     }
 }
 
@@ -498,55 +490,73 @@ impl Hnf2 {
     }
 }
 
-/// Status of one state in a frequency map (the `status` array of
-/// `manakov.frequency_map`; the codes are part of the API).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-#[repr(u8)]
-pub enum Status {
+/// The status codes of a frequency map, defined once: each row gives the
+/// variant's doc, its name, its code and its short name; [`Status`],
+/// [`STATUS_NAMES`] and [`Status::ALL`] are generated from it, so that codes
+/// and names cannot drift apart.
+macro_rules! status_table {
+    ($($(#[doc = $doc:literal])+ $variant:ident = $code:literal, $name:literal;)+) => {
+        /// Status of one state in a frequency map (the `status` array of
+        /// `manakov.frequency_map`; the codes are part of the API).
+        #[derive(Debug, Clone, Copy, PartialEq, Eq)]
+        #[repr(u8)]
+        pub enum Status {
+            $($(#[doc = $doc])+ $variant = $code,)+
+        }
+
+        /// Short names of the status codes, indexed by code.
+        pub const STATUS_NAMES: [&str; [$($code),+].len()] = [$($name),+];
+
+        impl Status {
+            /// Every status, in the order of its code.
+            pub const ALL: [Status; [$($code),+].len()] = [$(Status::$variant),+];
+
+            /// The short name of the status ([`STATUS_NAMES`]).
+            pub fn name(self) -> &'static str {
+                STATUS_NAMES[self as usize]
+            }
+        }
+    };
+}
+
+status_table! {
     /// Frequencies computed.
-    Ok = 0,
+    Ok = 0, "ok";
     /// `h1² = 4 h0²`: `F(s)` of (19) is undefined (the level set is singular).
-    SingularCasimirs = 1,
+    SingularCasimirs = 1, "h1^2 = 4 h0^2";
     /// Two branch points `d_j` of (8) coincide (`h0 = 0` and a repeated root of
     /// `F` (19) included): the genus drops, a separatrix or a degenerate torus.
-    CoincidingBranchPoints = 2,
+    CoincidingBranchPoints = 2, "coinciding branch points";
     /// The divisor of the initial state has a point at infinity.
-    DivisorAtInfinity = 3,
+    DivisorAtInfinity = 3, "divisor at infinity";
     /// An iteration of the solution did not converge.
-    NoConvergence = 4,
+    NoConvergence = 4, "no convergence";
     /// `l0 = 0`.
-    ZeroState = 5,
+    ZeroState = 5, "zero state";
     /// A non-finite entry in the state.
-    NonFinite = 6,
+    NonFinite = 6, "non-finite state";
     /// The top's flow and the second flow do not span a real plane.
-    DegeneratePlane = 7,
+    DegeneratePlane = 7, "degenerate plane";
     /// No rank-2 lattice of periods in the real plane (not a compact torus).
-    NoRealLattice = 8,
+    NoRealLattice = 8, "no real lattice";
     /// Any other refusal of the solution (its message names the reason).
-    Singular = 9,
+    Singular = 9, "singular";
     /// The theta-quotient gradients at `v0` do not determine the velocity `U`.
-    DegenerateGradients = 10,
+    DegenerateGradients = 10, "degenerate gradients";
     /// The solution's theta quotients reproduce `l0` but solve Frahm's
     /// equations (1) at `v0` for no velocity: its set-up is wrong at this
     /// state (one of the Theorem's outliers), so are its frequencies.
-    InconsistentQuotients = 11,
+    InconsistentQuotients = 11, "inconsistent quotients";
 }
 
-/// Short names of the status codes, indexed by code.
-pub const STATUS_NAMES: [&str; 12] = [
-    "ok",
-    "h1^2 = 4 h0^2",
-    "coinciding branch points",
-    "divisor at infinity",
-    "no convergence",
-    "zero state",
-    "non-finite state",
-    "degenerate plane",
-    "no real lattice",
-    "singular",
-    "degenerate gradients",
-    "inconsistent quotients",
-];
+// The codes are the indices of the table (so that `STATUS_NAMES[code]` is the name).
+const _: () = {
+    let mut i = 0;
+    while i < Status::ALL.len() {
+        assert!(Status::ALL[i] as usize == i);
+        i += 1;
+    }
+};
 
 impl From<TorusFailure> for Status {
     fn from(f: TorusFailure) -> Status {

@@ -22,7 +22,7 @@ use super::{
 };
 use crate::error::{Error, Result, SingularKind};
 use crate::so4;
-use crate::solution::velocity::{algebraic_rates, NO_CONSENSUS};
+use crate::solution::velocity::algebraic_rates;
 use crate::solution::{a_periods_of, level_set_curve, Solution};
 
 /// The six `c_ij` (`i < j`, state order) of `ManakovTop(a, b)` (2).
@@ -46,8 +46,9 @@ pub fn flow_data(sol: &Solution, b2: &[f64; 4]) -> Result<FlowData> {
     // the second flow's fit must hold as well before it defines the real plane.
     let (u2, res) = sol.rates(&[c2])?[0];
     if res.is_nan() || res > QUOTIENT_RESIDUAL_RTOL {
-        return Err(Error::InvalidArgument {
+        return Err(Error::Singular {
             what: INCONSISTENT,
+            kind: SingularKind::InconsistentQuotients,
             reason: format!(
                 "the theta quotients (9)-(10) at v0 satisfy Frahm's equations (1) of the \
                  second flow for no velocity (least-squares residual {res:e} > \
@@ -77,13 +78,13 @@ pub fn classify(e: &Error) -> Status {
             | SingularKind::RepeatedRoot => Status::CoincidingBranchPoints,
             SingularKind::DivisorAtInfinity => Status::DivisorAtInfinity,
             SingularKind::DegenerateGradients => Status::DegenerateGradients,
+            SingularKind::InconsistentQuotients => Status::InconsistentQuotients,
+            SingularKind::NoVelocityConsensus => Status::Singular,
         },
+        Error::NoRealTorus { failure } => Status::from(*failure),
         Error::RepeatedBranchPoints { .. } => Status::CoincidingBranchPoints,
         Error::NoConvergence { .. } => Status::NoConvergence,
         Error::NonFinite { .. } => Status::NonFinite,
-        Error::InvalidArgument {
-            what: INCONSISTENT, ..
-        } => Status::InconsistentQuotients,
         _ => Status::Singular,
     }
 }
@@ -126,8 +127,9 @@ pub fn state_frequencies(a: &[f64; 4], b: &[f64; 4], l0: &[f64; 6]) -> MapEntry 
     frequencies_of_state(
         l0,
         |l| match level_set_flow_data(a, b, &b2, l) {
-            Err(Error::InvalidArgument {
-                what: NO_CONSENSUS, ..
+            Err(Error::Singular {
+                kind: SingularKind::NoVelocityConsensus,
+                ..
             }) => Solution::new(a, b, l).and_then(|s| flow_data(&s, &b2)),
             other => other,
         },

@@ -284,7 +284,30 @@ fn failures_are_named() {
         Err(TorusFailure::ImagTauNotPositive)
     );
     let e: Error = TorusFailure::DegeneratePlane { sin_angle: 0.0 }.into();
-    assert!(e.to_string().contains("real plane"));
+    // The failure stays data; the message reads as before ("invalid real torus: …").
+    assert_eq!(
+        e,
+        Error::NoRealTorus {
+            failure: TorusFailure::DegeneratePlane { sin_angle: 0.0 }
+        }
+    );
+    assert_eq!(
+        e.to_string(),
+        "invalid real torus: the two flows do not span a real plane (sin of their angle 0e0)"
+    );
+    assert_eq!(solve::classify(&e), Status::DegeneratePlane);
+}
+
+/// The status codes and their names come from one table: every code is its
+/// index, and `name` agrees with `STATUS_NAMES`.
+#[test]
+fn status_codes_and_names_agree() {
+    assert_eq!(Status::ALL.len(), STATUS_NAMES.len());
+    for (code, s) in Status::ALL.iter().enumerate() {
+        assert_eq!(*s as usize, code);
+        assert_eq!(s.name(), STATUS_NAMES[code]);
+    }
+    assert_eq!(Status::InconsistentQuotients.name(), "inconsistent quotients");
 }
 
 #[test]
@@ -559,8 +582,9 @@ mod on_the_solution {
             what: "state l",
             reason: "h0 = 0 coincide infinity".into(),
         };
-        let inconsistent = Error::InvalidArgument {
+        let inconsistent = Error::Singular {
             what: super::super::solve::INCONSISTENT,
+            kind: SingularKind::InconsistentQuotients,
             reason: String::new(),
         };
         assert_eq!(classify(&inconsistent), Status::InconsistentQuotients);
