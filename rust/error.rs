@@ -57,6 +57,13 @@ pub enum Error {
     NoRealTorus { failure: TorusFailure },
     /// The computation was cancelled (Ctrl-C in Python; see [`crate::numeric::cancel`]).
     Interrupted,
+    /// Row `row` of a batch of `rows` failed with `source` (Python sees the
+    /// exception of `source`, its message prefixed with the row).
+    InRow {
+        row: usize,
+        rows: usize,
+        source: Box<Error>,
+    },
 }
 
 /// Why a state has no genus-2 theta-function solution ([`Error::Singular`]).
@@ -154,6 +161,7 @@ impl fmt::Display for Error {
             ),
             Error::NoRealTorus { failure } => write!(f, "invalid real torus: {failure}"),
             Error::Interrupted => write!(f, "interrupted"),
+            Error::InRow { row, rows, source } => write!(f, "row {row} of {rows}: {source}"),
         }
     }
 }

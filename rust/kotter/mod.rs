@@ -33,17 +33,20 @@
 //! # Files
 //!
 //! `schottky.rs`: `l(s)`, `f(s)` and the Lax pair at a point `s`;
+//! `batch.rs`: many states at once, with the policy for failing rows;
 //! `roots.rs`: the quartic `F` (19) and its roots; `polish.rs`: each root on
 //! its own branch, in double-double; `constants.rs`: the level-set constants
 //! (20)–(26), (38)–(41); `map.rs`: a state to `ξ, η` and the points of the
 //! curve (37), (42), and back.
 
+mod batch;
 mod constants;
 mod map;
 mod polish;
 mod roots;
 mod schottky;
 
+pub use batch::{kotter_batch, KotterBatch};
 pub use constants::{
     constants_from_h, kotter_constants, l_from_xi_eta, l_p, xi_eta, Coefficients23,
     KotterConstants, NEAR_SINGULAR_RTOL, REAL_RTOL, STRUCTURE_RTOL,

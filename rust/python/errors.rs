@@ -15,21 +15,27 @@ create_exception!(
 
 impl From<Error> for PyErr {
     fn from(e: Error) -> PyErr {
-        let msg = e.to_string();
-        // Exhaustive on purpose: a new variant must choose its exception here.
-        match e {
-            Error::NoConvergence { .. } => ConvergenceError::new_err(msg),
-            Error::Interrupted => PyKeyboardInterrupt::new_err(msg),
-            Error::Shape { .. }
-            | Error::NonFinite { .. }
-            | Error::RepeatedA { .. }
-            | Error::NotSymmetric { .. }
-            | Error::ImagNotPositiveDefinite { .. }
-            | Error::RepeatedBranchPoints { .. }
-            | Error::Singular { .. }
-            | Error::InvalidArgument { .. }
-            | Error::NoRealTorus { .. } => PyValueError::new_err(msg),
-        }
+        exception(&e, e.to_string())
+    }
+}
+
+/// The exception of `e` with the message `msg`.
+fn exception(e: &Error, msg: String) -> PyErr {
+    // Exhaustive on purpose: a new variant must choose its exception here.
+    match e {
+        Error::NoConvergence { .. } => ConvergenceError::new_err(msg),
+        Error::Interrupted => PyKeyboardInterrupt::new_err(msg),
+        // A batch row's error: its own exception, the message naming the row.
+        Error::InRow { source, .. } => exception(source, msg),
+        Error::Shape { .. }
+        | Error::NonFinite { .. }
+        | Error::RepeatedA { .. }
+        | Error::NotSymmetric { .. }
+        | Error::ImagNotPositiveDefinite { .. }
+        | Error::RepeatedBranchPoints { .. }
+        | Error::Singular { .. }
+        | Error::InvalidArgument { .. }
+        | Error::NoRealTorus { .. } => PyValueError::new_err(msg),
     }
 }
 

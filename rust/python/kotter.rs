@@ -91,63 +91,12 @@ fn kotter_quartic_py<'py>(
     Ok(stack(res?)?.into_pyarray(py).into_any())
 }
 
-/// A state whose every field is NaN (the rows that failed, with `errors="mask"`).
-fn nan_state() -> PyResult<kotter::KotterState> {
-    let n = C::new(f64::NAN, f64::NAN);
-    let constants = kotter::KotterConstants {
-        a: [f64::NAN; 4],
-        h: [f64::NAN; 4],
-        s: [n; 4],
-        sigma: [n; 4],
-        sqrt_fprime: [n; 4],
-        u: [[n; 3]; 4],
-        v: [[n; 3]; 4],
-        u_lo: [[n; 3]; 4],
-        v_lo: [[n; 3]; 4],
-        delta_det: [[n; 3]; 3],
-        sqrt_d: [n; 3],
-        d: [n; 3],
-        d_lo: [n; 3],
-        alpha: [n; 3],
-        beta: [n; 3],
-        gamma: [n; 3],
-        delta: [n; 3],
-        a_coef: [n; 3],
-        b_coef: [n; 3],
-        abgd39: [n; 4],
-        eps: n,
-        k: n,
-    };
-    // any regular curve: the rows' curves are rebuilt from their (NaN) d_j in Python
-    let curve =
-        crate::curve::KotterCurve::new(C::new(1.0, 1.0), C::new(2.0, 1.0), C::new(3.0, 1.0))?;
-    Ok(kotter::KotterState {
-        constants,
-        l_p: [[n; 3]; 4],
-        xi: [n; 3],
-        eta: [n; 3],
-        curve,
-        p0: n,
-        points: crate::curve::WurzelPoints {
-            z1: n,
-            y1: n,
-            z2: n,
-            y2: n,
-            g: n,
-            eps: [0; 5],
-            residual: f64::NAN,
-            zd1: [n; 5],
-            zd2: [n; 5],
-        },
-    })
-}
-
 /// Kötter's reduction and the uniformization for states `l` of shape (n, 6):
 /// a dict of arrays with leading axis n (see `manakov.kotter`), and `ok`, the
-/// rows that succeeded. With `l0`, every row is mapped with the constants of
-/// `l0`'s level set (`kotter::kotter_along`); otherwise each row with its own
-/// (`kotter::kotter`). `mask = false`: the first failing row raises, its
-/// index in the message; `mask = true`: failing rows are NaN and `ok` false.
+/// rows that succeeded (`kotter::kotter_batch`: with `l0`, every row mapped
+/// with the constants of `l0`'s level set; `mask = false`: the first failing
+/// row raises, its index in the message; `mask = true`: failing rows are NaN
+/// and `ok` false).
 #[pyfunction(name = "kotter_batch", signature = (a, l, l0=None, mask=false))]
 fn kotter_batch_py<'py>(
     py: Python<'py>,
@@ -162,117 +111,52 @@ fn kotter_batch_py<'py>(
         Some(v) => Some(array1(&v, "l0")?),
         None => None,
     };
-    let n = rows.len();
-    let all: Result<Vec<Result<kotter::KotterState, Error>>, Error> = py.detach(|| match l0 {
-        Some(l0) => {
-            let constants = kotter::kotter_constants(&a, &l0)?;
-            Ok(kotter::kotter_along(&constants, &rows))
-        }
-        None => Ok(rows.iter().map(|r| kotter::kotter(&a, r)).collect()),
-    });
-    let all = all?;
-    let mut ok = Vec::with_capacity(n);
-    let mut res = Vec::with_capacity(n);
-    for (i, r) in all.into_iter().enumerate() {
-        match r {
-            Ok(st) => {
-                ok.push(true);
-                res.push(st);
-            }
-            Err(e) if mask => {
-                let _ = e;
-                ok.push(false);
-                res.push(nan_state()?);
-            }
-            Err(e) => {
-                let err: PyErr = e.into();
-                if n == 1 {
-                    return Err(err);
-                }
-                let msg = format!("row {i} of {n}: {}", err.value(py));
-                return Err(PyErr::from_type(err.get_type(py), msg));
-            }
-        }
-    }
+    let b = py.detach(|| kotter::kotter_batch(&a, &rows, l0.as_ref(), mask))?;
+    let n = b.n;
     let dict = PyDict::new(py);
-    let c2 = |f: &dyn Fn(&kotter::KotterState) -> Vec<C>, m: usize| -> PyResult<Array2<C>> {
-        let v: Vec<C> = res.iter().flat_map(f).collect();
-        Array2::from_shape_vec((n, m), v).map_err(out_shape_err)
-    };
-    let c1 = |f: &dyn Fn(&kotter::KotterState) -> C| -> Array1<C> { res.iter().map(f).collect() };
-    let k = |st: &kotter::KotterState| st.constants.clone();
-    dict.set_item("h", {
-        let v: Vec<f64> = res.iter().flat_map(|st| st.constants.h).collect();
-        Array2::from_shape_vec((n, 4), v)
+    let two = |v: Vec<C>, m: usize| -> PyResult<Bound<'py, PyAny>> {
+        Ok(Array2::from_shape_vec((n, m), v)
             .map_err(out_shape_err)?
             .into_pyarray(py)
-    })?;
-    dict.set_item("s", c2(&|st| k(st).s.to_vec(), 4)?.into_pyarray(py))?;
-    dict.set_item("sigma", c2(&|st| k(st).sigma.to_vec(), 4)?.into_pyarray(py))?;
-    dict.set_item(
-        "sqrt_fprime",
-        c2(&|st| k(st).sqrt_fprime.to_vec(), 4)?.into_pyarray(py),
-    )?;
-    let lp: Vec<C> = res.iter().flat_map(|st| st.l_p.concat()).collect();
-    dict.set_item(
-        "l_p",
-        Array3::from_shape_vec((n, 4, 3), lp)
+            .into_any())
+    };
+    let three = |v: Vec<C>, m: usize, k: usize| -> PyResult<Bound<'py, PyAny>> {
+        Ok(Array3::from_shape_vec((n, m, k), v)
             .map_err(out_shape_err)?
-            .into_pyarray(py),
-    )?;
-    let dd: Vec<C> = res
-        .iter()
-        .flat_map(|st| st.constants.delta_det.concat())
-        .collect();
-    dict.set_item(
-        "Delta",
-        Array3::from_shape_vec((n, 3, 3), dd)
-            .map_err(out_shape_err)?
-            .into_pyarray(py),
-    )?;
-    dict.set_item("xi", c2(&|st| st.xi.to_vec(), 3)?.into_pyarray(py))?;
-    dict.set_item("eta", c2(&|st| st.eta.to_vec(), 3)?.into_pyarray(py))?;
-    dict.set_item(
-        "sqrt_d",
-        c2(&|st| k(st).sqrt_d.to_vec(), 3)?.into_pyarray(py),
-    )?;
-    dict.set_item("d", c2(&|st| k(st).d.to_vec(), 3)?.into_pyarray(py))?;
-    dict.set_item("alpha", c2(&|st| k(st).alpha.to_vec(), 3)?.into_pyarray(py))?;
-    dict.set_item("beta", c2(&|st| k(st).beta.to_vec(), 3)?.into_pyarray(py))?;
-    dict.set_item("gamma", c2(&|st| k(st).gamma.to_vec(), 3)?.into_pyarray(py))?;
-    dict.set_item("delta", c2(&|st| k(st).delta.to_vec(), 3)?.into_pyarray(py))?;
-    dict.set_item("A", c2(&|st| k(st).a_coef.to_vec(), 3)?.into_pyarray(py))?;
-    dict.set_item("B", c2(&|st| k(st).b_coef.to_vec(), 3)?.into_pyarray(py))?;
-    dict.set_item(
-        "abgd39",
-        c2(&|st| k(st).abgd39.to_vec(), 4)?.into_pyarray(py),
-    )?;
-    dict.set_item("eps", c1(&|st| st.constants.eps).into_pyarray(py))?;
-    dict.set_item("K", c1(&|st| st.constants.k).into_pyarray(py))?;
-    dict.set_item("P0", c1(&|st| st.p0).into_pyarray(py))?;
-    dict.set_item("g", c1(&|st| st.points.g).into_pyarray(py))?;
-    dict.set_item("z1", c1(&|st| st.points.z1).into_pyarray(py))?;
-    dict.set_item("y1", c1(&|st| st.points.y1).into_pyarray(py))?;
-    dict.set_item("z2", c1(&|st| st.points.z2).into_pyarray(py))?;
-    dict.set_item("y2", c1(&|st| st.points.y2).into_pyarray(py))?;
-    let zd: Vec<C> = res
-        .iter()
-        .flat_map(|st| [st.points.zd1, st.points.zd2].concat())
-        .collect();
-    dict.set_item(
-        "zd",
-        Array3::from_shape_vec((n, 2, 5), zd)
-            .map_err(out_shape_err)?
-            .into_pyarray(py),
-    )?;
-    let br: Vec<i8> = res.iter().flat_map(|st| st.points.eps).collect();
-    dict.set_item(
-        "branch",
-        Array2::from_shape_vec((n, 5), br)
-            .map_err(out_shape_err)?
-            .into_pyarray(py),
-    )?;
-    dict.set_item("ok", Array1::from_vec(ok).into_pyarray(py))?;
+            .into_pyarray(py)
+            .into_any())
+    };
+    let one = |v: Vec<C>| Array1::from_vec(v).into_pyarray(py).into_any();
+    let h = Array2::from_shape_vec((n, 4), b.h).map_err(out_shape_err)?;
+    dict.set_item("h", h.into_pyarray(py))?;
+    dict.set_item("s", two(b.s, 4)?)?;
+    dict.set_item("sigma", two(b.sigma, 4)?)?;
+    dict.set_item("sqrt_fprime", two(b.sqrt_fprime, 4)?)?;
+    dict.set_item("l_p", three(b.l_p, 4, 3)?)?;
+    dict.set_item("Delta", three(b.delta_det, 3, 3)?)?;
+    dict.set_item("xi", two(b.xi, 3)?)?;
+    dict.set_item("eta", two(b.eta, 3)?)?;
+    dict.set_item("sqrt_d", two(b.sqrt_d, 3)?)?;
+    dict.set_item("d", two(b.d, 3)?)?;
+    dict.set_item("alpha", two(b.alpha, 3)?)?;
+    dict.set_item("beta", two(b.beta, 3)?)?;
+    dict.set_item("gamma", two(b.gamma, 3)?)?;
+    dict.set_item("delta", two(b.delta, 3)?)?;
+    dict.set_item("A", two(b.a_coef, 3)?)?;
+    dict.set_item("B", two(b.b_coef, 3)?)?;
+    dict.set_item("abgd39", two(b.abgd39, 4)?)?;
+    dict.set_item("eps", one(b.eps))?;
+    dict.set_item("K", one(b.k))?;
+    dict.set_item("P0", one(b.p0))?;
+    dict.set_item("g", one(b.g))?;
+    dict.set_item("z1", one(b.z1))?;
+    dict.set_item("y1", one(b.y1))?;
+    dict.set_item("z2", one(b.z2))?;
+    dict.set_item("y2", one(b.y2))?;
+    dict.set_item("zd", three(b.zd, 2, 5)?)?;
+    let br = Array2::from_shape_vec((n, 5), b.branch).map_err(out_shape_err)?;
+    dict.set_item("branch", br.into_pyarray(py))?;
+    dict.set_item("ok", Array1::from_vec(b.ok).into_pyarray(py))?;
     Ok(dict)
 }
 

@@ -307,7 +307,10 @@ fn status_codes_and_names_agree() {
         assert_eq!(*s as usize, code);
         assert_eq!(s.name(), STATUS_NAMES[code]);
     }
-    assert_eq!(Status::InconsistentQuotients.name(), "inconsistent quotients");
+    assert_eq!(
+        Status::InconsistentQuotients.name(),
+        "inconsistent quotients"
+    );
 }
 
 #[test]
