@@ -117,6 +117,20 @@ pub struct Options {
 }
 
 impl Options {
+    /// The options of the method named `method` ([`Method::from_name`]),
+    /// checked ([`Options::validate`]).
+    pub fn parse(method: &str, dt: f64, rtol: f64, atol: f64, max_steps: u64) -> Result<Options> {
+        let o = Options {
+            method: Method::from_name(method)?,
+            dt,
+            rtol,
+            atol,
+            max_steps,
+        };
+        o.validate()?;
+        Ok(o)
+    }
+
     /// Checks `dt`, `rtol`, `atol`, `max_steps`.
     pub fn validate(&self) -> Result<()> {
         if self.max_steps == 0 || self.max_steps as f64 > MAX_STEPS {

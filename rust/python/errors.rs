@@ -41,8 +41,7 @@ fn exception(e: &Error, msg: String) -> PyErr {
 
 /// A cancellation token for a call that runs with the GIL released: it runs
 /// Python's signal handlers (so Ctrl-C is seen) from the calling thread, at
-/// most every `cancel::POLL_INTERVAL`.
-#[allow(dead_code)] // used by the integrate and theta bindings as they adopt it
+/// most every `numeric::cancel::POLL_INTERVAL`.
 pub fn py_cancel() -> crate::numeric::cancel::Cancel {
     crate::numeric::cancel::Cancel::with_poll(|| {
         pyo3::Python::attach(|py| py.check_signals().is_err())

@@ -10,6 +10,7 @@ use pyo3::prelude::*;
 mod arrays;
 mod curve;
 mod errors;
+mod integrate;
 mod kotter;
 mod riemann;
 mod so4;
@@ -28,6 +29,7 @@ mod _core {
     fn init(m: &Bound<'_, PyModule>) -> PyResult<()> {
         m.add("__version__", env!("CARGO_PKG_VERSION"))?;
         so4::register(m)?;
+        integrate::register(m)?;
         theta::register(m)?;
         kotter::register(m)?;
         curve::register(m)?;

@@ -8,26 +8,12 @@ use pyo3::prelude::*;
 
 use super::arrays::{out_shape_err, shape_err, vec1};
 use super::errors::py_cancel;
-use crate::error::Error;
-use crate::riemann::HyperellipticCurve;
+use crate::riemann::{AbelRoute, HyperellipticCurve};
 
 type C = Complex64;
 
-/// Points per chunk between cancellation checks (~2 ms of Abel integrals).
-const CHUNK: usize = 1024;
-
 fn matrix_to_array(m: &nalgebra::DMatrix<C>) -> Array2<C> {
     Array2::from_shape_fn((m.nrows(), m.ncols()), |(i, j)| m[(i, j)])
-}
-
-fn finite(what: &'static str, v: &[C]) -> Result<(), Error> {
-    match v
-        .iter()
-        .position(|z| !(z.re.is_finite() && z.im.is_finite()))
-    {
-        Some(index) => Err(Error::NonFinite { what, index }),
-        None => Ok(()),
-    }
 }
 
 /// A hyperelliptic curve with its homology basis, periods and Abel map.
@@ -106,8 +92,7 @@ impl HyperellipticCore {
         sheet: i8,
     ) -> PyResult<Bound<'py, PyArray1<C>>> {
         let xs = vec1(&x, "x", None)?;
-        finite("x", &xs)?;
-        let out: Vec<C> = py.detach(|| xs.iter().map(|&v| self.curve.y(v, sheet)).collect());
+        let out = py.detach(|| self.curve.y_many(&xs, sheet))?;
         Ok(Array1::from(out).into_pyarray(py))
     }
 
@@ -123,28 +108,14 @@ impl HyperellipticCore {
     ) -> PyResult<Bound<'py, PyArray2<C>>> {
         let xs = vec1(&x, "x", None)?;
         let ys = vec1(&y, "y", Some(xs.len()))?;
-        let g = self.curve.genus();
-        let n = xs.len();
+        let (g, n) = (self.curve.genus(), xs.len());
+        let route = match route {
+            None => AbelRoute::Best,
+            Some(r) if r < 0 => AbelRoute::Infinity,
+            Some(k) => AbelRoute::Branch(k as usize),
+        };
         let cancel = py_cancel();
-        let out = py.detach(|| -> Result<Vec<C>, Error> {
-            let mut out = vec![C::new(0.0, 0.0); n * g];
-            for (k, chunk) in out.chunks_mut(CHUNK * g).enumerate() {
-                cancel.check()?;
-                let lo = k * CHUNK;
-                let hi = (lo + CHUNK).min(n);
-                match route {
-                    None => self.curve.abel_batch(&xs[lo..hi], &ys[lo..hi], chunk)?,
-                    Some(r) => {
-                        let rr = if r < 0 { None } else { Some(r as usize) };
-                        for i in lo..hi {
-                            let u = self.curve.abel_via(xs[i], ys[i], rr)?;
-                            chunk[(i - lo) * g..(i - lo + 1) * g].copy_from_slice(&u);
-                        }
-                    }
-                }
-            }
-            Ok(out)
-        })?;
+        let out = py.detach(|| self.curve.abel_many(&xs, &ys, route, &cancel))?;
         Ok(Array2::from_shape_vec((n, g), out)
             .map_err(out_shape_err)?
             .into_pyarray(py))
@@ -161,19 +132,9 @@ impl HyperellipticCore {
     ) -> PyResult<Bound<'py, PyArray2<C>>> {
         let dxs = vec1(&dx, "dx", None)?;
         let ys = vec1(&y, "y", Some(dxs.len()))?;
-        let g = self.curve.genus();
-        let n = dxs.len();
+        let (g, n) = (self.curve.genus(), dxs.len());
         let cancel = py_cancel();
-        let out = py.detach(|| -> Result<Vec<C>, Error> {
-            let mut out = Vec::with_capacity(n * g);
-            for (i, (&d, &w)) in dxs.iter().zip(&ys).enumerate() {
-                if i % CHUNK == 0 {
-                    cancel.check()?;
-                }
-                out.extend(self.curve.abel_near_branch(k, d, w)?);
-            }
-            Ok(out)
-        })?;
+        let out = py.detach(|| self.curve.abel_near_branch_many(k, &dxs, &ys, &cancel))?;
         Ok(Array2::from_shape_vec((n, g), out)
             .map_err(out_shape_err)?
             .into_pyarray(py))
@@ -229,8 +190,7 @@ impl HyperellipticCore {
             return Err(shape_err("z", format!("(N, {g})"), v.shape()));
         }
         let flat: Vec<C> = v.iter().copied().collect();
-        finite("z", &flat)?;
-        let out: Vec<C> = flat.chunks(g).flat_map(|r| self.curve.reduce(r)).collect();
+        let out = self.curve.reduce_many(&flat)?;
         Ok(Array2::from_shape_vec((v.nrows(), g), out)
             .map_err(out_shape_err)?
             .into_pyarray(py))
@@ -251,19 +211,7 @@ impl HyperellipticCore {
         let flat: Vec<C> = v.iter().copied().collect();
         let n = v.nrows();
         let cancel = py_cancel();
-        let (xs, ys) = py.detach(|| -> Result<(Vec<C>, Vec<C>), Error> {
-            let mut xs = Vec::with_capacity(2 * n);
-            let mut ys = Vec::with_capacity(2 * n);
-            for (i, row) in flat.chunks(g).enumerate() {
-                if i % 256 == 0 {
-                    cancel.check()?;
-                }
-                let [(x1, y1), (x2, y2)] = self.curve.invert(row)?;
-                xs.extend([x1, x2]);
-                ys.extend([y1, y2]);
-            }
-            Ok((xs, ys))
-        })?;
+        let (xs, ys) = py.detach(|| self.curve.invert_many(&flat, &cancel))?;
         Ok((
             Array2::from_shape_vec((n, 2), xs)
                 .map_err(out_shape_err)?

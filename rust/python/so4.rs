@@ -1,23 +1,21 @@
-//! Bindings for `crate::so4` and `crate::integrate`.
+//! Bindings for `crate::so4`.
 
 use numpy::ndarray::{Array2, Array3};
 use numpy::{IntoPyArray, PyArray1, PyArray2, PyArray3, PyReadonlyArray1, PyReadonlyArray2};
 use pyo3::prelude::*;
 
 use super::arrays::{array1, out_shape_err, rows, stack, vec1};
-use super::errors::py_cancel;
 use crate::error::Error;
-use crate::integrate::{self, Method, Options};
 use crate::so4::{self, FrahmTop};
 
 /// Copies a read-only 2-d array (any strides) into a row-major Vec with its shape.
-fn vec2(x: &PyReadonlyArray2<'_, f64>) -> (Vec<f64>, usize, usize) {
+pub(super) fn vec2(x: &PyReadonlyArray2<'_, f64>) -> (Vec<f64>, usize, usize) {
     let v = x.as_array();
     let (r, c) = v.dim();
     (v.iter().copied().collect(), r, c)
 }
 
-fn top_from_c(c: &PyReadonlyArray2<'_, f64>) -> Result<FrahmTop, Error> {
+pub(super) fn top_from_c(c: &PyReadonlyArray2<'_, f64>) -> Result<FrahmTop, Error> {
     let (cv, r, k) = vec2(c);
     if r != k {
         return Err(Error::Shape {
@@ -29,7 +27,7 @@ fn top_from_c(c: &PyReadonlyArray2<'_, f64>) -> Result<FrahmTop, Error> {
     FrahmTop::new(r, &cv)
 }
 
-fn check_states(what: &'static str, cols: usize, m: usize) -> Result<(), Error> {
+pub(super) fn check_states(what: &'static str, cols: usize, m: usize) -> Result<(), Error> {
     if cols != m {
         return Err(Error::Shape {
             what,
@@ -165,131 +163,6 @@ fn poisson_tensor_py<'py>(
         .into_pyarray(py))
 }
 
-fn options(method: &str, dt: f64, rtol: f64, atol: f64, max_steps: u64) -> Result<Options, Error> {
-    let o = Options {
-        method: Method::from_name(method)?,
-        dt,
-        rtol,
-        atol,
-        max_steps,
-    };
-    o.validate()?;
-    Ok(o)
-}
-
-/// The result of `integrate`: `(l (S', m), steps, evals, error)`.
-type IntegrateOut<'py> = (
-    Bound<'py, PyArray2<f64>>,
-    u64,
-    u64,
-    Option<Bound<'py, PyAny>>,
-);
-
-/// Integrates (1) from l0 at t0, sampling at `times`; returns `(l (S', m), steps,
-/// evals, error)`: on a failure or Ctrl-C after the run started, `error` is the
-/// exception to raise (not raised here) and `l` holds the `S' < S` samples reached.
-/// Interruptible: Python's signal handlers run every `cancel::POLL_INTERVAL`.
-#[pyfunction(name = "integrate")]
-#[pyo3(signature = (c, l0, t0, times, method, dt, rtol, atol, max_steps))]
-#[allow(clippy::too_many_arguments)]
-fn integrate_py<'py>(
-    py: Python<'py>,
-    c: PyReadonlyArray2<'py, f64>,
-    l0: PyReadonlyArray1<'py, f64>,
-    t0: f64,
-    times: PyReadonlyArray1<'py, f64>,
-    method: &str,
-    dt: f64,
-    rtol: f64,
-    atol: f64,
-    max_steps: u64,
-) -> PyResult<IntegrateOut<'py>> {
-    let top = top_from_c(&c)?;
-    let (l0, times) = (vec1(&l0, "l0", None)?, vec1(&times, "times", None)?);
-    let opts = options(method, dt, rtol, atol, max_steps)?;
-    let cancel = py_cancel();
-    let (tr, res) =
-        py.detach(|| integrate::integrate_partial(&top, &l0, t0, &times, &opts, &cancel))?;
-    let m = top.dim();
-    let y = Array2::from_shape_vec((tr.t.len(), m), tr.y)
-        .map_err(out_shape_err)?
-        .into_pyarray(py);
-    let err = res
-        .err()
-        .map(|e| PyErr::from(e).into_value(py).into_any().into_bound(py));
-    Ok((y, tr.steps, tr.evals, err))
-}
-
-/// Integrates a batch (B, m) of initial states; returns (l (B, S, m), steps).
-#[pyfunction(name = "integrate_many")]
-#[pyo3(signature = (c, l0s, t0, times, method, dt, rtol, atol, max_steps, parallel))]
-#[allow(clippy::too_many_arguments)]
-fn integrate_many_py<'py>(
-    py: Python<'py>,
-    c: PyReadonlyArray2<'py, f64>,
-    l0s: PyReadonlyArray2<'py, f64>,
-    t0: f64,
-    times: PyReadonlyArray1<'py, f64>,
-    method: &str,
-    dt: f64,
-    rtol: f64,
-    atol: f64,
-    max_steps: u64,
-    parallel: bool,
-) -> PyResult<(Bound<'py, PyArray3<f64>>, u64)> {
-    let top = top_from_c(&c)?;
-    let (l0s, rows, cols) = vec2(&l0s);
-    check_states("l0s", cols, top.dim())?;
-    let times = vec1(&times, "times", None)?;
-    let opts = options(method, dt, rtol, atol, max_steps)?;
-    let cancel = py_cancel();
-    let (ys, steps) = py.detach(|| {
-        integrate::integrate_many_with(&top, &l0s, t0, &times, &opts, parallel, &cancel)
-    })?;
-    let y = Array3::from_shape_vec((rows, times.len(), cols), ys)
-        .map_err(out_shape_err)?
-        .into_pyarray(py);
-    Ok((y, steps))
-}
-
-/// Refuses, before any work, a run that needs more than `max_steps` steps (ValueError
-/// naming the cause: the sample spacing or dt); see `integrate::check_budget`.
-#[pyfunction(name = "check_budget")]
-fn check_budget_py(
-    method: &str,
-    t0: f64,
-    times: PyReadonlyArray1<'_, f64>,
-    dt: f64,
-    max_steps: u64,
-) -> PyResult<()> {
-    let times = vec1(&times, "times", None)?;
-    integrate::check_sample_times(t0, &times)?;
-    integrate::check_budget(Method::from_name(method)?, t0, &times, dt, max_steps)?;
-    Ok(())
-}
-
-/// `(c, b, mu)` as numpy arrays.
-type Tableau<'py> = (
-    Bound<'py, PyArray1<f64>>,
-    Bound<'py, PyArray1<f64>>,
-    Bound<'py, PyArray2<f64>>,
-);
-
-/// The Gauss tableau (c, b, mu) of a Gauss method, mu_ij = a_ij / b_j.
-#[pyfunction(name = "gauss_tableau")]
-fn gauss_tableau_py<'py>(py: Python<'py>, method: &str) -> PyResult<Tableau<'py>> {
-    let m = Method::from_name(method)?;
-    let (c, b, mu) = m.gauss_tableau().ok_or_else(|| Error::InvalidArgument {
-        what: "method",
-        reason: format!("{method:?} is not a Gauss method"),
-    })?;
-    let s = b.len();
-    let mu = Array2::from_shape_vec((s, s), mu)
-        .map_err(out_shape_err)?
-        .into_pyarray(py);
-    Ok((c.to_vec().into_pyarray(py), b.to_vec().into_pyarray(py), mu))
-}
-
 /// Adds this module's functions to `manakov._core`.
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(manakov_c_py, m)?)?;
@@ -300,9 +173,5 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(manakov_integral_labels_py, m)?)?;
     m.add_function(wrap_pyfunction!(manakov_integrals_py, m)?)?;
     m.add_function(wrap_pyfunction!(poisson_tensor_py, m)?)?;
-    m.add_function(wrap_pyfunction!(integrate_py, m)?)?;
-    m.add_function(wrap_pyfunction!(integrate_many_py, m)?)?;
-    m.add_function(wrap_pyfunction!(gauss_tableau_py, m)?)?;
-    m.add_function(wrap_pyfunction!(check_budget_py, m)?)?;
     Ok(())
 }

@@ -11,7 +11,7 @@ use pyo3::prelude::*;
 use super::errors::py_cancel;
 
 use crate::error::Error;
-use crate::theta::{apply_scale, ThetaPlan, MAX_GENUS};
+use crate::theta::{ThetaPlan, MAX_GENUS};
 
 type Jet<'py> = (
     Bound<'py, PyArray2<Complex64>>,
@@ -86,29 +86,7 @@ fn theta_jet_py<'py>(
     // Invalid tau or tol is reported before a large batch is allocated.
     let plan = ThetaPlan::new(&tau_v, g, tol, order)?.with_parallel(parallel);
     let n = 1usize << (2 * g);
-    let (gd, hd) = match order {
-        0 => (0, 0),
-        1 => (g, 0),
-        _ => (g, g),
-    };
-    // Sizes are checked before anything is allocated or copied: a batch too large
-    // for memory is a MemoryError (numpy's own, from the allocation below), one
-    // too large to address a ValueError; never an abort or a panic.
-    let per_point = n * (1 + gd + gd * hd); // values, gradient, Hessian entries
-    let entries = npts.checked_mul(per_point).filter(|&e| {
-        e.checked_mul(std::mem::size_of::<Complex64>())
-            .is_some_and(|b| b <= isize::MAX as usize)
-    });
-    if entries.is_none() {
-        return Err(Error::InvalidArgument {
-            what: "z",
-            reason: format!(
-                "{npts} points of genus {g} need {npts} x {per_point} complex outputs: \
-                 more than the address space"
-            ),
-        }
-        .into());
-    }
+    let (gd, hd) = plan.batch_widths(npts)?;
     // The values and L are written straight into numpy-allocated arrays: numpy
     // asks for huge pages for large arrays, which saves most of the page faults
     // of first touching a fresh 256-bytes-per-point output (measured: a one-core
@@ -133,12 +111,15 @@ fn theta_jet_py<'py>(
     let (values, logs) = unsafe { (values_arr.as_slice_mut()?, logs_arr.as_slice_mut()?) };
     let cancel = py_cancel();
     let out = py.detach(move || -> Result<_, Error> {
-        let finite = if scaled && order == 0 {
-            plan.eval_batch_scaled_cancel(&z_flat, values, logs, &cancel)?
-        } else {
-            plan.eval_batch_cancel(&z_flat, values, &mut gradient, &mut hessian, logs, &cancel)?;
-            !scaled || apply_scale(values, &mut gradient, &mut hessian, logs)
-        };
+        let finite = plan.eval_batch_jet(
+            &z_flat,
+            values,
+            &mut gradient,
+            &mut hessian,
+            logs,
+            scaled,
+            &cancel,
+        )?;
         Ok((gradient, hessian, finite))
     })?;
     let (gradient, hessian, finite) = out;

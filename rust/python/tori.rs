@@ -6,7 +6,6 @@ use pyo3::prelude::*;
 
 use super::arrays::{array1, rows, stack};
 use super::errors::py_cancel;
-use crate::error::Error;
 use crate::tori::{self, Char};
 
 type C = Complex64;
@@ -31,16 +30,7 @@ fn real_torus_py<'py>(
     let u: [C; 2] = array1(&u, "U")?;
     let u2: [C; 2] = array1(&u2, "U2")?;
     let chars: Vec<Char> = rows(&chars, "characteristics", None)?;
-    if let Some(bad) = chars.iter().flatten().find(|&&v| v > 1) {
-        return Err(Error::InvalidArgument {
-            what: "characteristics",
-            reason: format!("entries must be 0 or 1, got {bad}"),
-        }
-        .into());
-    }
-    let torus = py
-        .detach(|| tori::real_torus(&tau, &u, &u2, &chars))
-        .map_err(Error::from)?;
+    let torus = py.detach(|| tori::real_torus_checked(&tau, &u, &u2, &chars))?;
     Ok((
         stack(torus.lambda)?.into_pyarray(py),
         stack(torus.coords)?.into_pyarray(py),
@@ -61,19 +51,9 @@ fn frequency_map_py<'py>(
 ) -> PyResult<(Bound<'py, PyArray2<f64>>, Bound<'py, PyArray1<u8>>)> {
     let a: [f64; 4] = array1(&a, "a")?;
     let b: [f64; 4] = array1(&b, "b")?;
-    crate::error::check_finite("a", &a)?;
-    crate::error::check_finite("b", &b)?;
-    // The top itself must be valid (distinct a_i): an argument error, not a status.
-    crate::so4::manakov_c(&a, &b)?;
     let ls: Vec<[f64; 6]> = rows(&states, "states", None)?;
     let cancel = py_cancel();
-    let out = py.detach(|| {
-        tori::map_states(
-            &ls,
-            |l0| tori::solve::state_frequencies(&a, &b, l0),
-            &cancel,
-        )
-    })?;
+    let out = py.detach(|| tori::solve::frequency_map(&a, &b, &ls, &cancel))?;
     let nu = stack(out.iter().map(|e| e.nu))?;
     let status: Vec<u8> = out.iter().map(|e| e.status as u8).collect();
     Ok((nu.into_pyarray(py), Array1::from(status).into_pyarray(py)))

@@ -43,9 +43,11 @@ pub mod quad;
 mod abel;
 mod constant;
 mod invert;
+mod many;
 mod periods;
 
 pub use invert::INVERT_MAX_RESIDUAL;
+pub use many::AbelRoute;
 
 #[cfg(test)]
 mod tests;

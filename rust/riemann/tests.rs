@@ -232,3 +232,67 @@ fn abel_near_a_branch_point_keeps_the_local_parameter() {
         }
     }
 }
+
+/// The batch entry points: the routes of `abel_many` are those of `abel` and
+/// `abel_via` point by point, `invert_many` inverts them, non-finite input is
+/// named, and a cancelled token stops the batch.
+#[test]
+fn batches_follow_the_point_by_point_maps() {
+    use crate::numeric::cancel::Cancel;
+    let e = [
+        c(0.1, 0.2),
+        c(1.3, -0.4),
+        c(-0.7, 0.9),
+        c(2.1, 0.5),
+        c(-1.5, -1.1),
+    ];
+    let h = HyperellipticCurve::new(&e).unwrap();
+    let x = [c(0.4, 0.3), c(-0.2, -0.8), c(1.7, 1.1)];
+    let y = h.y_many(&x, 1).unwrap();
+    assert_eq!(y, x.map(|v| h.y(v, 1)));
+    let never = Cancel::never();
+    let best = h.abel_many(&x, &y, AbelRoute::Best, &never).unwrap();
+    let inf = h.abel_many(&x, &y, AbelRoute::Infinity, &never).unwrap();
+    let br = h.abel_many(&x, &y, AbelRoute::Branch(2), &never).unwrap();
+    for i in 0..3 {
+        assert_eq!(best[2 * i..2 * i + 2], h.abel(x[i], y[i]).unwrap()[..]);
+        assert_eq!(
+            inf[2 * i..2 * i + 2],
+            h.abel_via(x[i], y[i], None).unwrap()[..]
+        );
+        assert_eq!(
+            br[2 * i..2 * i + 2],
+            h.abel_via(x[i], y[i], Some(2)).unwrap()[..]
+        );
+    }
+    // u(P1) + u(P2) back to the pair (in either order).
+    let u: Vec<C> = (0..2).map(|k| best[k] + best[2 + k]).collect();
+    let (xs, _) = h.invert_many(&u, &never).unwrap();
+    let hit = |z: C| xs.iter().any(|w| (w - z).norm() < 1e-9);
+    assert!(hit(x[0]) && hit(x[1]), "{xs:?}");
+    assert_eq!(
+        h.reduce_many(&[c(0.0, 0.0), c(f64::NAN, 0.0)]),
+        Err(Error::NonFinite {
+            what: "z",
+            index: 1
+        })
+    );
+    assert!(matches!(
+        h.y_many(&[c(f64::INFINITY, 0.0)], 1),
+        Err(Error::NonFinite { what: "x", .. })
+    ));
+    assert!(matches!(
+        h.abel_many(&x, &y[..2], AbelRoute::Best, &never),
+        Err(Error::Shape { .. })
+    ));
+    let cancelled = Cancel::never();
+    cancelled.cancel();
+    assert_eq!(
+        h.abel_many(&x, &y, AbelRoute::Best, &cancelled),
+        Err(Error::Interrupted)
+    );
+    assert_eq!(
+        h.invert_many(&u, &cancelled).map(|_| ()),
+        Err(Error::Interrupted)
+    );
+}

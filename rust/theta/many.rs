@@ -267,6 +267,59 @@ impl ThetaPlan {
     }
 }
 
+impl ThetaPlan {
+    /// The derivative widths `(gd, hd)` of a batch at the plan's order
+    /// (gradient `(n, 4^g, gd)`, Hessian `(n, 4^g, gd, hd)`), after checking
+    /// that the outputs of `npts` points fit the address space (checked before
+    /// anything is allocated: a batch too large to address is refused, never
+    /// an abort or a panic).
+    pub fn batch_widths(&self, npts: usize) -> Result<(usize, usize)> {
+        let g = self.g;
+        let n = 1usize << (2 * g);
+        let (gd, hd) = match self.order {
+            0 => (0, 0),
+            1 => (g, 0),
+            _ => (g, g),
+        };
+        let per_point = n * (1 + gd + gd * hd); // values, gradient, Hessian entries
+        let entries = npts.checked_mul(per_point).filter(|&e| {
+            e.checked_mul(std::mem::size_of::<Complex64>())
+                .is_some_and(|b| b <= isize::MAX as usize)
+        });
+        if entries.is_none() {
+            return Err(Error::InvalidArgument {
+                what: "z",
+                reason: format!(
+                    "{npts} points of genus {g} need {npts} x {per_point} complex outputs: \
+                     more than the address space"
+                ),
+            });
+        }
+        Ok((gd, hd))
+    }
+
+    /// A batch at the plan's order: normalised values and derivatives, or
+    /// (`scaled`) θ itself, with the scaling fused into the genus-2 kernel for
+    /// values only. Returns `false` if, scaled, some value overflowed.
+    #[allow(clippy::too_many_arguments)]
+    pub fn eval_batch_jet(
+        &self,
+        z: &[Complex64],
+        values: &mut [Complex64],
+        gradient: &mut [Complex64],
+        hessian: &mut [Complex64],
+        log_scale: &mut [f64],
+        scaled: bool,
+        cancel: &Cancel,
+    ) -> Result<bool> {
+        if scaled && self.order == 0 {
+            return self.eval_batch_scaled_cancel(z, values, log_scale, cancel);
+        }
+        self.eval_batch_cancel(z, values, gradient, hessian, log_scale, cancel)?;
+        Ok(!scaled || apply_scale(values, gradient, hessian, log_scale))
+    }
+}
+
 /// Multiplies batch outputs of [`ThetaPlan::eval_batch`] by `exp(L)` in place, giving
 /// θ itself. Returns `false` (leaving the outputs partly scaled) if some value
 /// is not a finite double, i.e. θ overflows.

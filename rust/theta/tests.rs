@@ -777,3 +777,40 @@ fn lattice_coordinates_give_the_thetas_of_the_point() {
         }
     }
 }
+
+/// The batch entry of the binding: the widths of the derivative outputs per
+/// order, a batch too large to address refused before any allocation, and
+/// `eval_batch_jet` the same values as the per-point path (scaled: times exp(L)).
+#[test]
+fn batch_jet_widths_and_values() {
+    let tau = [
+        Complex64::new(0.3, 1.1),
+        Complex64::new(0.1, 0.4),
+        Complex64::new(0.1, 0.4),
+        Complex64::new(-0.2, 1.3),
+    ];
+    for (order, widths) in [(0, (0, 0)), (1, (2, 0)), (2, (2, 2))] {
+        let plan = ThetaPlan::new(&tau, 2, 1e-15, order).unwrap();
+        assert_eq!(plan.batch_widths(10).unwrap(), widths);
+        assert!(matches!(
+            plan.batch_widths(usize::MAX / 8),
+            Err(Error::InvalidArgument { what: "z", .. })
+        ));
+    }
+    let plan = ThetaPlan::new(&tau, 2, 1e-15, 0).unwrap();
+    let z = [Complex64::new(0.2, 0.7), Complex64::new(-0.4, 1.9)];
+    let (one, l) = plan.theta_all(&z).unwrap();
+    let mut values = vec![Complex64::new(0.0, 0.0); 16];
+    let mut logs = [0.0];
+    let never = crate::numeric::cancel::Cancel::never();
+    let ok = plan
+        .eval_batch_jet(&z, &mut values, &mut [], &mut [], &mut logs, false, &never)
+        .unwrap();
+    assert!(ok);
+    assert_eq!((values.clone(), logs[0]), (one.clone(), l));
+    plan.eval_batch_jet(&z, &mut values, &mut [], &mut [], &mut logs, true, &never)
+        .unwrap();
+    for (v, w) in values.iter().zip(&one) {
+        assert!((v - w * l.exp()).norm() <= 1e-15 * (w * l.exp()).norm());
+    }
+}

@@ -420,6 +420,18 @@ impl Kernel {
     }
 }
 
+/// [`real_torus`] for characteristics given by a caller: entries other than
+/// 0 or 1 are an invalid argument, and the failure an [`Error::NoRealTorus`].
+pub fn real_torus_checked(tau: &Tau, u: &C2, u2: &C2, chars: &[Char]) -> Result<RealTorus> {
+    if let Some(bad) = chars.iter().flatten().find(|&&v| v > 1) {
+        return Err(Error::InvalidArgument {
+            what: "characteristics",
+            reason: format!("entries must be 0 or 1, got {bad}"),
+        });
+    }
+    Ok(real_torus(tau, u, u2, chars)?)
+}
+
 /// Lagrange–Gauss reduction of the pair `(a, b)` (coordinates, real image) in
 /// the metric `g`: afterwards `‖a‖ ≤ ‖b‖` and `|⟨a, b⟩| ≤ ‖a‖²/2`. (Exact
 /// ties, `‖a‖ = ‖b‖`, happen on a set of measure zero of a torus family.)

@@ -21,6 +21,7 @@ use super::{
     frequencies_of_state, real_torus, second_flow_b, Char, FlowData, MapEntry, RealTorus, Status,
 };
 use crate::error::{Error, Result, SingularKind};
+use crate::numeric::cancel::Cancel;
 use crate::so4;
 use crate::solution::velocity::algebraic_rates;
 use crate::solution::{a_periods_of, level_set_curve, Solution};
@@ -135,6 +136,24 @@ pub fn state_frequencies(a: &[f64; 4], b: &[f64; 4], l0: &[f64; 6]) -> MapEntry 
         },
         classify,
     )
+}
+
+/// The frequency map of the top `(a, b)` over `states`: [`state_frequencies`]
+/// of each, in parallel ([`super::map_states`], `cancel` checked between
+/// waves).
+///
+/// Errors: an invalid top (non-finite `a`, `b`, repeated `a_i`: an argument
+/// error, not a status); `Interrupted`.
+pub fn frequency_map(
+    a: &[f64; 4],
+    b: &[f64; 4],
+    states: &[[f64; 6]],
+    cancel: &Cancel,
+) -> Result<Vec<MapEntry>> {
+    crate::error::check_finite("a", a)?;
+    crate::error::check_finite("b", b)?;
+    so4::manakov_c(a, b)?;
+    super::map_states(states, |l0| state_frequencies(a, b, l0), cancel)
 }
 
 /// [`state_frequencies`] through the Theorem's solution ([`flow_data`]):
