@@ -42,7 +42,7 @@ impl HyperellipticCurve {
     }
 
     /// The Abel map of the points `(x_i, y_i)`, row-major `(N, g)`, along
-    /// `route`; `cancel` is checked every [`CHUNK`] points.
+    /// `route`; `cancel` is checked every `CHUNK` points.
     ///
     /// Errors: `x`, `y` of different lengths; those of the Abel map for a point.
     pub fn abel_many(&self, x: &[C], y: &[C], route: AbelRoute, cancel: &Cancel) -> Result<Vec<C>> {
@@ -76,7 +76,7 @@ impl HyperellipticCurve {
     }
 
     /// [`HyperellipticCurve::abel_near_branch`] of the points `(e_k + dx_i, y_i)`,
-    /// row-major `(N, g)`; `cancel` is checked every [`CHUNK`] points.
+    /// row-major `(N, g)`; `cancel` is checked every `CHUNK` points.
     pub fn abel_near_branch_many(
         &self,
         k: usize,
@@ -112,7 +112,7 @@ impl HyperellipticCurve {
 
     /// [`HyperellipticCurve::invert`] of the rows of `u` (row-major `(N, 2)`):
     /// `(x, y)`, each row-major `(N, 2)`; `cancel` is checked every
-    /// [`INVERT_CHUNK`] rows.
+    /// `INVERT_CHUNK` rows.
     pub fn invert_many(&self, u: &[C], cancel: &Cancel) -> Result<(Vec<C>, Vec<C>)> {
         let n = u.len() / self.g.max(1);
         let mut xs = Vec::with_capacity(2 * n);
