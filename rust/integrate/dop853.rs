@@ -13,12 +13,8 @@
 #![allow(clippy::needless_range_loop)]
 #![allow(clippy::excessive_precision)]
 
-use super::explicit::{
-    check_error_norm, next_attempt, scaled, starting_step, too_many_steps, Explicit,
-};
+use super::explicit::{scaled, Control, Explicit};
 use super::VectorField;
-use crate::error::Result;
-use crate::numeric::cancel::Cancel;
 
 /// Nodes `c_i`. The vector field is autonomous, so only the order-condition
 /// tests use them.
@@ -227,126 +223,96 @@ pub(super) const ER: [f64; 12] = [
 
 /// DOP853 stepper with scratch allocated once.
 pub(super) struct Dop853 {
-    m: usize,
+    ctl: Control,
     k: Vec<f64>,
     ytmp: Vec<f64>,
     ynew: Vec<f64>,
-    h: f64,
-    k1_valid: bool,
-    evals: u64,
-    rtol: f64,
-    atol: f64,
 }
 
 impl Dop853 {
     pub(super) fn new(m: usize, h0: f64, rtol: f64, atol: f64) -> Self {
         Dop853 {
-            m,
+            ctl: Control::new(m, h0, rtol, atol),
             k: vec![0.0; 12 * m],
             ytmp: vec![0.0; m],
             ynew: vec![0.0; m],
-            h: h0,
-            k1_valid: false,
-            evals: 0,
-            rtol,
-            atol,
         }
     }
 }
 
 impl Explicit for Dop853 {
-    /// Advances `y` from `t` to exactly `t_target`; returns the number of accepted steps,
-    /// failing once more than `budget` are needed.
-    fn advance<F: VectorField>(
-        &mut self,
-        f: &F,
-        y: &mut [f64],
-        t: &mut f64,
-        t_target: f64,
-        budget: u64,
-        cancel: &Cancel,
-    ) -> Result<u64> {
-        let m = self.m;
-        let mut steps = 0u64;
-        let mut attempts = 0u32;
-        if !self.k1_valid {
-            f.eval(y, &mut self.k[0..m]);
-            self.evals += 1;
-            self.k1_valid = true;
-        }
-        if self.h == 0.0 {
-            self.h = starting_step(y, &self.k[0..m], self.atol, self.rtol);
-        }
-        while *t < t_target {
-            let (h, last) = next_attempt(
-                "dop853 step size underflow",
-                self.h,
-                *t,
-                t_target,
-                (self.rtol, steps),
-                &mut attempts,
-                cancel,
-            )?;
-            for st in 1..12 {
-                for i in 0..m {
-                    let mut acc = 0.0;
-                    for j in 0..st {
-                        acc += A[st][j] * self.k[j * m + i];
-                    }
-                    self.ytmp[i] = y[i] + h * acc;
-                }
-                let (_, tail) = self.k.split_at_mut(st * m);
-                f.eval(&self.ytmp, &mut tail[..m]);
-            }
-            self.evals += 11;
-            let (mut err5, mut err3) = (0.0f64, 0.0f64);
-            for i in 0..m {
-                let mut bsum = 0.0;
-                let mut e5 = 0.0;
-                for j in 0..12 {
-                    let kj = self.k[j * m + i];
-                    bsum += B[j] * kj;
-                    e5 += ER[j] * kj;
-                }
-                let e3 = bsum
-                    - BHH[0] * self.k[i]
-                    - BHH[1] * self.k[8 * m + i]
-                    - BHH[2] * self.k[11 * m + i];
-                self.ynew[i] = y[i] + h * bsum;
-                let sk = self.atol + self.rtol * y[i].abs().max(self.ynew[i].abs());
-                err5 += scaled(e5, sk).powi(2);
-                err3 += scaled(e3, sk).powi(2);
-            }
-            let deno = if err5 + 0.01 * err3 > 0.0 {
-                err5 + 0.01 * err3
-            } else {
-                1.0
-            };
-            let err = h.abs() * err5 * (1.0 / (m as f64 * deno)).sqrt();
-            check_error_norm("dop853 (state became non-finite)", err, self.rtol, steps)?;
-            // hnew = h / fac, fac = err^(1/8) / 0.9 limited to [1/6, 3] (HNW I, II.4 and dop853).
-            let fac = (err.powf(0.125) / 0.9).clamp(1.0 / 6.0, 3.0);
-            if err <= 1.0 {
-                y.copy_from_slice(&self.ynew);
-                f.eval(y, &mut self.k[0..m]);
-                self.evals += 1;
-                *t = if last { t_target } else { *t + h };
-                steps += 1;
-                if !last {
-                    self.h = h / fac;
-                }
-            } else {
-                self.h = h / fac.max(1.0);
-            }
-            if steps > budget {
-                return Err(too_many_steps(budget));
-            }
-        }
-        Ok(steps)
+    const UNDERFLOW: &'static str = "dop853 step size underflow";
+    const NON_FINITE: &'static str = "dop853 (state became non-finite)";
+
+    fn ctl(&self) -> &Control {
+        &self.ctl
     }
 
-    fn evals(&self) -> u64 {
-        self.evals
+    fn ctl_mut(&mut self) -> &mut Control {
+        &mut self.ctl
+    }
+
+    fn k1(&mut self) -> &mut [f64] {
+        &mut self.k[..self.ctl.m]
+    }
+
+    #[inline(always)]
+    fn attempt<F: VectorField>(&mut self, f: &F, y: &[f64], h: f64) -> f64 {
+        let m = self.ctl.m;
+        let (k, ytmp, ynew) = (&mut self.k[..], &mut self.ytmp[..], &mut self.ynew[..]);
+        for st in 1..12 {
+            for i in 0..m {
+                let mut acc = 0.0;
+                for j in 0..st {
+                    acc += A[st][j] * k[j * m + i];
+                }
+                ytmp[i] = y[i] + h * acc;
+            }
+            let (_, tail) = k.split_at_mut(st * m);
+            f.eval(ytmp, &mut tail[..m]);
+        }
+        self.ctl.evals += 11;
+        let (atol, rtol) = (self.ctl.atol, self.ctl.rtol);
+        let (mut err5, mut err3) = (0.0f64, 0.0f64);
+        for i in 0..m {
+            let mut bsum = 0.0;
+            let mut e5 = 0.0;
+            for j in 0..12 {
+                let kj = k[j * m + i];
+                bsum += B[j] * kj;
+                e5 += ER[j] * kj;
+            }
+            let e3 = bsum - BHH[0] * k[i] - BHH[1] * k[8 * m + i] - BHH[2] * k[11 * m + i];
+            ynew[i] = y[i] + h * bsum;
+            let sk = atol + rtol * y[i].abs().max(ynew[i].abs());
+            err5 += scaled(e5, sk).powi(2);
+            err3 += scaled(e3, sk).powi(2);
+        }
+        let deno = if err5 + 0.01 * err3 > 0.0 {
+            err5 + 0.01 * err3
+        } else {
+            1.0
+        };
+        h.abs() * err5 * (1.0 / (m as f64 * deno)).sqrt()
+    }
+
+    #[inline(always)]
+    fn accept<F: VectorField>(&mut self, f: &F, y: &mut [f64]) {
+        let m = self.ctl.m;
+        y.copy_from_slice(&self.ynew);
+        f.eval(y, &mut self.k[0..m]);
+        self.ctl.evals += 1;
+    }
+
+    #[inline(always)]
+    fn next_h(&self, h: f64, err: f64, last: bool, accepted: bool) -> f64 {
+        // hnew = h / fac, fac = err^(1/8) / 0.9 limited to [1/6, 3] (HNW I, II.4 and dop853).
+        let fac = (err.powf(0.125) / 0.9).clamp(1.0 / 6.0, 3.0);
+        match (accepted, last) {
+            (true, false) => h / fac,
+            (true, true) => self.ctl.h,
+            (false, _) => h / fac.max(1.0),
+        }
     }
 }
 

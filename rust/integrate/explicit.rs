@@ -10,6 +10,7 @@ use crate::numeric::tol::min_step;
 
 /// `x / sc` in the error norms, with `0 / 0 = 0`: with `atol = 0` a component that is
 /// exactly zero has scale 0, and it contributes nothing to the norm.
+#[inline(always)]
 pub(super) fn scaled(x: f64, sc: f64) -> f64 {
     if x == 0.0 {
         0.0
@@ -104,10 +105,62 @@ pub(super) fn check_error_norm(what: &'static str, err: f64, rtol: f64, steps: u
     Ok(())
 }
 
-/// An explicit adaptive stepper (dopri5, dop853) with its scratch space.
+/// What an explicit stepper carries between calls: the step size its
+/// controller proposes, the slot `k1 = f(y)` (valid between calls, FSAL), the
+/// evaluation count and the tolerances.
+pub(super) struct Control {
+    pub(super) m: usize,
+    pub(super) h: f64,
+    pub(super) k1_valid: bool,
+    pub(super) evals: u64,
+    pub(super) rtol: f64,
+    pub(super) atol: f64,
+}
+
+impl Control {
+    pub(super) fn new(m: usize, h0: f64, rtol: f64, atol: f64) -> Self {
+        Control {
+            m,
+            h: h0,
+            k1_valid: false,
+            evals: 0,
+            rtol,
+            atol,
+        }
+    }
+}
+
+/// An explicit adaptive stepper (dopri5, dop853) with its scratch space: the
+/// method-specific parts of [`Explicit::advance`].
 pub(super) trait Explicit {
-    /// Advances `y` from `t` to exactly `t_target` with adaptive steps; returns
-    /// the number of accepted steps, failing once more than `budget` are needed.
+    /// The errors' names of a step-size underflow and of a non-finite state.
+    const UNDERFLOW: &'static str;
+    const NON_FINITE: &'static str;
+
+    fn ctl(&self) -> &Control;
+    fn ctl_mut(&mut self) -> &mut Control;
+    /// The stage slot `k1` (length `m`), which holds `f(y)`.
+    fn k1(&mut self) -> &mut [f64];
+
+    /// Computes the stages of a step of size `h` from `y` and the candidate
+    /// new state; returns the error norm of the step.
+    fn attempt<F: VectorField>(&mut self, f: &F, y: &[f64], h: f64) -> f64;
+
+    /// Takes the candidate as the new state `y` (and `k1 = f(y)` with it).
+    fn accept<F: VectorField>(&mut self, f: &F, y: &mut [f64]);
+
+    /// The controller's next step after an attempt of size `h` with error
+    /// `err` (`accepted` when `err ≤ 1`; `last` when `h` was cut to the target).
+    fn next_h(&self, h: f64, err: f64, last: bool, accepted: bool) -> f64;
+
+    /// The vector-field evaluations so far.
+    fn evals(&self) -> u64 {
+        self.ctl().evals
+    }
+
+    /// Advances `y` from `t` to exactly `t_target` with adaptive steps;
+    /// returns the number of accepted steps, failing once more than `budget`
+    /// are needed.
     fn advance<F: VectorField>(
         &mut self,
         f: &F,
@@ -116,8 +169,44 @@ pub(super) trait Explicit {
         t_target: f64,
         budget: u64,
         cancel: &Cancel,
-    ) -> Result<u64>;
-
-    /// The vector-field evaluations so far.
-    fn evals(&self) -> u64;
+    ) -> Result<u64> {
+        let mut steps = 0u64;
+        let mut attempts = 0u32;
+        if !self.ctl().k1_valid {
+            f.eval(y, self.k1());
+            let c = self.ctl_mut();
+            c.evals += 1;
+            c.k1_valid = true;
+        }
+        if self.ctl().h == 0.0 {
+            let (atol, rtol) = (self.ctl().atol, self.ctl().rtol);
+            let h = starting_step(y, self.k1(), atol, rtol);
+            self.ctl_mut().h = h;
+        }
+        while *t < t_target {
+            let rtol = self.ctl().rtol;
+            let (h, last) = next_attempt(
+                Self::UNDERFLOW,
+                self.ctl().h,
+                *t,
+                t_target,
+                (rtol, steps),
+                &mut attempts,
+                cancel,
+            )?;
+            let err = self.attempt(f, y, h);
+            check_error_norm(Self::NON_FINITE, err, rtol, steps)?;
+            let accepted = err <= 1.0;
+            if accepted {
+                self.accept(f, y);
+                *t = if last { t_target } else { *t + h };
+                steps += 1;
+            }
+            self.ctl_mut().h = self.next_h(h, err, last, accepted);
+            if steps > budget {
+                return Err(too_many_steps(budget));
+            }
+        }
+        Ok(steps)
+    }
 }
