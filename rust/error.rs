@@ -45,6 +45,10 @@ pub enum Error {
     },
     /// Any other invalid argument, with the reason.
     InvalidArgument { what: &'static str, reason: String },
+    /// A valid input whose closed-form result could not be built or did not
+    /// pass its own check (`reason` names the step): never returned as a
+    /// result. Python sees `manakov.ClosedFormError`.
+    Unverified { what: &'static str, reason: String },
     /// An iteration did not reach its tolerance.
     NoConvergence {
         what: &'static str,
@@ -150,6 +154,7 @@ impl fmt::Display for Error {
             Error::Singular { what, reason, .. } | Error::InvalidArgument { what, reason } => {
                 write!(f, "invalid {what}: {reason}")
             }
+            Error::Unverified { what, reason } => write!(f, "no trustworthy {what}: {reason}"),
             Error::NoConvergence {
                 what,
                 tol,

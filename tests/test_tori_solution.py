@@ -218,10 +218,11 @@ SINGULAR_STATES = [
         tori.ZERO_STATE,
     ),
     (
+        # in the so(3) block {1, 2, 4}
         [1.0, 0, 0, 0, 0.5, 0],
-        "invalid state l0: h0 = 0e0 vanishes: the branch points d_0 = 0 and d_j coincide "
-        "(F (19) has double roots), the curve (8) degenerates; the solution exists in a "
-        "limiting sense (genus < 2, elementary functions), not as a genus-2 theta quotient",
+        "invalid state l: h0 = 0 and the double roots of F(s) (19), the roots of "
+        "h1 s^2 - h2 s + h3, coincide or lie at an a_j: the reduction degenerates there "
+        "(an equilibrium, an so(3) block or a separatrix)",
         tori.COINCIDING_BRANCH_POINTS,
     ),
     (
@@ -232,10 +233,14 @@ SINGULAR_STATES = [
         tori.SINGULAR_CASIMIRS,
     ),
     (
+        # 1e-12 from the equilibrium l12 E12: the roots of h1 s^2 - h2 s + h3 lie at
+        # a_3, a_4, where the two roots of F of each pair meet
         [1.0, 0, 0, 0, 0, 1e-12],
-        "invalid state l: h0 = 0.000000000001 vanishes: F(s) (19) = (h1 s^2 - h2 s + h3)^2 "
-        "/ h1^2 has double roots and the branch sigma = -(h1 s^2 - h2 s + h3)/(2 h0) is "
-        "undefined",
+        (
+            "invalid state l: F(s) (19) has a repeated root s = 2.0000000",
+            "(|s_",
+            "): l^(p) (20) divides by sqrt(F'(s_p)) = 0",
+        ),
         tori.COINCIDING_BRANCH_POINTS,
     ),
     (

@@ -5,7 +5,7 @@ four-dimensional rigid body around a fixed point: an elementary approach*.
 Equation numbers in docstrings are the paper's.
 """
 
-from ._core import ConvergenceError, __version__
+from ._core import ClosedFormError, ConvergenceError, __version__
 from .curve import CurvePoints, KotterCurve, Wurzel
 from .problems import Problem, benchmark_setup, problem, problem_names
 from .reduction import Kotter, LevelSet, from_kotter, kotter
@@ -38,6 +38,7 @@ __all__ = [
     "char_index",
     "CHARACTERISTICS",
     "characteristics",
+    "ClosedFormError",
     "ConvergenceError",
     "CurvePoints",
     "FrahmTop",

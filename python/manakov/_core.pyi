@@ -6,6 +6,7 @@ from numpy.typing import NDArray
 from typing_extensions import final
 
 __all__ = [
+    "ClosedFormError",
     "ConvergenceError",
     "check_budget",
     "check_c",
@@ -44,6 +45,7 @@ __all__ = [
 __version__: str
 
 class ConvergenceError(RuntimeError): ...
+class ClosedFormError(RuntimeError): ...
 
 # --- riemann (rust/python/riemann.rs) ---
 
@@ -261,6 +263,8 @@ class SolutionCore:
     def constants(self) -> npt.NDArray[np.complex128]: ...
     @property
     def calibration(self) -> npt.NDArray[np.float64]: ...
+    @property
+    def self_check(self) -> float: ...
     def quotient(
         self,
     ) -> tuple[npt.NDArray[np.int64], npt.NDArray[np.complex128], npt.NDArray[np.complex128]]: ...

@@ -269,7 +269,12 @@ class Kotter:
     sqrt_fprime : ndarray (4,) complex
         ``sqrt(F'(s_p))``, principal.
     l_p : ndarray (4, 3) complex
-        ``l^(p) = l(s_p)/sqrt(F'(s_p))`` (20); ``l_p[p-1]`` is ``l^(p)``.
+        ``l^(p) = l(s_p)/sqrt(F'(s_p))`` (20); ``l_p[p-1]`` is ``l^(p)``. At
+        ``h0 = 0``, where ``F'(s_p) = 0``, (20) is normalised by its limit
+        ``sqrt(F'(s_p)/|h0|)`` instead (and ``sqrt_fprime`` is that root): a
+        common factor on ``l^(p)``, ``xi``, ``eta``, ``g`` and on ``alpha .. delta``,
+        ``Delta``, ``K``, ``A``, ``B``, ``abgd39`` that leaves every relation
+        (11)-(42) as it is (each is homogeneous in it); see docs/degenerate.md.
     Delta : ndarray (3, 3) complex
         ``Delta[p-1, j-1] = Delta_j^(p)`` (25), corrected (a determinant).
     xi, eta : ndarray (3,) complex
@@ -423,12 +428,38 @@ def _errors_mask(errors: str) -> bool:
     return errors == "mask"
 
 
+# The core normalises (20) by sqrt(F'(s_p)/|h0|), finite at h0 = 0 where
+# F'(s_p) = 0 (docs/degenerate.md); the fields are reported in the paper's
+# normalisation sqrt(F'(s_p)) wherever h0 != 0: each field is multiplied by
+# sqrt(|h0|) to this power (the relations (11)-(42) are homogeneous in it).
+_PAPER_POWER = {
+    "sqrt_fprime": 1,
+    "l_p": -1,
+    "xi": -1,
+    "eta": -1,
+    "Delta": -2,
+    "alpha": 1,
+    "beta": 1,
+    "gamma": 1,
+    "delta": 1,
+    "A": 2,
+    "B": 2,
+    "abgd39": 2,
+    "K": 2,
+    "g": -1,
+}
+
+
 def _build(
     a: np.ndarray, b: np.ndarray, flat: np.ndarray, shape: tuple[int, ...], raw: Any
 ) -> Kotter:
     fields: dict[str, Any] = {}
+    h0 = np.asarray(raw["h"]).reshape(shape + (4,))[..., 0]
+    w = np.where(h0 == 0, 1.0, np.sqrt(np.abs(h0)))
     for name, fshape in _FIELD_SHAPES.items():
         arr = np.asarray(raw[name]).reshape(shape + fshape)
+        if name in _PAPER_POWER:
+            arr = arr * (w ** _PAPER_POWER[name]).reshape(w.shape + (1,) * len(fshape))
         if arr.ndim == 0:
             arr = arr[()]
         else:

@@ -199,6 +199,19 @@ class Solution:
         return _frozen(self._core.calibration)
 
     @property
+    def self_check(self) -> float:
+        """The largest relative defect found by the solution's own check when it was built.
+
+        At ``t = 0`` and at three points of the torus the quotients (9)–(10) must give
+        a real state with the integrals (6)–(7) of ``l0``, whose velocity along ``U``
+        is Frahm's (1), and ``l(0) = l0``; defects are relative to ``|l0|``, to the
+        largest speed ``|dl/dt|`` met at those points and to the scales of the
+        integrals. A solution is only returned when this is at most 1e-10
+        (correct set-ups leave ~1e-15 … 1e-11).
+        """
+        return float(self._core.self_check)
+
+    @property
     def torus(self) -> Torus:
         """The real torus of the motion (docs/tori.md): a reduced basis ``λ1, λ2``
         of the periods of ``l`` in the real plane of ``U`` and a second

@@ -391,6 +391,14 @@ impl<'a> Fit<'a> {
         rhs: &nalgebra::SVector<Complex64, 6>,
         colscale: &[f64; 3],
     ) -> Option<FitState> {
+        // nalgebra's SVD panics on NaN entries
+        if !jac
+            .iter()
+            .chain(rhs.iter())
+            .all(|v| v.re.is_finite() && v.im.is_finite())
+        {
+            return None;
+        }
         let Ok(step) = jac.svd(true, true).solve(rhs, 1e-14) else {
             return None;
         };

@@ -4,12 +4,12 @@
 //! (23)–(24) and the structure of `H0` on Kötter's quadrics (38)–(40), all
 //! carried in double-double and rounded once (docs/kotter.md §3).
 
+use super::pairs::{self, PAIR_ROUTE_RTOL};
 use super::polish::{polish_root, Level, PolishedRoot};
 use super::roots::{check_repeated, quartic_f_den, quartic_roots};
 use super::{check_a, integrals, l_from_m_n, m_n, C, CYCLIC, ONE, ZERO};
 use crate::error::{check_finite, Error, Result, SingularKind};
 use crate::numeric::dd::Cdd;
-use crate::numeric::tol::REDUCTION_FLOOR_RTOL;
 
 /// Residual (relative to the size of the terms) above which the existence
 /// conditions of (38)–(39) (`Σ c_j q_j = 0`, `Σ c_j (p_j + r_j) = 0`) and the
@@ -115,6 +115,16 @@ pub fn kotter_constants(a: &[f64; 4], l: &[f64; 6]) -> Result<KotterConstants> {
     near_singular(l, constants_impl(a, &h, &p_at_a, Some((m, n))))
 }
 
+/// Below this `|h0|/h1` the constants `ε` and `K` of the corrected (40) are set
+/// to 0, their value at `h0 = 0`. With (20) normalised by `√(F'(s_p)/|h0|)`, `ε`
+/// and `K` vanish like `h0` and their closed forms (sums in DD, relative accuracy
+/// ~1e-32) cancel down to them, leaving an absolute error of ~1e-32/|h0| in `ε`;
+/// at `|h0| = 1e-16 h1` that error and `ε` itself are both ~1e-16 of the scale,
+/// so below it 0 is the more accurate value. Then `h0 = K g² (1 − ε P_0)²` no
+/// longer fixes `g` (its sign is free: the hyperelliptic involution), and the
+/// scale of `g` comes from (30a) alone (docs/degenerate.md, "h0 = 0").
+pub const H0_NEGLIGIBLE_RTOL: f64 = 1e-16;
+
 /// States closer than `NEAR_SINGULAR_RTOL` to the singular set `h1² = 4h0²`,
 /// in the relative distance `δ = (h1² − 4h0²)/h1²` (`= |m − n|²|m + n|²/h1²`),
 /// may raise. Down to it the reduction round-trips at roundoff: all 3000 states
@@ -192,29 +202,24 @@ fn constants_impl(
         None => h[1] * h[1] - 4.0 * h[0] * h[0],
     };
     let f = quartic_f_den(a, h, den)?;
-    if h[0] == 0.0 || h[0].abs() <= REDUCTION_FLOOR_RTOL * h[1] {
-        return Err(Error::Singular {
-            what: "state l",
-            kind: SingularKind::VanishingH0,
-            reason: format!(
-                "h0 = {} vanishes: F(s) (19) = (h1 s^2 - h2 s + h3)^2 / h1^2 has double roots and \
-                 the branch sigma = -(h1 s^2 - h2 s + h3)/(2 h0) is undefined",
-                h[0]
-            ),
-        });
-    }
-    let s0 = quartic_roots(&f)?;
-    let roots = polished_roots(&Level { a, h, mn, den }, p_at_a, &s0);
-    check_repeated(&roots.iter().map(|r| r.s).collect::<Vec<_>>())?;
+    let lv = Level { a, h, mn, den };
+    let (roots, pair) = roots_of_f(&lv, p_at_a, &f)?;
     // Everything below is a function of (s_p, σ_p, F'(s_p)) and is carried in
     // DD, rounded to double once at the end: the third quadric (11) of the
     // rounded constants holds only as well as they are consistent with each
     // other, and near the singular set Δ_j^(3) and the forms u m + v n cancel
     // by about the inverse relative distance to it (docs/kotter.md §3).
-    let (u, v) = coefficients_20(a, &roots)?;
+    let (u, v) = coefficients_20(a, &roots, pair.as_ref())?;
     let dd = delta_determinants(&u, &v);
     let bc = BranchConstants::from_determinants(&u, &v, &dd)?;
-    let kk = k_keps_dd(&bc.abgd_dd, &bc.d_dd);
+    // ε ~ h0 and K ~ |h0| (in the normalisation of (20) by √(F'/|h0|)): below
+    // H0_NEGLIGIBLE_RTOL their DD sums are rounding noise and their true values
+    // below it, so they are 0 (K = 0 marks the case downstream).
+    let kk = if h[0].abs() <= H0_NEGLIGIBLE_RTOL * h[1] {
+        (ZERO, ZERO, ZERO)
+    } else {
+        k_keps_dd(&bc.abgd_dd, &bc.d_dd)
+    };
     let [alpha, beta, gamma, delta] = bc.abgd_dd.map(|row| row.map(Cdd::to_c));
     let (a_coef, b_coef, abgd39, eps, k) = h0_structure(&alpha, &beta, &gamma, &delta, &bc.d, kk)?;
     let round2 = |x: &[[Cdd; 3]; 4]| x.map(|row| row.map(Cdd::to_c));
@@ -245,6 +250,46 @@ fn constants_impl(
     })
 }
 
+/// The four roots of `F` (19), polished, in the documented order: near
+/// `h0 = 0` as pairs on the two branches of `√G` ([`pairs`], with the pair
+/// structure returned), elsewhere (or where the pair route does not apply)
+/// from the quartic.
+fn roots_of_f(
+    lv: &Level,
+    p_at_a: &[f64; 4],
+    f: &[f64; 5],
+) -> Result<(Vec<PolishedRoot>, Option<PairStructure>)> {
+    let h = lv.h;
+    if h[0].abs() <= PAIR_ROUTE_RTOL * h[1] {
+        if let Some((r, partner, side)) = pairs::pair_roots(lv, p_at_a) {
+            return Ok((r.into(), Some(PairStructure { partner, side })));
+        }
+    }
+    if h[0] == 0.0 {
+        return Err(Error::Singular {
+            what: "state l",
+            kind: SingularKind::RepeatedRoot,
+            reason: "h0 = 0 and the double roots of F(s) (19), the roots of h1 s^2 - h2 s + h3, \
+                     coincide or lie at an a_j: the reduction degenerates there (an equilibrium, \
+                     an so(3) block or a separatrix)"
+                .into(),
+        });
+    }
+    let s0 = quartic_roots(f)?;
+    let roots = polished_roots(lv, p_at_a, &s0);
+    check_repeated(&roots.iter().map(|r| r.s).collect::<Vec<_>>())?;
+    Ok((roots, None))
+}
+
+/// What the pair route knows of its roots ([`pairs::pair_roots`]): which is
+/// the exact conjugate partner of the root before it, and the side of the
+/// real axis (`±1`, 0 for real pairs) each member of a conjugate pair comes
+/// from as `h0 → 0`.
+struct PairStructure {
+    partner: [bool; 4],
+    side: [f64; 4],
+}
+
 /// The four roots of `F` polished on their own branches ([`polish_root`]);
 /// the partner of a conjugate pair as the exact conjugate.
 fn polished_roots(lv: &Level, p_at_a: &[f64; 4], s0: &[C; 4]) -> Vec<PolishedRoot> {
@@ -254,7 +299,7 @@ fn polished_roots(lv: &Level, p_at_a: &[f64; 4], s0: &[C; 4]) -> Vec<PolishedRoo
             let partner = roots[p - 1].conj();
             roots.push(partner);
         } else {
-            roots.push(polish_root(lv, p_at_a, s0[p]));
+            roots.push(polish_root(lv, p_at_a, s0[p], None));
         }
     }
     roots
@@ -266,7 +311,11 @@ fn polished_roots(lv: &Level, p_at_a: &[f64; 4], s0: &[C; 4]) -> Vec<PolishedRoo
 /// Errors: `F'(s_p)` zero or not finite; a root `s_p` indistinguishable from
 /// some `a_j` (then `√s_kl = √G/√s_j4` is 0/0).
 #[allow(clippy::type_complexity)]
-fn coefficients_20(a: &[f64; 4], roots: &[PolishedRoot]) -> Result<([[Cdd; 3]; 4], [[Cdd; 3]; 4])> {
+fn coefficients_20(
+    a: &[f64; 4],
+    roots: &[PolishedRoot],
+    pair: Option<&PairStructure>,
+) -> Result<([[Cdd; 3]; 4], [[Cdd; 3]; 4])> {
     let s: [C; 4] = std::array::from_fn(|p| roots[p].s);
     let scale_a = a.iter().fold(1.0f64, |m, v| m.max(v.abs()));
     let mut u = [[Cdd::ZERO; 3]; 4];
@@ -318,10 +367,11 @@ fn coefficients_20(a: &[f64; 4], roots: &[PolishedRoot]) -> Result<([[Cdd; 3]; 4
         // The partner of a conjugate pair has the conjugate u, v, unless a
         // principal root (of x_j x_4 or of F') lies on its cut, where both
         // members take +i√|·|.
-        let partner = p % 2 == 1
-            && s[p].im != 0.0
-            && s[p] == s[p - 1].conj()
-            && roots[p].sqrt_fprime == roots[p - 1].sqrt_fprime.conj();
+        let conj_pair = match pair {
+            Some(ps) => ps.partner[p],
+            None => p % 2 == 1 && s[p].im != 0.0 && s[p] == s[p - 1].conj(),
+        };
+        let partner = conj_pair && roots[p].sqrt_fprime == roots[p - 1].sqrt_fprime.conj();
         let x = &roots[p].x;
         let inv_sfp = roots[p].sqrt_fprime.recip();
         let sg_sfp = roots[p].sigma.mul(inv_sfp);
@@ -331,7 +381,19 @@ fn coefficients_20(a: &[f64; 4], roots: &[PolishedRoot]) -> Result<([[Cdd; 3]; 4
                 v[p][j] = v[p - 1][j].conj();
                 continue;
             }
-            let r = x[j].mul(x[3]).sqrt();
+            let mut r = x[j].mul(x[3]).sqrt();
+            // A conjugate pair merged onto the real axis (h0 ≈ 0, pairs.rs) with
+            // s_j4 < 0 there: √s_j4 on its cut. The branch is the limit from the
+            // member's own side of the axis, Im s → ±0, where Im s_j4 has the sign
+            // of ±Re(x_j + x_4): as for the pair at small h0 ≠ 0.
+            let side = pair.map_or(0.0, |ps| ps.side[p]);
+            let prod = x[j].mul(x[3]).to_c();
+            if side != 0.0 && prod.re < 0.0 && prod.im.abs() <= 1e-28 * prod.re.abs() {
+                let up = side * (x[j].add(x[3]).to_c().re).signum();
+                if (r.to_c().im > 0.0) != (up > 0.0) {
+                    r = r.neg();
+                }
+            }
             root_jd[j] = r;
             u[p][j] = r.mul(inv_sfp);
             v[p][j] = sg_sfp.div(r);
@@ -530,13 +592,19 @@ fn h0_structure(
     // κ = Π (d_m − d4) (docs/kotter.md §7). K, Kε and K/κ come from
     // [`k_keps_dd`] (K/κ directly: κ vanishes when some d_j = d4).
     let kappa = (d[0] - d4) * (d[1] - d4) * (d[2] - d4);
-    let eps = k_eps / k;
+    // K = 0: h0 negligible (constants_impl), where ε = 0 too and the perfect
+    // square below holds trivially.
+    let eps = if k == ZERO { ZERO } else { k_eps / k };
     // The perfect square of (40), (Kε)² = K · Kε², with Kε² d4 = κ Σ c̃_j p_j;
     // relative to the size of the terms (the sum cancels when two d_j are close).
     let terms_e2: f64 = (0..3).map(|j| (ct[j] * ac[j]).norm()).sum();
     let k_eps2: C = kappa / d4 * (0..3).map(|j| ct[j] * ac[j]).sum::<C>();
-    let r3 = (k_eps * k_eps - k * k_eps2).norm()
-        / ((k_eps * k_eps).norm() + (k * kappa / d4).norm() * terms_e2);
+    let r3 = if k == ZERO {
+        0.0
+    } else {
+        (k_eps * k_eps - k * k_eps2).norm()
+            / ((k_eps * k_eps).norm() + (k * kappa / d4).norm() * terms_e2)
+    };
     let worst = r1.max(r2).max(r3);
     if worst.is_nan() || worst > STRUCTURE_RTOL {
         return Err(Error::InvalidArgument {
@@ -581,15 +649,20 @@ fn existence_residuals(
         let size: f64 = size.iter().sum();
         (t[0] + t[1] + t[2]).norm() / size.max(f64::MIN_POSITIVE)
     };
+    // The size of a term is that of the full products (|α_j| + |β_j|)(|γ_j| + |δ_j|)
+    // of (23)'s coefficients, the scale of their rounding: near h0 = 0 some of
+    // α_j … δ_j vanish like h0 (docs/degenerate.md), and the products p_j + r_j,
+    // q_j with them, so relative to those products alone the sums would be noise.
+    let full: [f64; 3] = std::array::from_fn(|j| {
+        (alpha[j].norm() + beta[j].norm()) * (gamma[j].norm() + delta[j].norm())
+    });
     let r1 = rel_sum(
         std::array::from_fn(|j| c33[j] * (ac[j] + cc[j])),
-        std::array::from_fn(|j| c33[j].norm() * (ac[j].norm() + cc[j].norm())),
+        std::array::from_fn(|j| c33[j].norm() * full[j]),
     );
     let r2 = rel_sum(
         std::array::from_fn(|j| c33[j] * bc[j]),
-        std::array::from_fn(|j| {
-            c33[j].norm() * ((alpha[j] * delta[j]).norm() + (beta[j] * gamma[j]).norm())
-        }),
+        std::array::from_fn(|j| c33[j].norm() * full[j]),
     );
     (r1, r2)
 }

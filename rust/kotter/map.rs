@@ -174,12 +174,14 @@ fn kotter_with_impl(constants: KotterConstants, l: &[f64; 6]) -> Result<KotterSt
         }
         Ok(sqrt_principal(C::new(constants.h[0], 0.0) / constants.k) / one_m)
     };
+    // h0 negligible (K = 0): (42) is 0/0 and the sign of g free; g from (30a).
+    let h0_free = constants.k == ZERO;
     // The sign of g from (42) at the closed-form P_0 (31b); the consistency
     // check at P_0 of the polished points: near the singular set the closed
     // form cancels like the start of the inverse map (to ~1e-6 at
     // (h1² − 4h0²)/h1² = 4e-12), while P_0 = eps_0 √z1 √z2 of the points is
     // accurate.
-    let g_sign = g42_at(p0)?;
+    let g_sign = if h0_free { None } else { Some(g42_at(p0)?) };
     let lmap = [
         constants.alpha,
         constants.beta,
@@ -190,14 +192,14 @@ fn kotter_with_impl(constants: KotterConstants, l: &[f64; 6]) -> Result<KotterSt
         xi,
         eta,
         None,
-        Some(g_sign),
+        g_sign,
         UNIFORM_RTOL,
         Some(&lmap),
         start.as_ref().map(|(s, _)| s),
     )?;
     let p0 =
         f64::from(points.eps[0]) * sqrt_principal(points.zd1[0]) * sqrt_principal(points.zd2[0]);
-    let g42 = g42_at(p0)?;
+    let g42 = if h0_free { points.g } else { g42_at(p0)? };
     let mis = (points.g - g42).norm();
     if mis.is_nan() || mis > G42_RTOL * g42.norm() {
         return Err(Error::InvalidArgument {

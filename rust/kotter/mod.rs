@@ -42,6 +42,7 @@
 mod batch;
 mod constants;
 mod map;
+mod pairs;
 mod polish;
 mod roots;
 mod schottky;
@@ -49,12 +50,13 @@ mod schottky;
 pub use batch::{kotter_batch, KotterBatch};
 pub use constants::{
     constants_from_h, kotter_constants, l_from_xi_eta, l_p, xi_eta, Coefficients23,
-    KotterConstants, NEAR_SINGULAR_RTOL, REAL_RTOL, STRUCTURE_RTOL,
+    KotterConstants, H0_NEGLIGIBLE_RTOL, NEAR_SINGULAR_RTOL, REAL_RTOL, STRUCTURE_RTOL,
 };
 pub use map::{
     follow_order, from_kotter, kotter, kotter_along, kotter_with, on_level_set, KotterState,
     G42_RTOL, LEVEL_SET_RTOL, UNIFORM_RTOL,
 };
+pub use pairs::PAIR_ROUTE_RTOL;
 pub use roots::{quartic_f, quartic_roots, REPEATED_ROOT_RTOL, ROOT_STAGNATION};
 pub use schottky::{branch_sign, cubic_interpolant, g_poly, lax_m, p_poly, schottky, SQRT_G_RTOL};
 

@@ -20,11 +20,22 @@ pub(super) struct Level<'a> {
 }
 
 impl Level<'_> {
+    /// `sgn(h0)`, `+1` at `h0 = 0`: (20) is normalised by `√(F'(s_p)/|h0|)`
+    /// ([`super::KotterConstants::sqrt_fprime`]), and
+    /// `F'(s_p)/|h0| = −4 sgn(h0) σ_p f'(s_p)/(h1² − 4h0²)` by (19').
+    pub(super) fn h0_sign(&self) -> f64 {
+        if self.h[0] < 0.0 {
+            -1.0
+        } else {
+            1.0
+        }
+    }
+
     /// `P(s) = h1 s² − h2 s + h3` and `P'(s)` from the offsets `x_m = s − a_m`.
     /// From the state, `P(s) = Σ_j (x_j x_4 m_j² + x_k x_l n_j²)`: the
     /// offsets carry `s − a_m` to full relative accuracy, so `P` near a root of
     /// `G` (where it is small) keeps its relative accuracy.
-    fn p_dp(&self, s: C, x: &[C; 4]) -> (C, C) {
+    pub(super) fn p_dp(&self, s: C, x: &[C; 4]) -> (C, C) {
         match self.mn {
             Some((m, n)) => {
                 let mut p = ZERO;
@@ -137,9 +148,10 @@ pub(super) struct PolishedRoot {
     pub(super) x: [Cdd; 4],
     /// `σ = √G(s)` on the branch where `f(s) = 0`.
     pub(super) sigma: Cdd,
-    /// `F'(s) = f'(s) f̃(s) / (h1² − 4h0²)` with `f̃(s) = −4 h0 σ` (docs/kotter.md §3).
+    /// `F'(s)/|h0| = f'(s) f̃(s) / (|h0| (h1² − 4h0²))` with `f̃(s) = −4 h0 σ`
+    /// (docs/kotter.md §3; the scale `|h0|` keeps it finite at `h0 = 0`).
     pub(super) fprime: C,
-    /// `√F'(s)`, principal.
+    /// `√(F'(s)/|h0|)`, principal.
     pub(super) sqrt_fprime: Cdd,
 }
 
@@ -174,7 +186,12 @@ impl PolishedRoot {
 /// Near `a_i`, where `√G ~ √t` is not smooth, the start is first refined on
 /// `(P(a_i) + P'(a_i) t + h1 t²)² − 4h0² t Π_{m≠i}(a_i − a_m + t)` (the
 /// numerator of (19) at `s = a_i + t`, all terms of the size of `t`).
-pub(super) fn polish_root(lv: &Level, p_at_a: &[f64; 4], s0: C) -> PolishedRoot {
+///
+/// With `branch` given (the pair route near `h0 = 0`, [`super::pairs`]) the
+/// branch is the one of `±√G(s0)` nearest it and the squared form is skipped:
+/// there the two roots of a pair are on different branches a distance `~h0`
+/// apart, and `|f|` at the start does not tell them apart (at `h0 = 0` not at all).
+pub(super) fn polish_root(lv: &Level, p_at_a: &[f64; 4], s0: C, branch: Option<C>) -> PolishedRoot {
     let a = lv.a;
     let [h0, h1, h2, _] = *lv.h;
     let mut best = 0;
@@ -189,7 +206,7 @@ pub(super) fn polish_root(lv: &Level, p_at_a: &[f64; 4], s0: C) -> PolishedRoot 
         .map(|m| (a[m] - ai).abs())
         .fold(f64::INFINITY, f64::min);
     let mut t = s0 - ai;
-    if t.norm() < 0.1 * gap {
+    if branch.is_none() && t.norm() < 0.1 * gap {
         let pa = p_at_a[best];
         let dpa = 2.0 * h1 * ai - h2;
         for _ in 0..4 {
@@ -214,12 +231,27 @@ pub(super) fn polish_root(lv: &Level, p_at_a: &[f64; 4], s0: C) -> PolishedRoot 
             }
         }
     }
-    // the branch: of ±√G(s0), the one on which f is the smaller
+    // the branch: of ±√G(s0), the one given, else the one on which f is the smaller
     let x0 = offsets_at(a, best, t);
     let g0 = sqrt_principal(x0.iter().product());
-    let (fp, _) = lv.f(ai + t, &x0, g0);
-    let (fm, _) = lv.f(ai + t, &x0, -g0);
-    let mut sigma = if fp.norm() <= fm.norm() { g0 } else { -g0 };
+    let mut sigma = match branch {
+        Some(b) => {
+            if (g0 * b.conj()).re >= 0.0 {
+                g0
+            } else {
+                -g0
+            }
+        }
+        None => {
+            let (fp, _) = lv.f(ai + t, &x0, g0);
+            let (fm, _) = lv.f(ai + t, &x0, -g0);
+            if fp.norm() <= fm.norm() {
+                g0
+            } else {
+                -g0
+            }
+        }
+    };
     let mut cur = (t, x0, sigma);
     let (f_cur, size) = lv.f(ai + t, &x0, sigma);
     let mut res_best = f_cur.norm() / size.max(f64::MIN_POSITIVE);
@@ -250,7 +282,7 @@ pub(super) fn polish_root(lv: &Level, p_at_a: &[f64; 4], s0: C) -> PolishedRoot 
     let (t, x, sigma) = best_state;
     let s = ai + t;
     let df = lv.df(s, &x, sigma);
-    let fprime = df * (-4.0 * h0 * sigma) / lv.den;
+    let fprime = df * (-4.0 * lv.h0_sign() * sigma) / lv.den;
     let plain = PolishedRoot {
         s,
         x: x.map(Cdd::new),
@@ -302,7 +334,7 @@ fn refine_dd(lv: &Level, i: usize, t: C, sigma: C, df: C) -> Option<PolishedRoot
     let t_dd = Cdd::new(t).sub(Cdd::new(step));
     let (x, sg) = offsets_dd(lv.a, i, t_dd, sigma);
     let dfd = df_dd(lv, h0, &x, sg);
-    let fp = dfd.mul(sg).mul_dd(h0).mul_f64(-4.0).div_dd(den);
+    let fp = dfd.mul(sg).mul_f64(-4.0 * lv.h0_sign()).div_dd(den);
     let sq = fp.sqrt();
     let s = t_dd.add_f64(lv.a[i]);
     let out = PolishedRoot {

@@ -83,15 +83,20 @@ fn degenerate_inputs_are_errors() {
             ..
         })
     ));
-    // h0 = 0
+    // h0 = 0 at an equilibrium (one component): the roots of h1 s² − h2 s + h3
+    // are a_3, a_4, where the pairs of roots of F meet; a generic rank-2 state
+    // (h0 = 0) reduces (pairs.rs).
     let z = [1.0, 0.0, 0.0, 0.0, 0.0, 0.0];
     assert!(matches!(
         kotter_constants(&A, &z),
         Err(Error::Singular {
-            kind: SingularKind::VanishingH0,
+            kind: SingularKind::RepeatedRoot,
             ..
         })
     ));
+    let mut rank2 = L0;
+    rank2[5] = -(L0[3] * L0[2] - L0[1] * L0[4]) / L0[0];
+    assert!(kotter_constants(&A, &rank2).is_ok());
     assert!(matches!(
         kotter_constants(&[1.0, 1.0, 2.0, 3.0], &L0),
         Err(Error::RepeatedA { .. })
@@ -443,7 +448,8 @@ fn fprime_identity_19prime() {
             .filter(|&q| q != p)
             .map(|q| k.s[p] - k.s[q])
             .product();
-        let fp = k.sqrt_fprime[p] * k.sqrt_fprime[p];
+        // (20) is normalised by √(F'(s_p)/|h0|) (finite at h0 = 0)
+        let fp = k.sqrt_fprime[p] * k.sqrt_fprime[p] * k.h[0].abs();
         assert_relative_eq!((fp - prod).norm() / prod.norm(), 0.0, epsilon = 1e-13);
         let f = p_poly(&k.h, k.s[p]) + 2.0 * k.h[0] * k.sigma[p];
         let scale = p_poly(&k.h, k.s[p]).norm() + (2.0 * k.h[0] * k.sigma[p]).norm();
@@ -536,4 +542,90 @@ fn level_set_kotter_along() {
     std::mem::swap(&mut swapped.y1, &mut swapped.y2);
     follow_order(&st.points, &mut swapped);
     assert_eq!((swapped.z1, swapped.y1), (st.points.z1, st.points.y1));
+}
+
+/// `L0` moved along `l34` so that `h0 = target` (h0 is linear in `l34`).
+fn with_h0(target: f64) -> [f64; 6] {
+    let mut l = L0;
+    l[5] = (target - (L0[3] * L0[2] - L0[1] * L0[4])) / L0[0];
+    l
+}
+
+#[test]
+fn pair_and_quartic_routes_agree() {
+    // Just below and above PAIR_ROUTE_RTOL the two routes take the same state
+    // to the same constants (the pair route below, the quartic above): the
+    // d_j, which depend continuously on h0, agree to roundoff across it.
+    let h1: f64 = L0.iter().map(|x| x * x).sum();
+    let below = kotter_constants(&A, &with_h0(0.999 * PAIR_ROUTE_RTOL * h1)).unwrap();
+    let above = kotter_constants(&A, &with_h0(1.001 * PAIR_ROUTE_RTOL * h1)).unwrap();
+    for j in 0..3 {
+        // d_j moves by O(Δh0) = 2e-6 relative between the two states
+        let rel = (below.d[j] - above.d[j]).norm() / above.d[j].norm();
+        assert!(rel < 1e-4, "{j}: {rel:e}");
+    }
+    // and at one state both routes agree to roundoff: force the quartic route
+    // by the integrals' form (constants_from_h takes the same route choice;
+    // compare the pair route's d_j with those of a state at the threshold's
+    // other side extrapolated linearly)
+    let mid = kotter_constants(&A, &with_h0(PAIR_ROUTE_RTOL * h1)).unwrap();
+    for j in 0..3 {
+        let lin = 0.5 * (below.d[j] + above.d[j]);
+        assert!((mid.d[j] - lin).norm() <= 1e-9 * mid.d[j].norm());
+    }
+}
+
+#[test]
+fn constants_are_continuous_down_to_h0_zero() {
+    // The pair route and the normalisation of (20) by √(F'/|h0|): the curve's
+    // d_j have a limit at h0 = 0, ε vanishes like h0, and h0 = 0 itself
+    // reduces and round-trips. (α_j … δ_j also have limits, up to the branch of
+    // √s_j4 at a root on its cut, which may differ between h0 > 0 and h0 = 0:
+    // both are valid reductions.)
+    let at0 = kotter_constants(&A, &with_h0(0.0)).unwrap();
+    assert_eq!(at0.eps, C::new(0.0, 0.0));
+    for h0 in [1e-6, 1e-9, 1e-12] {
+        let k = kotter_constants(&A, &with_h0(h0)).unwrap();
+        for j in 0..3 {
+            // d_j moves by O(h0)
+            let rel = (k.d[j] - at0.d[j]).norm() / at0.d[j].norm();
+            assert!(rel < 100.0 * h0, "h0 {h0:e}, d_{j}: {rel:e}");
+        }
+        // ε = O(h0)
+        assert!(k.eps.norm() <= h0);
+    }
+    // (21) and the quadrics (11) at h0 = 0
+    let l = with_h0(0.0);
+    let (xi, eta) = xi_eta(&at0, &l);
+    let scale: f64 = xi.iter().chain(eta.iter()).map(|v| v.norm_sqr()).sum();
+    let q1: C = (0..3).map(|j| xi[j] * xi[j] + eta[j] * eta[j]).sum();
+    let q2: C = (0..3).map(|j| xi[j] * eta[j]).sum();
+    let q3: C = (0..3)
+        .map(|j| at0.d[j] * xi[j] * xi[j] + eta[j] * eta[j] / at0.d[j])
+        .sum();
+    for q in [q1, q2] {
+        assert!(q.norm() <= 1e-14 * scale, "{q}");
+    }
+    let dmax = at0
+        .d
+        .iter()
+        .fold(1.0f64, |m, d| m.max(d.norm()).max(1.0 / d.norm()));
+    assert!(q3.norm() <= 1e-14 * scale * dmax, "{q3}");
+    let st = kotter_with(at0, &l).unwrap();
+    let p = st.points;
+    let back = from_kotter(
+        &st.constants.coefficients23(),
+        st.constants.d,
+        [p.z1, p.z2],
+        [p.y1, p.y2],
+        Some([p.zd1, p.zd2]),
+        p.g,
+        p.eps,
+    )
+    .unwrap();
+    let err = back
+        .iter()
+        .zip(&l)
+        .fold(0.0f64, |m, (x, y)| m.max((x - y).abs()));
+    assert!(err <= 1e-14, "round trip at h0 = 0: {err:e}");
 }

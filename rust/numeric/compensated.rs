@@ -43,6 +43,23 @@ pub fn two_prod(a: f64, b: f64) -> (f64, f64) {
     (p, ((ah * bh - p) + ah * bl + al * bh) + al * bl)
 }
 
+/// `Σ x_i y_i` in twice the working precision, rounded once (the Dot2
+/// algorithm of Ogita, Rump and Oishi, SIAM J. Sci. Comput. 26 (2005)):
+/// error-free products by `fma`, error-free sums by [`two_sum`], the errors
+/// summed and added at the end. Accurate to a few ulps of the result plus `u²`
+/// of the terms, however much they cancel.
+pub fn dot2(x: &[f64], y: &[f64]) -> f64 {
+    let (mut s, mut c) = (0.0f64, 0.0f64);
+    for (&a, &b) in x.iter().zip(y) {
+        let p = a * b;
+        let ep = a.mul_add(b, -p);
+        let (t, es) = two_sum(s, p);
+        s = t;
+        c += ep + es;
+    }
+    s + c
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

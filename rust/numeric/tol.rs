@@ -17,10 +17,11 @@ pub fn min_step(t: f64) -> f64 {
 /// give them their status without setting up the solution.
 pub const SINGULAR_SET_RTOL: f64 = 1e-13;
 
-/// The reduction's floor near the singular level sets (`crate::kotter`):
-/// `|h1² − 4h0²| ≤ REDUCTION_FLOOR_RTOL · h1²` is treated as `h1² = 4h0²`
-/// (the denominator of (19) vanishes), and `|h0| ≤ REDUCTION_FLOOR_RTOL · h1`
-/// as `h0 = 0`. From the state, `h1² − 4h0² = |m − n|² |m + n|²` is exact to
+/// The reduction's floor near the singular level set `h1² = 4h0²`
+/// (`crate::kotter`): `|h1² − 4h0²| ≤ REDUCTION_FLOOR_RTOL · h1²` is treated
+/// as `h1² = 4h0²` (the denominator of (19) vanishes). (`h0 = 0` is not
+/// singular for the reduction: it takes the limit there, `kotter::pairs`.)
+/// From the state, `h1² − 4h0² = |m − n|² |m + n|²` is exact to
 /// a few ulps; the bound is where the double-double level-set constants run
 /// out of digits: at `(h1² − 4h0²)/h1² = 4e-12` 2 of 600 random states fail
 /// (the inverse map of the curve); with the bound removed, 5 of 80 states of

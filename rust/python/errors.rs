@@ -13,6 +13,14 @@ create_exception!(
     "An iterative computation did not reach its tolerance."
 );
 
+create_exception!(
+    manakov,
+    ClosedFormError,
+    PyRuntimeError,
+    "A valid state whose closed-form solution could not be built to the package's \
+     accuracy, or failed its own check; the message names the step. Integrate it instead."
+);
+
 impl From<Error> for PyErr {
     fn from(e: Error) -> PyErr {
         exception(&e, e.to_string())
@@ -24,6 +32,7 @@ fn exception(e: &Error, msg: String) -> PyErr {
     // Exhaustive on purpose: a new variant must choose its exception here.
     match e {
         Error::NoConvergence { .. } => ConvergenceError::new_err(msg),
+        Error::Unverified { .. } => ClosedFormError::new_err(msg),
         Error::Interrupted => PyKeyboardInterrupt::new_err(msg),
         // A batch row's error: its own exception, the message naming the row.
         Error::InRow { source, .. } => exception(source, msg),

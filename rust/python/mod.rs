@@ -25,6 +25,9 @@ mod _core {
     #[pymodule_export]
     use super::errors::ConvergenceError;
 
+    #[pymodule_export]
+    use super::errors::ClosedFormError;
+
     #[pymodule_init]
     fn init(m: &Bound<'_, PyModule>) -> PyResult<()> {
         m.add("__version__", env!("CARGO_PKG_VERSION"))?;

@@ -122,6 +122,11 @@ impl SolutionCore {
         Array1::from(self.sol.calibration().to_vec()).into_pyarray(py)
     }
 
+    #[getter]
+    fn self_check(&self) -> f64 {
+        self.sol.self_check()
+    }
+
     /// `(idx (8,), num (6, 8), den (8,))` of `l_q = N_q/D`.
     fn quotient<'py>(&self, py: Python<'py>) -> PyResult<Quotient<'py>> {
         let (idx, num, den) = self.sol.quotient();

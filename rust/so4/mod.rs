@@ -22,6 +22,7 @@
 #![allow(clippy::needless_range_loop)]
 
 use crate::error::{check_finite, Error, Result};
+use crate::numeric::compensated::dot2;
 
 /// Length of the so(4) state vector.
 pub const DIM4: usize = 6;
@@ -390,7 +391,10 @@ pub fn poisson_tensor(n: usize, l: &[f64], out: &mut [f64]) {
 /// `{l, m}` the complement of `{j, k}` in `{1, 2, 3, 4}`.
 pub fn integrals4(a: &[f64; 4], l: &[f64; 6]) -> [f64; 4] {
     let [l12, l13, l14, l23, l24, l34] = *l;
-    let h0 = l12 * l34 + l23 * l14 + (-l13) * l24;
+    // H0 is a sum of products that cancels on and near rank-2 states (h0 = 0,
+    // Moser's case), where the reduction needs it to full relative accuracy:
+    // summed compensated, it is the correctly rounded value up to a few ulps.
+    let h0 = dot2(&[l12, l23, -l13], &[l34, l14, l24]);
     let mut h1 = 0.0;
     let mut h2 = 0.0;
     let mut h3 = 0.0;

@@ -12,15 +12,31 @@ use super::*;
 /// one (and the sign) nearest the reduction's `ε` (corrected (40)) is taken.
 /// (41) serves because it keeps its digits where (40)'s sums cancel.
 pub(super) fn eps41(k: &KotterConstants) -> C {
+    // ε = 0 marks a negligible h0 (kotter::H0_NEGLIGIBLE_RTOL), where (41)
+    // divides 0 by 0 (the roots of F are pairwise equal).
+    if k.eps == C::new(0.0, 0.0) {
+        return k.eps;
+    }
     let s = k.s;
     let sq = sqrt_principal;
     let sd4 = k.sqrt_d[0] * k.sqrt_d[1] * k.sqrt_d[2];
     let y = sq((s[1] - s[2]) * (s[0] - s[3]));
     let w = sq((s[0] - s[2]) * (s[1] - s[3]));
-    let den = sd4 * sq((s[0] - s[1]) * (s[2] - s[3]));
-    [(y - w) / den, (y + w) / den]
+    let z = sq((s[0] - s[1]) * (s[2] - s[3]));
+    let den = sd4 * z;
+    // (Y − W)(Y + W) = −Z²: the smaller of Y ∓ W is −Z²/(the larger), without
+    // the cancellation of the difference (near h0 = 0 the roots pair up, Z ~ h0
+    // and Y ≈ ±W to O(h0²)).
+    let (ym, yp) = (y - w, y + w);
+    let (ym, yp) = if ym.norm() <= yp.norm() {
+        (-z * z / yp, yp)
+    } else {
+        (ym, -z * z / ym)
+    };
+    [ym / den, yp / den]
         .into_iter()
         .flat_map(|e| [e, -e])
+        .filter(|e| e.re.is_finite() && e.im.is_finite())
         .min_by(|p, q| (p - k.eps).norm().total_cmp(&(q - k.eps).norm()))
         .unwrap_or(k.eps)
 }
@@ -73,9 +89,10 @@ pub struct LevelSetCurve {
 }
 
 /// The checks of `l0` that precede the reduction, and the reduction's
-/// level-set objects: refuses `l0 = 0`, `h0 = 0`, `h1² = 4h0²` (relative to
+/// level-set objects: refuses `l0 = 0`, `h1² = 4h0²` (relative to
 /// [`SINGULAR_SET_RTOL`]) and coinciding branch points with a
-/// [`Error::Singular`] that names the reason.
+/// [`Error::Singular`] that names the reason. `h0 = 0` (rank-2 states) is a
+/// regular level set: the reduction takes its limit there (docs/degenerate.md).
 pub fn level_set_curve(a: &[f64; 4], l0: &[f64; 6]) -> Result<LevelSetCurve> {
     crate::error::check_finite("l0", l0)?;
     let size = l0.iter().fold(0.0f64, |m, v| m.max(v.abs()));
@@ -86,18 +103,6 @@ pub fn level_set_curve(a: &[f64; 4], l0: &[f64; 6]) -> Result<LevelSetCurve> {
         ));
     }
     let h = so4::integrals4(a, l0);
-    let s2 = size * size;
-    if h[0].abs() <= SINGULAR_SET_RTOL * s2 {
-        return Err(singular(
-            SingularKind::VanishingH0,
-            format!(
-                "h0 = {:e} vanishes: the branch points d_0 = 0 and d_j coincide (F (19) has double \
-                 roots), the curve (8) degenerates; the solution exists in a limiting sense \
-                 (genus < 2, elementary functions), not as a genus-2 theta quotient",
-                h[0]
-            ),
-        ));
-    }
     let disc = h[1] * h[1] - 4.0 * h[0] * h[0];
     if disc.abs() <= SINGULAR_SET_RTOL * (h[1] * h[1] + 4.0 * h[0] * h[0]) {
         return Err(singular(

@@ -59,6 +59,15 @@ impl VelocitySystem {
                 amat[(q, k)] = ng - lq[q] * dgrad[k];
             }
         }
+        // nalgebra's SVD panics on NaN entries: a non-finite system is refused first.
+        if !amat.iter().all(|v| v.re.is_finite() && v.im.is_finite()) {
+            return Err(Error::Singular {
+                what: "state l0",
+                kind: SingularKind::DegenerateGradients,
+                reason: "the theta-quotient gradients at v0 are not finite: U is not determined"
+                    .into(),
+            });
+        }
         let svd = amat.clone().svd(true, true);
         let sv = &svd.singular_values;
         if sv[1].is_nan() || sv[1] <= 1e-12 * sv[0] {

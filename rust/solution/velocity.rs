@@ -190,7 +190,13 @@ impl<'a> Level<'a> {
             k,
             d: curve.branch_points(),
             sc: curve.c().map(sqrt_principal),
-            big_g: sqrt_principal(C::new(k.h[0], 0.0) / k.k),
+            // G = √(h0/K) (42); at negligible h0 (K = 0, ε = 0) l is linear in G
+            // and G is fixed per divisor by H1(l) = h1 instead ([`state_jet`]).
+            big_g: if k.k == ZERO {
+                ZERO
+            } else {
+                sqrt_principal(C::new(k.h[0], 0.0) / k.k)
+            },
         }
     }
 }
@@ -230,7 +236,9 @@ fn state_jet(lv: &Level, z: [C; 2], r: &[[C; 5]; 2], eps: &[f64; 5]) -> Option<S
     if den.norm_sqr() < POLE_MARGIN * POLE_MARGIN {
         return None;
     }
-    let g = big_g / den;
+    // G = 0 marks negligible h0: l is then computed at G = 1 and scaled below.
+    let h1_scale = big_g == ZERO;
+    let g = if h1_scale { ONE } else { big_g } / den;
     // ∂g/∂z_i = g ε ∂P_0/∂z_i / (1 − ε P_0)
     let dg: [C; 2] = std::array::from_fn(|i| g * k.eps * dp[i][0] / den);
     let mut m = [ZERO; 3];
@@ -252,8 +260,16 @@ fn state_jet(lv: &Level, z: [C; 2], r: &[[C; 5]; 2], eps: &[f64; 5]) -> Option<S
         }
     }
     let lay = |m: &[C; 3], n: &[C; 3]| [m[2], -m[1], n[0], m[0], n[1], n[2]];
-    let l = lay(&m, &n);
-    let dl = [lay(&dm[0], &dn[0]), lay(&dm[1], &dn[1])];
+    let mut l = lay(&m, &n);
+    let mut dl = [lay(&dm[0], &dn[0]), lay(&dm[1], &dn[1])];
+    if h1_scale {
+        // ε = 0: l and ∂l/∂z are linear in G; G² = h1 / Σ_q l_q² at G = 1, the
+        // principal root as for √(h0/K) (the sign is the involution's).
+        let s2: C = l.iter().map(|v| v * v).sum();
+        let gg = sqrt_principal(C::new(k.h[1], 0.0) / s2);
+        l = l.map(|v| v * gg);
+        dl = dl.map(|row| row.map(|v| v * gg));
+    }
     let finite = |v: &C| v.re.is_finite() && v.im.is_finite();
     (l.iter().all(finite) && dl.iter().flatten().all(finite)).then_some(StateJet { l, dl })
 }

@@ -535,19 +535,20 @@ mod on_the_solution {
         let (a, b, _) = GENERIC;
         let new = |l0: [f64; 6]| kind_of(Solution::new(&a, &b, &l0).map(|_| ()).unwrap_err());
         assert_eq!(new([0.0; 6]), ("state l0", SingularKind::ZeroState));
+        // an so(3)-block state: h0 = 0 with the roots of h1 s² − h2 s + h3 at a_j
         assert_eq!(
             new([1.0, 0.0, 0.0, 0.0, 0.5, 0.0]),
-            ("state l0", SingularKind::VanishingH0)
+            ("state l", SingularKind::RepeatedRoot)
         );
         // m = n: the solution's own check, before the reduction's.
         assert_eq!(
             new([0.3, -0.2, 0.5, 0.5, 0.2, 0.3]),
             ("state l0", SingularKind::SelfDual)
         );
-        // h0 just above the solution's threshold, within the reduction's.
+        // 1e-12 from an equilibrium: the pairs of roots of F meet at a_3, a_4.
         assert_eq!(
             new([1.0, 0.0, 0.0, 0.0, 0.0, 1e-12]),
-            ("state l", SingularKind::VanishingH0)
+            ("state l", SingularKind::RepeatedRoot)
         );
         assert_eq!(
             new([1.0, 0.0, 0.0, 0.0, 0.0, 0.5]),

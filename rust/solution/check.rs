@@ -1,0 +1,219 @@
+//! The self-check of a genus-2 solution, and the choice of the signs of the
+//! constants `C_L` that the initial state leaves undecided.
+//!
+//! A constant or branch of the set-up that is wrong reproduces `l0` at `t = 0`
+//! and may reproduce `l̇(0)` too (a wrong sign of a `C_L` whose `P_L(l0)`
+//! vanishes: the divisor of `l0` on a branch point, e.g. states with zero
+//! components), while `l(t)` is O(1) wrong later. So every solution is checked
+//! at points spread over its torus before it is returned (docs/degenerate.md).
+
+use num_complex::Complex64;
+
+use super::phase_mod2;
+use crate::error::Result;
+use crate::riemann::HyperellipticCurve;
+use crate::so4;
+use crate::theta::ThetaPlan;
+
+type C = Complex64;
+
+/// The estimate of a `C_L` at `v0` decides its sign when it agrees with one
+/// of `±√(C_L²)` to this relative accuracy (decided estimates agree to
+/// ~1e-14; an undecided one, `P_L(l0) θ(v0)/θ[χ_L](v0)` with both factors at
+/// rounding level, is off by O(1)). A sign left undecided is taken from the
+/// self-check ([`SelfCheck`]).
+pub(super) const SIGN_DECIDED_RTOL: f64 = 1e-3;
+
+/// Largest relative defect of a solution at its self-check points
+/// ([`SelfCheck::defect`]) that is accepted. Correct set-ups leave 1e-15 …
+/// 6e-12 (the four shared tops; 1000 random states with normal entries:
+/// median 1.3e-14, max 6e-12); a wrong sign of one constant leaves 1e-3 … 1.
+/// Near degenerate sets (a harsh random draw, docs/degenerate.md) solutions
+/// whose error over their window exceeds 1e-10 show defects from 1e-13 to 1e-8,
+/// those within it up to 5e-10: this bound refuses about half of the former and
+/// 2 % of the latter; the rest of the former is a drift of the phase that no
+/// check at a few points can see.
+pub const SELF_CHECK_RTOL: f64 = 1e-10;
+
+/// Fractions of the shortest lattice period of the phase at which the
+/// self-check evaluates the solution (besides `t = 0`): points spread over
+/// the torus, none a simple fraction of a period.
+const CHECK_PHASES: [f64; 3] = [0.29, 0.71, 1.37];
+
+/// The self-check looks at most this many shortest periods of the phase away
+/// from `t = 0`: far enough to see the torus when its two periods differ by
+/// orders of magnitude, not so far that the rounding of `U` (~1e-14 relative,
+/// growing linearly in `t`) is what it measures.
+const SLOW_CHECK_CAP: f64 = 50.0;
+
+/// What one sign pattern of the constants `C_L` makes of the solution: the
+/// quotients (9)–(10) and `U`.
+pub(super) struct Built {
+    pub(super) cl: [C; 7],
+    pub(super) num: [[C; 8]; 6],
+    pub(super) den: [C; 8],
+    pub(super) rate: [C; 2],
+}
+
+/// The sign patterns to try: the signs decided at `v0` with every
+/// combination of flips of the undecided ones (`calibration` above
+/// [`SIGN_DECIDED_RTOL`]); in practice 1, 2 or 4 patterns.
+pub(super) fn sign_patterns(cl: &[C; 7], calibration: &[f64; 7]) -> Vec<[C; 7]> {
+    let undecided: Vec<usize> = (0..7)
+        .filter(|&m| calibration[m].is_nan() || calibration[m] > SIGN_DECIDED_RTOL)
+        .collect();
+    (0..(1u32 << undecided.len()))
+        .map(|mask| {
+            let mut c = *cl;
+            for (bit, &m) in undecided.iter().enumerate() {
+                if (mask >> bit) & 1 == 1 {
+                    c[m] = -c[m];
+                }
+            }
+            c
+        })
+        .collect()
+}
+
+/// The self-check of a solution before it is returned: at `t = 0` and at a
+/// few points of the torus ([`CHECK_PHASES`]) the quotients (9)–(10) must
+/// give a real state on the level set of `l0` (the integrals (6)–(7)) whose
+/// velocity along `U` is Frahm's (1), and `l(0) = l0`. A constant or branch
+/// of the set-up that is wrong shows at once; the velocity fit at `v0` alone
+/// does not see every such error (a wrong sign of a `C_L` whose `P_L(l0)`
+/// vanishes reproduces `l0` and `l̇(0)`).
+pub(super) struct SelfCheck {
+    a: [f64; 4],
+    l0: [f64; 6],
+    c4: [f64; 6],
+    h: [f64; 4],
+    /// `|l0|`, the scale of `l`.
+    size: f64,
+    /// The scale of `l̇`: `(max c − min c) |l0|²` bounds `|l̇|` up to a factor
+    /// (adding a constant to every `c_ij` does not change (1)).
+    rate_scale: f64,
+    /// Scales of `h0 … h3`.
+    h_scale: [f64; 4],
+}
+
+impl SelfCheck {
+    pub(super) fn new(a: &[f64; 4], l0: &[f64; 6], c4: &[f64; 6]) -> Self {
+        let size = l0.iter().map(|x| x * x).sum::<f64>().sqrt();
+        let (cmin, cmax) = c4
+            .iter()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &c| {
+                (lo.min(c), hi.max(c))
+            });
+        let amax = a.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        let s2 = size * size;
+        SelfCheck {
+            a: *a,
+            l0: *l0,
+            c4: *c4,
+            h: so4::integrals4(a, l0),
+            size,
+            rate_scale: (cmax - cmin) * s2,
+            h_scale: [s2, s2, 2.0 * amax * s2, amax * amax * s2],
+        }
+    }
+
+    /// The largest relative defect over the check points (0 is perfect; NaN
+    /// counts as infinite): `|l(0) − l0|/|l0|`, `|Im l|/|l0|`, the integrals
+    /// (6)–(7) of `Re l` against those of `l0`, and `|dl/dt − (1)|` relative to
+    /// [`SelfCheck::rate_scale`], with `dl/dt = (∇N − l ∇D)·U / D` from the theta
+    /// jet.
+    pub(super) fn defect(
+        &self,
+        plan: &ThetaPlan,
+        curve: &HyperellipticCurve,
+        idx: &[usize; 8],
+        b: &Built,
+        v0: &[C; 2],
+    ) -> Result<f64> {
+        // Lattice coordinates of v0 and U: the check points are taken modulo
+        // twice the lattice (as l(t) is), at times that are fractions of the
+        // shortest and of the longest lattice period of the motion, so that they
+        // spread over the torus also when its two periods differ by orders of
+        // magnitude (near degenerate sets).
+        let (x0, y0) = curve.lattice_coordinates(v0);
+        let (xr, yr) = curve.lattice_coordinates(&b.rate);
+        let rates: Vec<f64> = xr.iter().chain(yr.iter()).map(|v| v.abs()).collect();
+        let fastest = rates.iter().fold(0.0f64, |m, &v| m.max(v));
+        let slowest = rates
+            .iter()
+            .filter(|&&v| v > 1e-12 * fastest)
+            .fold(f64::INFINITY, |m, &v| m.min(v));
+        let p_fast = if fastest > 0.0 { 2.0 / fastest } else { 1.0 };
+        let p_slow = if slowest.is_finite() {
+            2.0 / slowest
+        } else {
+            p_fast
+        };
+        let mut times: Vec<f64> = vec![0.0];
+        times.extend(CHECK_PHASES.iter().map(|c| c * p_fast));
+        // The slow period up to SLOW_CHECK_CAP fast periods: the check is of the
+        // quotient's shape, not of the drift of the phase over long times.
+        let p_slow = p_slow.min(SLOW_CHECK_CAP * p_fast);
+        if p_slow > 2.0 * p_fast {
+            times.extend(CHECK_PHASES.iter().map(|c| c * p_slow));
+        }
+        let tau = curve.tau_row_major();
+        let at = |t: f64| -> [C; 2] {
+            let ph = |a: f64, r: f64| phase_mod2(a, r, t);
+            let x = [ph(x0[0], xr[0]), ph(x0[1], xr[1])];
+            let y = [ph(y0[0], yr[0]), ph(y0[1], yr[1])];
+            [
+                C::new(x[0], 0.0) + tau[0] * y[0] + tau[1] * y[1],
+                C::new(x[1], 0.0) + tau[2] * y[0] + tau[3] * y[1],
+            ]
+        };
+        // The velocity defect is relative to the largest speed |(1)| met at the
+        // check points, not to the scale (max c − min c)|l|²: near an equilibrium
+        // the motion is slow, and a defect small against that scale would be a
+        // large relative error of the velocity, hence of the phase.
+        let (mut ode_res, mut speed) = (0.0f64, 0.0f64);
+        let mut worst = 0.0f64;
+        let mut note = |x: f64| {
+            worst = if x.is_nan() {
+                f64::INFINITY
+            } else {
+                worst.max(x)
+            };
+        };
+        for (k, &t) in times.iter().enumerate() {
+            let v = if k == 0 { *v0 } else { at(t) };
+            let jet = plan.jet(&v, 1)?;
+            let theta = |m: usize| jet.values[idx[m]];
+            let grad = |m: usize, k: usize| jet.gradient[idx[m] * 2 + k];
+            let d: C = (0..8).map(|m| b.den[m] * theta(m)).sum();
+            let dg: [C; 2] = std::array::from_fn(|k| (0..8).map(|m| b.den[m] * grad(m, k)).sum());
+            let mut l = [0.0; 6];
+            let mut ldot = [0.0; 6];
+            for q in 0..6 {
+                let n: C = (0..8).map(|m| b.num[q][m] * theta(m)).sum();
+                let ng: [C; 2] =
+                    std::array::from_fn(|k| (0..8).map(|m| b.num[q][m] * grad(m, k)).sum());
+                let lq = n / d;
+                let dq = ((ng[0] - lq * dg[0]) * b.rate[0] + (ng[1] - lq * dg[1]) * b.rate[1]) / d;
+                l[q] = lq.re;
+                ldot[q] = dq.re;
+                note(lq.im.abs() / self.size);
+                note(dq.im.abs() / self.rate_scale);
+            }
+            let f = so4::vector_field4(&self.c4, &l);
+            for q in 0..6 {
+                ode_res = ode_res.max((ldot[q] - f[q]).abs());
+                speed = speed.max(f[q].abs());
+                if k == 0 {
+                    note((l[q] - self.l0[q]).abs() / self.size);
+                }
+            }
+            let h = so4::integrals4(&self.a, &l);
+            for ((hi, h0i), sc) in h.iter().zip(&self.h).zip(&self.h_scale) {
+                note((hi - h0i).abs() / sc);
+            }
+        }
+        note(ode_res / speed.max(1e-30 * self.rate_scale));
+        Ok(worst)
+    }
+}

@@ -1,0 +1,82 @@
+"""Reference trajectories of Frahm's equations (1) in 80-bit long double.
+
+heyoka's Taylor integrator (Biscani & Izzo, MNRAS 504 (2021)) with
+``fp_type=np.longdouble`` (64-bit significand, unit roundoff 5.4e-20) and
+tolerance 1e-19: an integrator independent of the package, about three digits
+more precise than double, used as the reference for the package's solutions and
+integrators. The c_ij enter as runtime parameters, so one compiled integrator
+serves every top.
+
+Used by the committed data scripts (e.g. ``every_state_harsh.py``); needs the
+``bench`` extra (heyoka).
+"""
+
+from __future__ import annotations
+
+from functools import lru_cache
+
+import numpy as np
+
+# State order (l12, l13, l14, l23, l24, l34); PAIRS[q] = (i, j), 0-based, i < j.
+PAIRS = [(0, 1), (0, 2), (0, 3), (1, 2), (1, 3), (2, 3)]
+REF_TOL = 1e-19
+
+
+@lru_cache(maxsize=1)
+def _integrator():
+    import heyoka as hy
+
+    x = hy.make_vars(*[f"l{i + 1}{j + 1}" for i, j in PAIRS])
+    index = {p: q for q, p in enumerate(PAIRS)}
+
+    def L(i, j):
+        if i == j:
+            return 0.0
+        return x[index[(i, j)]] if i < j else -x[index[(j, i)]]
+
+    def W(i, j):
+        if i == j:
+            return 0.0
+        q = index[(min(i, j), max(i, j))]
+        return hy.par[q] * L(i, j)
+
+    rhs = []
+    for i, j in PAIRS:
+        # (1): l'_ij = sum_k (l_ik w_kj - w_ik l_kj), w_ij = c_ij l_ij
+        terms = []
+        for k in range(4):
+            if k in (i, j):
+                continue
+            terms.append(L(i, k) * W(k, j) - W(i, k) * L(k, j))
+        rhs.append(hy.sum(terms))
+    return hy.taylor_adaptive(
+        list(zip(x, rhs)),
+        [np.longdouble(0)] * 6,
+        fp_type=np.longdouble,
+        tol=np.longdouble(REF_TOL),
+        pars=[np.longdouble(0)] * 6,
+        compact_mode=True,
+    )
+
+
+def c_pairs(a, b) -> np.ndarray:
+    """c_ij of (2) in long double, in the state order."""
+    a = np.asarray(a, dtype=np.longdouble)
+    b = np.asarray(b, dtype=np.longdouble)
+    return np.array([(b[i] - b[j]) / (a[i] - a[j]) for i, j in PAIRS], dtype=np.longdouble)
+
+
+def reference(a, b, l0, t) -> np.ndarray:
+    """l(t) at the sorted times ``t`` (t[0] >= 0) from l(0) = l0, as long double (len(t), 6)."""
+    ta = _integrator()
+    ta.time = np.longdouble(0)
+    ta.state[:] = np.asarray(l0, dtype=np.longdouble)
+    ta.pars[:] = c_pairs(a, b)
+    t = np.asarray(t, dtype=np.longdouble)
+    res = ta.propagate_grid(t, max_delta_t=np.longdouble(np.inf))
+    outcome = res[0]
+    import heyoka as hy
+
+    if outcome != hy.taylor_outcome.time_limit:
+        raise RuntimeError(f"heyoka stopped early: {outcome}")
+    return np.asarray(res[-1], dtype=np.longdouble)
