@@ -33,6 +33,7 @@
 
 pub mod curve;
 pub mod error;
+pub mod fluid;
 pub mod integrate;
 pub mod kotter;
 pub mod numeric;
