@@ -113,7 +113,7 @@ impl KirchhoffBody {
         });
         // A form whose smallest eigenvalue is rounding noise of the largest is
         // not positive definite in any sense the motion could rely on.
-        if !(lo > 4.0 * f64::EPSILON * hi) {
+        if lo.is_nan() || lo <= 4.0 * f64::EPSILON * hi {
             return Err(Error::InvalidArgument {
                 what: "A, B, C",
                 reason: format!(
