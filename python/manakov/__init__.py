@@ -7,6 +7,15 @@ Equation numbers in docstrings are the paper's.
 
 from ._core import ClosedFormError, ConvergenceError, __version__
 from .curve import CurvePoints, KotterCurve, Wurzel
+from .fluid import (
+    ClebschSolution,
+    FluidProblem,
+    FluidTrajectory,
+    KirchhoffBody,
+    SpaceTrajectory,
+    fluid_problem,
+    fluid_problem_names,
+)
 from .problems import Problem, benchmark_setup, problem, problem_names
 from .reduction import Kotter, LevelSet, from_kotter, kotter
 from .riemann import HyperellipticCurve
@@ -36,17 +45,23 @@ from .tori import FrequencyMap, Torus, frequency_map, real_torus
 __all__ = [
     "benchmark_setup",
     "char_index",
+    "ClebschSolution",
     "CHARACTERISTICS",
     "characteristics",
     "ClosedFormError",
     "ConvergenceError",
     "CurvePoints",
+    "FluidProblem",
+    "fluid_problem",
+    "fluid_problem_names",
+    "FluidTrajectory",
     "FrahmTop",
     "frequency_map",
     "FrequencyMap",
     "HyperellipticCurve",
     "from_kotter",
     "from_matrix",
+    "KirchhoffBody",
     "kotter",
     "Kotter",
     "LevelSet",
@@ -62,6 +77,7 @@ __all__ = [
     "problem_names",
     "real_torus",
     "Solution",
+    "SpaceTrajectory",
     "theta",
     "theta_all",
     "theta_jet",

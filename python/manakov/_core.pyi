@@ -10,6 +10,7 @@ __all__ = [
     "ConvergenceError",
     "check_budget",
     "check_c",
+    "ClebschCore",
     "curve_branch_points",
     "curve_constants",
     "curve_eval",
@@ -23,6 +24,8 @@ __all__ = [
     "hamiltonian",
     "integrate",
     "integrate_many",
+    "KirchhoffCore",
+    "kirchhoff_casimirs",
     "kotter_batch",
     "kotter_from_points",
     "kotter_lax_m",
@@ -268,3 +271,70 @@ class SolutionCore:
     def quotient(
         self,
     ) -> tuple[npt.NDArray[np.int64], npt.NDArray[np.complex128], npt.NDArray[np.complex128]]: ...
+
+@final
+class KirchhoffCore:
+    def __new__(
+        cls,
+        a: npt.NDArray[np.float64],
+        b: npt.NDArray[np.float64],
+        c: npt.NDArray[np.float64],
+    ) -> KirchhoffCore: ...
+    @property
+    def rate_scale(self) -> float: ...
+    def vector_field(self, y: npt.NDArray[np.float64]) -> npt.NDArray[np.float64]: ...
+    def hamiltonian(self, y: npt.NDArray[np.float64]) -> npt.NDArray[np.float64]: ...
+    def integrate(
+        self,
+        y0: npt.NDArray[np.float64],
+        t0: float,
+        times: npt.NDArray[np.float64],
+        method: str,
+        dt: float,
+        rtol: float,
+        atol: float,
+        max_steps: int,
+    ) -> tuple[npt.NDArray[np.float64], int, int, BaseException | None]: ...
+    def integrate_many(
+        self,
+        y0s: npt.NDArray[np.float64],
+        t0: float,
+        times: npt.NDArray[np.float64],
+        method: str,
+        dt: float,
+        rtol: float,
+        atol: float,
+        max_steps: int,
+        parallel: bool,
+    ) -> tuple[npt.NDArray[np.float64], int]: ...
+    def integrate_space(
+        self,
+        s0: npt.NDArray[np.float64],
+        t0: float,
+        times: npt.NDArray[np.float64],
+        method: str,
+        dt: float,
+        rtol: float,
+        atol: float,
+        max_steps: int,
+    ) -> tuple[npt.NDArray[np.float64], int, int, BaseException | None]: ...
+
+def kirchhoff_casimirs(y: npt.NDArray[np.float64]) -> npt.NDArray[np.float64]: ...
+
+@final
+class ClebschCore:
+    def __new__(cls, a: npt.NDArray[np.float64], c: npt.NDArray[np.float64]) -> ClebschCore: ...
+    @property
+    def alpha(self) -> npt.NDArray[np.float64]: ...
+    @property
+    def beta(self) -> npt.NDArray[np.float64]: ...
+    @property
+    def order(self) -> npt.NDArray[np.int64]: ...
+    @property
+    def body_a(self) -> npt.NDArray[np.float64]: ...
+    @property
+    def violation(self) -> float: ...
+    @property
+    def mobius(self) -> tuple[float, float]: ...
+    def to_so4(self, y: npt.NDArray[np.float64]) -> npt.NDArray[np.float64]: ...
+    def to_body(self, l: npt.NDArray[np.float64]) -> npt.NDArray[np.float64]: ...  # noqa: E741

@@ -149,13 +149,21 @@ impl ClebschConjugacy {
                 ),
             });
         }
-        // Least squares a (mod shift): each difference takes a third of r.
-        let e = r / 3.0;
-        let mut a = [0.0, -(d[2] - e), d[1] - e];
-        let mean_a = (a[0] + a[1] + a[2]) / 3.0;
-        a.iter_mut().for_each(|x| *x -= mean_a);
-        for (_, j, k) in CYC {
-            if a[j] == a[k] {
+        // The pair (p, q) with the smallest |a_p − a_q| = |d_k| keeps its
+        // difference exactly: A_k = (b_p − b_q)/(a_p − a_q) is a quotient of two
+        // small differences there, and the rounding of the violation r into
+        // a_p − a_q would move A_k by r/d_k (1e-10 on a body with
+        // C1 − C2 = 1.6e-6). The third axis takes r, split between its two
+        // (large) differences.
+        let k = (0..3)
+            .min_by(|&x, &y| d[x].abs().total_cmp(&d[y].abs()))
+            .unwrap_or(0);
+        let (_, p, q) = CYC[k];
+        let mut a = [0.0; 3];
+        a[q] = -d[k];
+        a[k] = 0.5 * ((a[q] - d[p]) + d[q]);
+        for (_, j, l) in CYC {
+            if a[j] == a[l] {
                 return Err(Error::InvalidArgument {
                     what: "C",
                     reason: format!(
@@ -163,13 +171,15 @@ impl ClebschConjugacy {
                          axisymmetric (Kirchhoff's case); its motion is elliptic, the \
                          genus-2 curve degenerates",
                         j + 1,
-                        k + 1,
+                        l + 1,
                         j + 1,
-                        k + 1
+                        l + 1
                     ),
                 });
             }
         }
+        let mean_a = (a[0] + a[1] + a[2]) / 3.0;
+        let a_centred = a.map(|x| x - mean_a);
         let mean_c = (c_diag[0] + c_diag[1] + c_diag[2]) / 3.0;
         let b = c_diag.map(|c| mean_c - c);
         // Sort the axes by a: sorted[0] has the smallest a.
@@ -187,19 +197,30 @@ impl ClebschConjugacy {
                 lambda / (x + (a[i] - a[sorted[0]]))
             }
         });
-        let rho = (al[0] * al[1] * al[2]).sqrt() / lambda;
-        let be: [f64; 3] = std::array::from_fn(|i| rho * b[i] * al[i]);
+        // β_i = (ρ/λ) b_i α_i, ρ = √(α1 α2 α3), up to β → β + p0 + p1 α (no change
+        // of the flow). In the gauge β_p = β_q = 0 the top's c_pq = 0 and
+        // c_p∞ = ρ A_k/α_p exactly, instead of a difference of two nearly equal
+        // c's (docs/clebsch.md, "Conditioning"); the remaining two relations
+        // (α_j/ρ)(c_j∞ − c_{j,l}) = A_m give β_∞ = −ρ A_k and β_k, taken as the
+        // mean of its two expressions (equal by Clebsch's condition).
+        let rho = (al[0] * al[1] * al[2]).sqrt();
+        let mut be = [0.0; 3];
+        be[k] = 0.5
+            * rho
+            * ((a_diag[p] - a_diag[k]) * (al[q] - al[k]) / al[q]
+                + (a_diag[q] - a_diag[k]) * (al[p] - al[k]) / al[p]);
+        let be_inf = -rho * a_diag[k];
         // Ascending α: ∞ (α = 0) first, then the axes by decreasing a.
         let orig = [3, sorted[2], sorted[1], sorted[0]];
         let alpha = orig.map(|o| if o == 3 { 0.0 } else { al[o] });
-        let beta = orig.map(|o| if o == 3 { 0.0 } else { be[o] });
+        let beta = orig.map(|o| if o == 3 { be_inf } else { be[o] });
         let sl = lambda.sqrt();
         let sm: [f64; 3] = std::array::from_fn(|j| 1.0 / al[j].sqrt());
         let sn: [f64; 3] = CYC.map(|(_, k, l)| sl / (al[k] * al[l]).sqrt());
         let sm_inv: [f64; 3] = std::array::from_fn(|j| al[j].sqrt());
         let sn_inv: [f64; 3] = CYC.map(|(_, k, l)| (al[k] * al[l]).sqrt() / sl);
         Ok(ClebschConjugacy {
-            a,
+            a: a_centred,
             b,
             violation,
             sigma,
@@ -268,7 +289,7 @@ impl ClebschConjugacy {
     }
 
     /// `y = L⁻¹ l`: the body's `(M, p)` of a state of the conjugate top.
-    pub fn from_so4(&self, l: &[f64; 6]) -> [f64; 6] {
+    pub fn to_body(&self, l: &[f64; 6]) -> [f64; 6] {
         let mut x = [[0.0; 4]; 4];
         for (p, &(q, r)) in crate::so4::PAIRS4.iter().enumerate() {
             let (i, j) = (self.orig[q], self.orig[r]);
@@ -315,7 +336,7 @@ impl ClebschSolution {
 
     /// `(M, p)` at time `t`.
     pub fn state(&self, t: f64) -> Result<[f64; 6]> {
-        Ok(self.conj.from_so4(&self.sol.l(t)?))
+        Ok(self.conj.to_body(&self.sol.l(t)?))
     }
 
     /// `(M, p)` at the times `t` into `out` (`6 t.len()` entries, row-major).
@@ -323,7 +344,7 @@ impl ClebschSolution {
         self.sol.l_batch(t, out, cancel)?;
         for row in out.chunks_exact_mut(6) {
             let l: [f64; 6] = std::array::from_fn(|k| row[k]);
-            row.copy_from_slice(&self.conj.from_so4(&l));
+            row.copy_from_slice(&self.conj.to_body(&l));
         }
         Ok(())
     }

@@ -286,7 +286,7 @@ fn clebsch_field_is_conjugate_to_a_manakov_top() {
                     "trial {trial}: X(L y) = {lhs:?} vs L X(y) = {rhs:?}"
                 );
             }
-            let back = conj.from_so4(&l);
+            let back = conj.to_body(&l);
             for k in 0..6 {
                 assert!((back[k] - y[k]).abs() <= 4.0 * f64::EPSILON * y[k].abs());
             }

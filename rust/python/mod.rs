@@ -10,6 +10,7 @@ use pyo3::prelude::*;
 mod arrays;
 mod curve;
 mod errors;
+mod fluid;
 mod integrate;
 mod kotter;
 mod riemann;
@@ -39,6 +40,7 @@ mod _core {
         tori::register(m)?;
         riemann::register(m)?;
         solution::register(m)?;
+        fluid::register(m)?;
         Ok(())
     }
 }

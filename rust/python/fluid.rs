@@ -1,0 +1,295 @@
+//! Bindings for `crate::fluid`: a frozen class holding a Kirchhoff body
+//! (field, energy, integration with the GIL released), and one holding the
+//! Clebsch conjugacy (the maps to and from the conjugate Manakov top).
+
+use numpy::ndarray::{Array2, Array3};
+use numpy::{IntoPyArray, PyArray1, PyArray2, PyArray3, PyReadonlyArray1, PyReadonlyArray2};
+use pyo3::prelude::*;
+
+use super::arrays::{array1, out_shape_err, rows, stack, vec1};
+use super::errors::py_cancel;
+use crate::error::Error;
+use crate::fluid::clebsch::ClebschConjugacy;
+use crate::fluid::{self, KirchhoffBody, SpaceMotion, DIM, SPACE_DIM};
+use crate::integrate::{self, Method, Options, VectorField};
+
+/// A 3 × 3 array as its 9 entries, row-major.
+fn mat3(x: &PyReadonlyArray2<'_, f64>, what: &'static str) -> PyResult<[f64; 9]> {
+    let r = rows::<f64, 3>(x, what, Some(3))?;
+    Ok(std::array::from_fn(|k| r[k / 3][k % 3]))
+}
+
+fn options(method: &str, dt: f64, rtol: f64, atol: f64, max_steps: u64) -> Result<Options, Error> {
+    let o = Options {
+        method: Method::from_name(method)?,
+        dt,
+        rtol,
+        atol,
+        max_steps,
+    };
+    o.validate()?;
+    Ok(o)
+}
+
+/// The result of an integration: `(y (S', m), steps, evals, error)`.
+type IntegrateOut<'py> = (
+    Bound<'py, PyArray2<f64>>,
+    u64,
+    u64,
+    Option<Bound<'py, PyAny>>,
+);
+
+/// Integrates `f` from `y0`; an error after the run started is returned, not raised,
+/// with the samples reached.
+#[allow(clippy::too_many_arguments)]
+fn run<'py, F: VectorField>(
+    py: Python<'py>,
+    f: &F,
+    y0: &[f64],
+    t0: f64,
+    times: &[f64],
+    opts: &Options,
+) -> PyResult<IntegrateOut<'py>> {
+    let cancel = py_cancel();
+    let (tr, res) = py.detach(|| integrate::integrate_partial(f, y0, t0, times, opts, &cancel))?;
+    let m = f.dim();
+    let y = Array2::from_shape_vec((tr.t.len(), m), tr.y)
+        .map_err(out_shape_err)?
+        .into_pyarray(py);
+    let err = res
+        .err()
+        .map(|e| PyErr::from(e).into_value(py).into_any().into_bound(py));
+    Ok((y, tr.steps, tr.evals, err))
+}
+
+/// A rigid body in an ideal fluid, `H = ½ (Mᵀ A M + 2 Mᵀ B p + pᵀ C p)`.
+#[pyclass(name = "KirchhoffCore", module = "manakov._core", frozen)]
+pub struct KirchhoffCore {
+    body: KirchhoffBody,
+}
+
+#[pymethods]
+impl KirchhoffCore {
+    #[new]
+    fn new(
+        a: PyReadonlyArray2<'_, f64>,
+        b: PyReadonlyArray2<'_, f64>,
+        c: PyReadonlyArray2<'_, f64>,
+    ) -> PyResult<Self> {
+        let (a, b, c) = (mat3(&a, "A")?, mat3(&b, "B")?, mat3(&c, "C")?);
+        Ok(KirchhoffCore {
+            body: KirchhoffBody::new(&a, &b, &c)?,
+        })
+    }
+
+    /// `‖Q'‖₂`, the rate scale of the field (Casimir parts removed).
+    #[getter]
+    fn rate_scale(&self) -> f64 {
+        self.body.rate_scale()
+    }
+
+    /// Kirchhoff's equations at each row of `y` (N, 6).
+    fn vector_field<'py>(
+        &self,
+        py: Python<'py>,
+        y: PyReadonlyArray2<'py, f64>,
+    ) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        let ys = rows::<f64, 6>(&y, "y", None)?;
+        let out: Vec<[f64; 6]> =
+            py.detach(|| ys.iter().map(|s| self.body.vector_field(s)).collect());
+        Ok(stack(out)?.into_pyarray(py))
+    }
+
+    /// The energy at each row of `y` (N, 6).
+    fn hamiltonian<'py>(
+        &self,
+        py: Python<'py>,
+        y: PyReadonlyArray2<'py, f64>,
+    ) -> PyResult<Bound<'py, PyArray1<f64>>> {
+        let ys = rows::<f64, 6>(&y, "y", None)?;
+        let out: Vec<f64> = py.detach(|| ys.iter().map(|s| self.body.hamiltonian(s)).collect());
+        Ok(out.into_pyarray(py))
+    }
+
+    /// Integrates from `y0` (6,) at `t0`, sampling at `times`: `(y (S', 6), steps,
+    /// evals, error)` (see `integrate` of the so(4) bindings).
+    #[pyo3(signature = (y0, t0, times, method, dt, rtol, atol, max_steps))]
+    #[allow(clippy::too_many_arguments)]
+    fn integrate<'py>(
+        &self,
+        py: Python<'py>,
+        y0: PyReadonlyArray1<'py, f64>,
+        t0: f64,
+        times: PyReadonlyArray1<'py, f64>,
+        method: &str,
+        dt: f64,
+        rtol: f64,
+        atol: f64,
+        max_steps: u64,
+    ) -> PyResult<IntegrateOut<'py>> {
+        let y0: [f64; DIM] = array1(&y0, "y0")?;
+        let times = vec1(&times, "times", None)?;
+        let opts = options(method, dt, rtol, atol, max_steps)?;
+        run(py, &self.body, &y0, t0, &times, &opts)
+    }
+
+    /// Integrates a batch `y0s` (B, 6); returns `(y (B, S, 6), steps)`.
+    #[pyo3(signature = (y0s, t0, times, method, dt, rtol, atol, max_steps, parallel))]
+    #[allow(clippy::too_many_arguments)]
+    fn integrate_many<'py>(
+        &self,
+        py: Python<'py>,
+        y0s: PyReadonlyArray2<'py, f64>,
+        t0: f64,
+        times: PyReadonlyArray1<'py, f64>,
+        method: &str,
+        dt: f64,
+        rtol: f64,
+        atol: f64,
+        max_steps: u64,
+        parallel: bool,
+    ) -> PyResult<(Bound<'py, PyArray3<f64>>, u64)> {
+        let y0s = rows::<f64, 6>(&y0s, "y0s", None)?;
+        let n = y0s.len();
+        let flat: Vec<f64> = y0s.into_iter().flatten().collect();
+        let times = vec1(&times, "times", None)?;
+        let opts = options(method, dt, rtol, atol, max_steps)?;
+        let cancel = py_cancel();
+        let body = &self.body;
+        let (ys, steps) = py.detach(|| {
+            integrate::integrate_many_with(body, &flat, t0, &times, &opts, parallel, &cancel)
+        })?;
+        let y = Array3::from_shape_vec((n, times.len(), DIM), ys)
+            .map_err(out_shape_err)?
+            .into_pyarray(py);
+        Ok((y, steps))
+    }
+
+    /// Integrates the body with its rotation and position, `s0 = (M, p, R row-major,
+    /// x)` (18,): `(s (S', 18), steps, evals, error)`.
+    #[pyo3(signature = (s0, t0, times, method, dt, rtol, atol, max_steps))]
+    #[allow(clippy::too_many_arguments)]
+    fn integrate_space<'py>(
+        &self,
+        py: Python<'py>,
+        s0: PyReadonlyArray1<'py, f64>,
+        t0: f64,
+        times: PyReadonlyArray1<'py, f64>,
+        method: &str,
+        dt: f64,
+        rtol: f64,
+        atol: f64,
+        max_steps: u64,
+    ) -> PyResult<IntegrateOut<'py>> {
+        let s0: [f64; SPACE_DIM] = array1(&s0, "s0")?;
+        let times = vec1(&times, "times", None)?;
+        let opts = options(method, dt, rtol, atol, max_steps)?;
+        run(
+            py,
+            &SpaceMotion { body: &self.body },
+            &s0,
+            t0,
+            &times,
+            &opts,
+        )
+    }
+}
+
+/// The Casimirs `(p·p, M·p)` at each row of `y` (N, 6).
+#[pyfunction(name = "kirchhoff_casimirs")]
+fn kirchhoff_casimirs_py<'py>(
+    py: Python<'py>,
+    y: PyReadonlyArray2<'py, f64>,
+) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    let ys = rows::<f64, 6>(&y, "y", None)?;
+    let out: Vec<[f64; 2]> = py.detach(|| ys.iter().map(fluid::casimirs).collect());
+    Ok(stack(out)?.into_pyarray(py))
+}
+
+/// The linear conjugacy of a Clebsch body to a Manakov top.
+#[pyclass(name = "ClebschCore", module = "manakov._core", frozen)]
+pub struct ClebschCore {
+    conj: ClebschConjugacy,
+}
+
+#[pymethods]
+impl ClebschCore {
+    #[new]
+    fn new(a: PyReadonlyArray1<'_, f64>, c: PyReadonlyArray1<'_, f64>) -> PyResult<Self> {
+        let (a, c): ([f64; 3], [f64; 3]) = (array1(&a, "A")?, array1(&c, "C")?);
+        Ok(ClebschCore {
+            conj: ClebschConjugacy::new(&a, &c)?,
+        })
+    }
+
+    /// `a` of the conjugate Manakov top.
+    #[getter]
+    fn alpha<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        self.conj.alpha().to_vec().into_pyarray(py)
+    }
+
+    /// `b` of the conjugate Manakov top.
+    #[getter]
+    fn beta<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        self.conj.beta().to_vec().into_pyarray(py)
+    }
+
+    /// The original index of each of the top's indices (0–2 the axes, 3 = ∞).
+    #[getter]
+    fn order<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<i64>> {
+        self.conj
+            .order()
+            .iter()
+            .map(|&o| o as i64)
+            .collect::<Vec<_>>()
+            .into_pyarray(py)
+    }
+
+    /// The body's `a_i` (`a_j − a_k = (C_k − C_j)/A_i`, mean 0).
+    #[getter]
+    fn body_a<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        self.conj.body_a().to_vec().into_pyarray(py)
+    }
+
+    /// Clebsch's condition relative to its terms.
+    #[getter]
+    fn violation(&self) -> f64 {
+        self.conj.violation()
+    }
+
+    /// `(σ, λ)` of the Möbius map `s = σ + λ/t`.
+    #[getter]
+    fn mobius(&self) -> (f64, f64) {
+        self.conj.mobius()
+    }
+
+    /// `l = L y` for each row of `y` (N, 6).
+    fn to_so4<'py>(
+        &self,
+        py: Python<'py>,
+        y: PyReadonlyArray2<'py, f64>,
+    ) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        let ys = rows::<f64, 6>(&y, "y", None)?;
+        let out: Vec<[f64; 6]> = py.detach(|| ys.iter().map(|s| self.conj.to_so4(s)).collect());
+        Ok(stack(out)?.into_pyarray(py))
+    }
+
+    /// `y = L⁻¹ l` for each row of `l` (N, 6).
+    fn to_body<'py>(
+        &self,
+        py: Python<'py>,
+        l: PyReadonlyArray2<'py, f64>,
+    ) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        let ls = rows::<f64, 6>(&l, "l", None)?;
+        let out: Vec<[f64; 6]> = py.detach(|| ls.iter().map(|s| self.conj.to_body(s)).collect());
+        Ok(stack(out)?.into_pyarray(py))
+    }
+}
+
+/// Adds this module's classes and functions to `manakov._core`.
+pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_class::<KirchhoffCore>()?;
+    m.add_class::<ClebschCore>()?;
+    m.add_function(wrap_pyfunction!(kirchhoff_casimirs_py, m)?)?;
+    Ok(())
+}
