@@ -223,7 +223,7 @@ impl ClebschConjugacy {
             a: a_centred,
             b,
             violation,
-            sigma,
+            sigma: sigma - mean_a,
             lambda,
             alpha,
             beta,
@@ -247,7 +247,8 @@ impl ClebschConjugacy {
     pub fn violation(&self) -> f64 {
         self.violation
     }
-    /// `(σ, λ)` of the Möbius map `s = σ + λ/t`.
+    /// `(σ, λ)` of the Möbius map `s = σ + λ/t`, `σ` in the coordinates of
+    /// [`ClebschConjugacy::body_a`]: `α_i = λ/(a_i − σ)`.
     pub fn mobius(&self) -> (f64, f64) {
         (self.sigma, self.lambda)
     }

@@ -45,8 +45,8 @@ def main() -> None:
             "case": "clebsch",
             "A": [1.0, 1.0, 1.0],
             "C": [1.0, 2.5, 4.0],
-            "M0": [0.3, 0.8, -0.5],
-            "p0": [-0.6, 0.4, 0.9],
+            "M0": [0.5, 0.5, 0.5],
+            "p0": [1.0, -0.5, 0.2],
             "note": "equal A_i: Clebsch's condition holds for every C (a_i = -C_i/A)",
         },
         "clebsch_near_degenerate": {
