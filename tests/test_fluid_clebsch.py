@@ -160,6 +160,17 @@ def test_closed_form_matches_integration_on_0_100(name):
     assert err <= CLOSED_FORM_RTOL, err
     np.testing.assert_allclose(sol.M(0.0), pr.M0, rtol=0, atol=1e-14 * scale)
     assert sol.M(t).shape == (201, 3) and sol.p(2.5).shape == (3,)
+    # (M, p) is a quotient of theta functions of v0 + U t (the explicit form).
+    idx, num, den = sol.quotient()
+    for tk in (0.0, 7.5):
+        v = sol.solution.u0 + sol.solution.riemann_constant + sol.U * tk
+        chars = [manakov.CHARACTERISTICS[i] for i in idx]
+        vals = [manakov.theta(v, sol.tau, char=c, log_scale=True) for c in chars]
+        logs = np.array([complex(lg) for _, lg in vals])
+        top = logs.real.max()
+        th = np.array([complex(x) * np.exp(lg - top) for (x, _), lg in zip(vals, logs)])
+        y = (num @ th / (den @ th)).real
+        np.testing.assert_allclose(y, np.concatenate(sol.state(tk)), rtol=0, atol=1e-12 * scale)
 
 
 def test_closed_form_on_random_states():

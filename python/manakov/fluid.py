@@ -1033,6 +1033,24 @@ class ClebschSolution:
         """Torus angles ``(ν1 t, ν2 t) mod 1``, shape ``(..., 2)``."""
         return self._solution.angles(t)
 
+    def quotient(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """The theta quotients of ``(M, p)``: ``(idx, num, den)`` with
+        ``y_q = Re(Σ_m num[q, m] θ[idx[m]](v) / Σ_m den[m] θ[idx[m]](v))``,
+        ``y = (M1, M2, M3, p1, p2, p3)``, ``v = u0 + K + U t`` (theta indices in the
+        package's characteristic order; :meth:`manakov.Solution.quotient` of the
+        conjugate top with its numerators mapped by ``L⁻¹``, a real linear map).
+
+        Returns
+        -------
+        idx : ndarray, int64, shape (8,)
+        num : ndarray, complex, shape (6, 8)
+        den : ndarray, complex, shape (8,)
+        """
+        idx, num, den = self._solution.quotient()
+        # Columns of L⁻¹: the images of the unit vectors of l.
+        T = np.stack([np.concatenate(self._body.from_so4(e)) for e in np.eye(6)], axis=1)
+        return idx, T @ num, den
+
     def __repr__(self) -> str:
         return f"ClebschSolution({self._solution!r})"
 
