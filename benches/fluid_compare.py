@@ -137,6 +137,10 @@ def heyoka_batch_run(ta, y0s: np.ndarray, t_end: float) -> np.ndarray:
     return out[:n]
 
 
+def line(label: str, t: float, e: float, extra: str = "") -> None:
+    print(f"{label:42s} {t * 1e3:10.2f} {e:9.1e} {extra}")
+
+
 def report(rows: list[tuple[str, str, float, float]]) -> None:
     """rows: (solver, setting, time, error). Per target, the fastest run of each solver."""
     solvers = ["manakov gauss16", "manakov dop853", "scipy DOP853", "heyoka"]
@@ -156,7 +160,7 @@ def report(rows: list[tuple[str, str, float, float]]) -> None:
             ratio = f" ({b[0] / ref[0]:.1f}x)" if ref is not None else ""
             cells.append(f"{b[0] * 1e3:13.2f} ms{ratio:>8s}")
         print(f"  {target:8.0e}  " + "  ".join(cells))
-    print("  (time of the fastest run with error <= target; in parentheses: time / manakov gauss16)")
+    print("  (fastest run with error <= target; in parentheses: time / manakov gauss16)")
 
 
 def single(name: str, t_end: float, repeats: int, scipy_repeats: int) -> None:
@@ -166,7 +170,7 @@ def single(name: str, t_end: float, repeats: int, scipy_repeats: int) -> None:
     ref = reference(body, y0[None, :], t_end)
     sys = heyoka_system(body)
     dt0 = body.default_dt(pr.M0, pr.p0)
-    print(f"\n{name} ({body.case}), single trajectory to t = {t_end:g}; default gauss16 step {dt0:.4f}")
+    print(f"\n{name} ({body.case}), one trajectory to t = {t_end:g}; default dt {dt0:.4f}")
     print(f"{'solver':42s} {'time [ms]':>10s} {'error':>9s} {'steps':>9s}")
     rows = []
     for f in DT_FACTORS:
@@ -175,7 +179,7 @@ def single(name: str, t_end: float, repeats: int, scipy_repeats: int) -> None:
         )
         e = rel_err(np.hstack([tr.M, tr.p])[-1:], ref)
         rows.append(("manakov gauss16", f"dt={f:g}x default", tm, e))
-        print(f"{f'manakov gauss16 dt = {f:g} x default':42s} {tm * 1e3:10.2f} {e:9.1e} {tr.steps:9d}")
+        line(f"manakov gauss16 dt = {f:g} x default", tm, e, f"{tr.steps:9d}")
     for rt in RTOLS:
         tm, tr = median_time(
             lambda rt=rt: body.integrate(
@@ -185,7 +189,7 @@ def single(name: str, t_end: float, repeats: int, scipy_repeats: int) -> None:
         )
         e = rel_err(np.hstack([tr.M, tr.p])[-1:], ref)
         rows.append(("manakov dop853", f"rtol={rt:.0e}", tm, e))
-        print(f"{f'manakov dop853 rtol = atol = {rt:.0e}':42s} {tm * 1e3:10.2f} {e:9.1e} {tr.steps:9d}")
+        line(f"manakov dop853 rtol = atol = {rt:.0e}", tm, e, f"{tr.steps:9d}")
     f = field_numpy(body)
     for rt in RTOLS:
         tm, sol = median_time(
@@ -196,7 +200,7 @@ def single(name: str, t_end: float, repeats: int, scipy_repeats: int) -> None:
         )
         e = rel_err(sol.y.T, ref)
         rows.append(("scipy DOP853", f"rtol={rt:.0e}", tm, e))
-        print(f"{f'scipy DOP853 rtol = atol = {rt:.0e}':42s} {tm * 1e3:10.2f} {e:9.1e} {sol.nfev:9d} evals")
+        line(f"scipy DOP853 rtol = atol = {rt:.0e}", tm, e, f"{sol.nfev:9d} evals")
     for tol in HEYOKA_TOLS:
         tc, ta = heyoka_compile(sys, False, tol)
 
@@ -209,7 +213,7 @@ def single(name: str, t_end: float, repeats: int, scipy_repeats: int) -> None:
         th, y = median_time(run, repeats)
         e = rel_err(y[None, :], ref)
         rows.append(("heyoka", f"tol={tol:.1e}", th, e))
-        print(f"{f'heyoka tol = {tol:.1e}':42s} {th * 1e3:10.2f} {e:9.1e}   compile {tc:.2f} s")
+        line(f"heyoka tol = {tol:.1e}", th, e, f"  compile {tc:.2f} s")
     report(rows)
 
 
@@ -235,13 +239,13 @@ def batch(n: int, t_end: float, repeats: int, ref_states: int) -> None:
         )
         e = rel_err(np.hstack([Ms[:, -1], ps[:, -1]]), ref)
         rows.append(("manakov gauss16", f"dt={f:g}x", tm, e))
-        print(f"{f'manakov gauss16 dt = {f:g} x default':42s} {tm * 1e3:10.2f} {e:9.1e}")
+        line(f"manakov gauss16 dt = {f:g} x default", tm, e)
     for tol in HEYOKA_TOLS:
         tc, ta = heyoka_compile(sys, True, tol)
         th, y = median_time(lambda ta=ta: heyoka_batch_run(ta, y0s, t_end), repeats)
         e = rel_err(y, ref)
         rows.append(("heyoka", f"tol={tol:.1e}", th, e))
-        print(f"{f'heyoka batch tol = {tol:.1e}':42s} {th * 1e3:10.2f} {e:9.1e}   compile {tc:.2f} s")
+        line(f"heyoka batch tol = {tol:.1e}", th, e, f"  compile {tc:.2f} s")
     report(rows)
 
 
