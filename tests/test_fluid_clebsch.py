@@ -332,8 +332,10 @@ def test_solve_refuses_other_bodies_and_singular_states():
         _ = gen.body.conjugate_top
     body = manakov.fluid_problem("clebsch_generic").body
     # M·p = 0: h0 = 0 for the conjugate top, the genus drops.
-    with pytest.raises(ValueError, match="h0"):
+    with pytest.raises(ValueError, match=r"M0·p0 = 0.*h0"):
         body.solve([1.0, 0.0, 0.0], [0.0, 1.0, 0.0])
+    with pytest.raises(ValueError, match="p0 = 0"):
+        body.solve([1.0, 0.5, 0.0], [0.0, 0.0, 0.0])
     with pytest.raises(ValueError, match="finite"):
         body.solve([np.nan, 0, 0], [0, 1, 0])
     with pytest.raises(ValueError, match=r"shape \(3,\)"):

@@ -948,7 +948,22 @@ class ClebschSolution:
         for x in (self._M0, self._p0):
             x.setflags(write=False)
         l0 = body.to_so4(self._M0, self._p0)
-        self._solution = Solution(top.a, top.b, l0)
+        try:
+            self._solution = Solution(top.a, top.b, l0)
+        except ValueError as err:
+            M0a, p0a = self._M0, self._p0
+            hint = ""
+            if not np.any(p0a):
+                hint = "p0 = 0: the body turns as Euler's top (elliptic functions), h0 = 0; "
+            elif abs(M0a @ p0a) <= 1e-13 * np.linalg.norm(M0a) * np.linalg.norm(p0a):
+                hint = (
+                    "M0·p0 = 0, the conjugate top's h0 = 0: two branch points of the curve "
+                    "coincide and the genus drops; "
+                )
+            raise ValueError(
+                f"no genus-2 solution through M0 = {M0a.tolist()}, p0 = {p0a.tolist()}: "
+                f"{hint}the conjugate Manakov top says: {err}"
+            ) from None
 
     @property
     def body(self) -> KirchhoffBody:
