@@ -68,9 +68,10 @@ _EXPLICIT = ("dopri5", "dop853")
 
 #: Default Gauss step in units of ``1/Ω``, ``Ω = ‖Q'‖₂ |(M0, p0)|`` (``Q'`` the
 #: energy matrix without its Casimir parts, :attr:`KirchhoffBody.rate_scale`).
-#: Chosen on random dense bodies and the committed Clebsch bodies so that
-#: gauss16 is at roundoff (error at t = 20 ~1e-15 against a 10× smaller step,
-#: 1e-13 at 1.5/Ω) with ~15 stage sweeps per step; docs/clebsch.md.
+#: gauss16 at ``1/Ω`` is at roundoff: ≤ 6.7e-14 against a 20× smaller step on 8
+#: random dense bodies (t = 2) and the seven reference bodies (t = 20), with 11–16
+#: stage sweeps per step; at ``1.5/Ω`` up to 1.8e-10 (tests/data/fluid_step_study.py).
+#: gauss4 and gauss6 keep the so(4) top's ratios to gauss16.
 DT_SCALE = {"gauss4": 0.007, "gauss6": 0.03, "gauss16": 1.0}
 
 _CYC = ((0, 1, 2), (1, 2, 0), (2, 0, 1))
