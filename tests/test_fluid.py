@@ -7,11 +7,14 @@ translation, a steady rotation).
 
 from __future__ import annotations
 
+import os
 import time
 from pathlib import Path
 
 import numpy as np
 import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
 from scipy.integrate import solve_ivp
 
 import manakov
@@ -395,3 +398,81 @@ def test_reference_bodies_match_their_generator():
     subprocess.run([sys.executable, str(script)], check=True, capture_output=True)
     assert path.read_text() == before
     assert json.loads(before)["bodies"]
+
+
+# --- fuzzing -------------------------------------------------------------------
+
+
+#: Documented exceptions; a Rust panic (PanicException, a BaseException) fails.
+ALLOWED = (ValueError, manakov.ConvergenceError)
+#: Cases per property (MANAKOV_FUZZ_SLOW=1: 3000, as tests/test_fuzz.py widens its runs).
+FUZZ_EXAMPLES = 3000 if os.environ.get("MANAKOV_FUZZ_SLOW") else 60
+FUZZ = settings(
+    max_examples=FUZZ_EXAMPLES,
+    deadline=None,
+    derandomize=True,
+    suppress_health_check=list(HealthCheck),
+)
+
+_finite = st.floats(allow_nan=False, allow_infinity=False, width=64)
+_any = st.floats(width=64)
+_exp = st.integers(-300, 300)
+
+
+def _call(fn, *args, **kw):
+    try:
+        return fn(*args, **kw)
+    except ALLOWED:
+        return None
+    except BaseException as e:  # noqa: BLE001 - a panic is a BaseException
+        raise AssertionError(f"undocumented {type(e).__name__}: {e}") from e
+
+
+@FUZZ
+@given(st.lists(_any, min_size=27, max_size=27), st.lists(_any, min_size=6, max_size=6), _exp)
+def test_fuzz_bodies_and_states(entries, state, e):
+    """Any A, B, C (scaled by 10^e, NaN and infinities included) and any state:
+    a body or ValueError; then finite results or ValueError/ConvergenceError."""
+    with np.errstate(all="ignore"):  # the inputs themselves may overflow to inf
+        m = np.array(entries).reshape(3, 3, 3) * 10.0**e
+        sym = [0.5 * m[0] + 0.5 * m[0].T, m[1], 0.5 * m[2] + 0.5 * m[2].T]
+    body = _call(manakov.KirchhoffBody, *sym)
+    if body is None:
+        return
+    y = np.array(state)
+    y_copy = y.copy()
+    for fn in (body.vector_field, body.hamiltonian, body.integrals):
+        out = _call(fn, y[:3], y[3:])
+        if out is not None:
+            vals = list(out.values()) if isinstance(out, dict) else out
+            vals = vals if isinstance(vals, (list, tuple)) else [vals]
+            assert all(np.all(np.isfinite(v)) for v in vals)
+    tr = _call(body.integrate, y[:3], y[3:], 1.0, max_steps=10**5)
+    if tr is not None:
+        assert np.all(np.isfinite(tr.M)) and np.all(np.isfinite(tr.p))
+    np.testing.assert_array_equal(y, y_copy)
+
+
+@FUZZ
+@given(
+    st.lists(st.floats(1e-3, 1e3), min_size=3, max_size=3),
+    st.floats(-10, 10),
+    st.floats(0, 1e3),
+    st.lists(_finite.filter(lambda x: abs(x) < 1e6), min_size=6, max_size=6),
+    st.integers(-100, 100),
+)
+def test_fuzz_clebsch(A, theta, kappa, state, e):
+    """Clebsch bodies over wide scales (C_i = κ + θ A_j A_k, then all times 10^e):
+    the conjugacy and the closed form give finite values or documented errors."""
+    A = np.array(A) * 10.0**e
+    C = kappa * 10.0**e + theta * np.array([A[1] * A[2], A[2] * A[0], A[0] * A[1]]) / 10.0**e
+    body = _call(manakov.KirchhoffBody.clebsch, A, C)
+    if body is None:
+        return
+    y = np.array(state)
+    sol = _call(body.solve, y[:3], y[3:])
+    if sol is None:
+        return
+    out = _call(sol.state, [0.0, 1.0, 10.0])
+    if out is not None:
+        assert np.all(np.isfinite(out[0])) and np.all(np.isfinite(out[1]))

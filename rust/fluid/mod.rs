@@ -107,10 +107,16 @@ impl KirchhoffBody {
             })
         });
         let body = KirchhoffBody { a, b, c, diagonal };
-        let eig = body.energy_matrix().symmetric_eigenvalues();
-        let (lo, hi) = eig.iter().fold((f64::INFINITY, 0.0f64), |(lo, hi), &e| {
-            (lo.min(e), hi.max(e.abs()))
-        });
+        let (lo, hi) = scaled_eigen_range(&body.energy_matrix());
+        if !(hi.is_finite() && body.rate_scale().is_finite()) {
+            return Err(Error::InvalidArgument {
+                what: "A, B, C",
+                reason: format!(
+                    "the energy's eigenvalues overflow the double range (largest {hi:e}); \
+                     rescale A, B, C (H -> H/s rescales time, t -> s t)"
+                ),
+            });
+        }
         // A form whose smallest eigenvalue is rounding noise of the largest is
         // not positive definite in any sense the motion could rely on.
         if lo.is_nan() || lo <= 4.0 * f64::EPSILON * hi {
@@ -146,8 +152,9 @@ impl KirchhoffBody {
         let mut q = Matrix6::zeros();
         for i in 0..3 {
             for j in 0..3 {
-                q[(i, j)] = 0.5 * (self.a[3 * i + j] + self.a[3 * j + i]);
-                q[(3 + i, 3 + j)] = 0.5 * (self.c[3 * i + j] + self.c[3 * j + i]);
+                // Halved before adding: entries near the double limit do not overflow.
+                q[(i, j)] = 0.5 * self.a[3 * i + j] + 0.5 * self.a[3 * j + i];
+                q[(3 + i, 3 + j)] = 0.5 * self.c[3 * i + j] + 0.5 * self.c[3 * j + i];
                 q[(i, 3 + j)] = self.b[3 * i + j];
                 q[(3 + j, i)] = self.b[3 * i + j];
             }
@@ -163,16 +170,22 @@ impl KirchhoffBody {
     /// with its inverse.
     pub fn rate_scale(&self) -> f64 {
         let mu = (self.b[0] + self.b[4] + self.b[8]) / 3.0;
-        let cm = Matrix3::from_row_slice(&self.c);
-        let ce = (0.5 * (cm + cm.transpose())).symmetric_eigenvalues();
-        let kappa = 0.5 * (ce.max() + ce.min());
         let mut q = self.energy_matrix();
+        let cm: Matrix3<f64> = q.fixed_view::<3, 3>(3, 3).into_owned();
+        let sc = cm.amax();
+        let kappa = if sc > 0.0 && sc.is_finite() {
+            let ce = (cm / sc).symmetric_eigenvalues();
+            0.5 * (ce.max() + ce.min()) * sc
+        } else {
+            0.0
+        };
         for i in 0..3 {
             q[(i, 3 + i)] -= mu;
             q[(3 + i, i)] -= mu;
             q[(3 + i, 3 + i)] -= kappa;
         }
-        q.symmetric_eigenvalues().amax()
+        let (lo, hi) = scaled_eigen_range(&q);
+        hi.max(-lo)
     }
 
     /// `ω = ∂H/∂M = A M + B p` and `v = ∂H/∂p = Bᵀ M + C p`.
@@ -256,6 +269,21 @@ impl KirchhoffBody {
         0.5 * ((y[0] * w[0] + y[1] * w[1] + y[2] * w[2])
             + (y[3] * v[0] + y[4] * v[1] + y[5] * v[2]))
     }
+}
+
+/// The smallest eigenvalue and the largest modulus of the eigenvalues of a
+/// symmetric 6 × 6 matrix, computed on the matrix scaled to entries ≤ 1 (so the
+/// iteration never sees an overflowed square) and scaled back.
+fn scaled_eigen_range(q: &Matrix6<f64>) -> (f64, f64) {
+    let s = q.amax();
+    if s == 0.0 || !s.is_finite() {
+        return (0.0, if s == 0.0 { 0.0 } else { f64::INFINITY });
+    }
+    let eig = (q / s).symmetric_eigenvalues();
+    let (lo, hi) = eig.iter().fold((f64::INFINITY, 0.0f64), |(lo, hi), &e| {
+        (lo.min(e), hi.max(e.abs()))
+    });
+    (lo * s, hi * s)
 }
 
 /// The Casimirs of e(3)*: `(p·p, M·p)`.
