@@ -407,7 +407,15 @@ def test_sigint_writes_partial_output_and_exits_130(tmp_path, suffix):
 
 def test_commands_registry_builds_the_parser():
     names = [c.name for c in cli.COMMANDS]
-    assert names == ["simulate", "kotter", "theta", "theorem", "frequency-map"]
+    assert names == [
+        "simulate",
+        "kotter",
+        "theta",
+        "theorem",
+        "frequency-map",
+        "fluid-simulate",
+        "fluid-theorem",
+    ]
     for c in cli.COMMANDS:
         assert callable(c.run) and callable(c.add_arguments) and c.example.startswith("manakov ")
 

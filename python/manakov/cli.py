@@ -17,6 +17,9 @@ Subcommands (``manakov <command> --help`` shows each with an example):
     divisor in the complex x-plane.
 ``theta``
     Values of the theta functions (34)-(36) at a point.
+``fluid-simulate``, ``fluid-theorem``
+    A rigid body in an ideal fluid (Kirchhoff's equations) and the Clebsch case
+    in theta functions; see ``manakov._cli_fluid``.
 
 Ctrl-C stops any command: ``simulate`` writes the samples computed so far
 (to ``<output stem>.partial<suffix>``, marked partial), prints one line and
@@ -43,7 +46,7 @@ from typing import Any, TextIO
 
 import numpy as np
 
-from . import __version__, problem, problem_names
+from . import __version__, _cli_fluid, problem, problem_names
 from ._progress import ProgressBar
 from .top import DEFAULT_MAX_STEPS, METHODS, ManakovTop, state_dim
 
@@ -655,6 +658,29 @@ COMMANDS: tuple[Command, ...] = (
         _add_frequency_map,
         _run_frequency_map,
     ),
+    Command(
+        "fluid-simulate",
+        "integrate a rigid body in an ideal fluid and write its motion in space",
+        "Integrate Kirchhoff's equations dM/dt = M x dH/dM + p x dH/dp, dp/dt = p x dH/dM "
+        "for H = (M^T A M + 2 M^T B p + p^T C p)/2, with the body's rotation R and position "
+        "x in space (docs/clebsch.md). Writes t, M, p, R, x and the integrals (.npz or .csv) "
+        "and a PNG of the path, the body's axes, M, p and the drift of the integrals. "
+        "Ctrl-C writes the samples so far to <output stem>.partial<suffix>, status 130.",
+        "manakov fluid-simulate clebsch_generic --t-end 60 -o clebsch.npz\n"
+        "  manakov fluid-simulate --A 1,2,3 --B 0,0,0 --C 2,1,3 --M0 1,0,0.5 --p0 0,1,0.2",
+        _cli_fluid.add_simulate,
+        _cli_fluid.run_simulate,
+    ),
+    Command(
+        "fluid-theorem",
+        "M(t), p(t) of a Clebsch body from theta functions against integration, as a PNG",
+        "The Clebsch case in closed form: the body's field is linearly conjugate to a "
+        "Manakov top's, and M(t), p(t) are the Theorem's theta quotients at v0 + U t mapped "
+        "back (docs/clebsch.md); plotted against gauss16, with their difference.",
+        "manakov fluid-theorem clebsch_generic -o clebsch-theorem.png",
+        _cli_fluid.add_theorem,
+        _cli_fluid.run_theorem,
+    ),
 )
 
 
@@ -699,7 +725,7 @@ def main(argv: Sequence[str] | None = None) -> int:
             status = run(args)
             sys.stdout.flush()
             return status
-        except Interrupted as e:
+        except (Interrupted, _cli_fluid.FluidInterrupted) as e:
             print(f"manakov: {e}", file=sys.stderr)
             return EXIT_INTERRUPTED
         except BrokenPipeError:

@@ -59,6 +59,7 @@ __all__ = [
     "fluid_problem_names",
     "plot_clebsch_theorem",
     "plot_motion",
+    "plot_space_trajectory",
 ]
 
 #: The integrable cases :class:`KirchhoffBody` knows by name (``"general"``: none).
@@ -1244,11 +1245,6 @@ def plot_motion(
     SpaceTrajectory
         The motion that was plotted.
     """
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
     t_end_f = _scalar(t_end, "t_end")
     if not t_end_f > 0:
         raise ValueError(f"t_end must be > 0, got {t_end_f}")
@@ -1256,6 +1252,33 @@ def plot_motion(
         raise ValueError(f"samples must be >= 2, got {samples}")
     t = np.linspace(0.0, t_end_f, int(samples))
     tr = body.motion_in_space(M0, p0, t_end_f, t_eval=t)
+    plot_space_trajectory(body, tr, path, frames=frames)
+    return tr
+
+
+def plot_space_trajectory(
+    body: KirchhoffBody, tr: SpaceTrajectory, path: str, *, frames: int = 12
+) -> None:
+    """Plot a computed :class:`SpaceTrajectory` of ``body`` as in :func:`plot_motion`.
+
+    Parameters
+    ----------
+    body : KirchhoffBody
+    tr : SpaceTrajectory
+        From :meth:`KirchhoffBody.motion_in_space` (at least 2 samples).
+    path : str
+        The PNG file to write.
+    frames : int
+        How many instants show the body's axes.
+    """
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    if tr.t.size < 2:
+        raise ValueError(f"the trajectory needs at least 2 samples, got {tr.t.size}")
+    t = tr.t
     P, K = tr.impulse(), tr.moment()
     fig = plt.figure(figsize=(13, 4.6))
     ax = fig.add_subplot(1, 3, 1, projection="3d")
@@ -1266,7 +1289,8 @@ def plot_motion(
         for i, col in enumerate(("tab:red", "tab:green", "tab:blue")):
             e = tr.R[k][:, i] * size
             ax.plot(*np.stack([tr.x[k], tr.x[k] + e]).T, color=col, lw=1.2)
-    ax.quiver(*tr.x[0], *(P[0] / np.linalg.norm(P[0]) * 2 * size), color="k", lw=1.5)
+    if np.any(P[0]):
+        ax.quiver(*tr.x[0], *(P[0] / np.linalg.norm(P[0]) * 2 * size), color="k", lw=1.5)
     ax.set_box_aspect(tuple(np.maximum(np.ptp(tr.x, axis=0), 1e-3 * span)))
     ax.set_title("origin's path, body axes (r, g, b), impulse P", fontsize=9)
     ax.set_xlabel("x1")
@@ -1291,11 +1315,13 @@ def plot_motion(
     ax3.set_xlabel("t")
     ax3.set_title("running maximum of the relative drift", fontsize=9)
     ax3.legend(fontsize=7)
-    fig.suptitle(f"{body.case} body in an ideal fluid, {tr.method}, dt = {tr.dt:.3g}", fontsize=10)
+    step = (float(t[-1]) - float(t[0])) / tr.steps if tr.steps else float("nan")
+    fig.suptitle(
+        f"{body.case} body in an ideal fluid, {tr.method}, mean step {step:.3g}", fontsize=10
+    )
     fig.tight_layout()
     fig.savefig(path, dpi=100)
     plt.close(fig)
-    return tr
 
 
 def plot_clebsch_theorem(
