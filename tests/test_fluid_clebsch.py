@@ -144,6 +144,26 @@ def test_package_conjugacy(name):
         np.testing.assert_allclose(np.concatenate(back), np.r_[M, p], rtol=4e-16, atol=0)
 
 
+@pytest.mark.parametrize("name", CLEBSCH)
+def test_direction_of_U_is_the_image_of_mu_c(name):
+    """The top's μ_b = Σ α_i + p2/p3 (docs/theorem.md, the direction of U) is the
+    Möbius image λ/(μ_c − σ) of the body's μ_c = a1 + a2 + a3 + q1/q2,
+    b = −C = q0 + q1 a + q2 a²."""
+    body = manakov.fluid_problem(name).body
+    conj = body._clebsch
+    a, b = conj.body_a, -np.diag(body.C)
+    q = np.linalg.solve(np.vander(a, 3, increasing=True), b)
+    sigma, lam = conj.mobius
+    top = body.conjugate_top
+    p = np.linalg.solve(np.vander(top.a, 4, increasing=True), top.b)
+    mu_b = top.a.sum() + p[2] / p[3]
+    if abs(q[2]) < 1e-14 * np.max(np.abs(q)):  # b linear in a: μ_c = ∞, μ_b = 0
+        assert abs(mu_b) < 1e-14
+        return
+    mu_c = a.sum() + q[1] / q[2]
+    assert mu_b == pytest.approx(lam / (mu_c - sigma), rel=1e-12, abs=1e-14)
+
+
 # --- the closed form ---------------------------------------------------------
 
 
