@@ -217,6 +217,25 @@ def test_cases_are_recognised():
         manakov.KirchhoffBody.lyapunov_steklov([0.7, 1.3, 2.1], 0.37)
 
 
+def test_clebsch_condition_tolerance_is_the_documented_one():
+    from manakov.fluid import CLEBSCH_RTOL
+
+    A = np.array([0.7, 1.3, 2.2])
+    C = 1.5 + 0.6 * np.array([A[1] * A[2], A[2] * A[0], A[0] * A[1]])
+    terms = np.array([(C[1] - C[2]) / A[0], (C[2] - C[0]) / A[1], (C[0] - C[1]) / A[2]])
+    scale = np.sum(np.abs(terms))
+    for factor, ok in ((0.5, True), (2.0, False)):
+        # Move C1 so that the condition is off by factor * CLEBSCH_RTOL of its terms.
+        dC = factor * CLEBSCH_RTOL * scale / (1 / A[2] - 1 / A[1])
+        C2 = C.copy()
+        C2[0] += dC
+        if ok:
+            assert manakov.KirchhoffBody.clebsch(A, C2).case == "clebsch"
+        else:
+            with pytest.raises(ValueError, match="Clebsch's condition"):
+                manakov.KirchhoffBody.clebsch(A, C2)
+
+
 def test_gauss16_agrees_with_scipy_dop853():
     rng = np.random.default_rng(7)
     cases = [

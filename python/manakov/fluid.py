@@ -49,6 +49,7 @@ from .tori import frequency_map as _frequency_map
 
 __all__ = [
     "CASES",
+    "CLEBSCH_RTOL",
     "DT_SCALE",
     "ClebschSolution",
     "FluidProblem",
@@ -76,6 +77,12 @@ _EXPLICIT = ("dopri5", "dop853")
 #: stage sweeps per step; at ``1.5/Ω`` up to 1.8e-10 (tests/data/fluid_step_study.py).
 #: gauss4 and gauss6 keep the so(4) top's ratios to gauss16.
 DT_SCALE = {"gauss4": 0.007, "gauss6": 0.03, "gauss16": 1.0}
+
+#: Clebsch's condition must hold to this fraction of ``Σ |C_j − C_k|/A_i`` (the
+#: core's ``fluid::clebsch::CLEBSCH_RTOL``): coefficients computed in floating
+#: point violate it by a few ulps; a larger violation is another body, which the
+#: closed form would silently replace by its nearest Clebsch body.
+CLEBSCH_RTOL = 1e-12
 
 _CYC = ((0, 1, 2), (1, 2, 0), (2, 0, 1))
 
