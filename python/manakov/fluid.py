@@ -374,9 +374,9 @@ class KirchhoffBody:
         Flüssigkeit*, Math. Ann. 42 (1893) 273–294; A. M. Lyapunov, *A new case of
         integrability of the equations of motion of a rigid body in a fluid*
         (1893); the explicit solution: Yu. N. Fedorov, B. Basak, Regul. Chaotic
-        Dyn. 16 (2011) 374–395). This form was recalled, not copied from a text
-        at hand; that ``F`` is conserved by it (and by no nearby form) is what the
-        tests check. The Casimir terms ``κ``, ``μ`` do not change the motion;
+        Dyn. 16 (2011) 374–395; their notation may differ). The tests establish
+        this form: ``F`` is conserved along the motion, and not when the sign of
+        ``ε`` in ``H`` is flipped. The Casimir terms ``κ``, ``μ`` do not change the motion;
         they make the energy positive definite where the bare form is not.
 
         Parameters
