@@ -2,64 +2,19 @@
 //! (field, energy, integration with the GIL released), and one holding the
 //! Clebsch conjugacy (the maps to and from the conjugate Manakov top).
 
-use numpy::ndarray::{Array2, Array3};
 use numpy::{IntoPyArray, PyArray1, PyArray2, PyArray3, PyReadonlyArray1, PyReadonlyArray2};
 use pyo3::prelude::*;
 
-use super::arrays::{array1, out_shape_err, rows, stack, vec1};
-use super::errors::py_cancel;
-use crate::error::Error;
+use super::arrays::{array1, rows, stack, vec1};
+use super::integrate::{run_many, run_partial, IntegrateOut};
 use crate::fluid::clebsch::ClebschConjugacy;
 use crate::fluid::{self, KirchhoffBody, SpaceMotion, DIM, SPACE_DIM};
-use crate::integrate::{self, Method, Options, VectorField};
+use crate::integrate::Options;
 
 /// A 3 × 3 array as its 9 entries, row-major.
 fn mat3(x: &PyReadonlyArray2<'_, f64>, what: &'static str) -> PyResult<[f64; 9]> {
     let r = rows::<f64, 3>(x, what, Some(3))?;
     Ok(std::array::from_fn(|k| r[k / 3][k % 3]))
-}
-
-fn options(method: &str, dt: f64, rtol: f64, atol: f64, max_steps: u64) -> Result<Options, Error> {
-    let o = Options {
-        method: Method::from_name(method)?,
-        dt,
-        rtol,
-        atol,
-        max_steps,
-    };
-    o.validate()?;
-    Ok(o)
-}
-
-/// The result of an integration: `(y (S', m), steps, evals, error)`.
-type IntegrateOut<'py> = (
-    Bound<'py, PyArray2<f64>>,
-    u64,
-    u64,
-    Option<Bound<'py, PyAny>>,
-);
-
-/// Integrates `f` from `y0`; an error after the run started is returned, not raised,
-/// with the samples reached.
-#[allow(clippy::too_many_arguments)]
-fn run<'py, F: VectorField>(
-    py: Python<'py>,
-    f: &F,
-    y0: &[f64],
-    t0: f64,
-    times: &[f64],
-    opts: &Options,
-) -> PyResult<IntegrateOut<'py>> {
-    let cancel = py_cancel();
-    let (tr, res) = py.detach(|| integrate::integrate_partial(f, y0, t0, times, opts, &cancel))?;
-    let m = f.dim();
-    let y = Array2::from_shape_vec((tr.t.len(), m), tr.y)
-        .map_err(out_shape_err)?
-        .into_pyarray(py);
-    let err = res
-        .err()
-        .map(|e| PyErr::from(e).into_value(py).into_any().into_bound(py));
-    Ok((y, tr.steps, tr.evals, err))
 }
 
 /// A rigid body in an ideal fluid, `H = ½ (Mᵀ A M + 2 Mᵀ B p + pᵀ C p)`.
@@ -129,8 +84,8 @@ impl KirchhoffCore {
     ) -> PyResult<IntegrateOut<'py>> {
         let y0: [f64; DIM] = array1(&y0, "y0")?;
         let times = vec1(&times, "times", None)?;
-        let opts = options(method, dt, rtol, atol, max_steps)?;
-        run(py, &self.body, &y0, t0, &times, &opts)
+        let opts = Options::parse(method, dt, rtol, atol, max_steps)?;
+        run_partial(py, &self.body, &y0, t0, &times, &opts)
     }
 
     /// Integrates a batch `y0s` (B, 6); returns `(y (B, S, 6), steps)`.
@@ -153,16 +108,8 @@ impl KirchhoffCore {
         let n = y0s.len();
         let flat: Vec<f64> = y0s.into_iter().flatten().collect();
         let times = vec1(&times, "times", None)?;
-        let opts = options(method, dt, rtol, atol, max_steps)?;
-        let cancel = py_cancel();
-        let body = &self.body;
-        let (ys, steps) = py.detach(|| {
-            integrate::integrate_many_with(body, &flat, t0, &times, &opts, parallel, &cancel)
-        })?;
-        let y = Array3::from_shape_vec((n, times.len(), DIM), ys)
-            .map_err(out_shape_err)?
-            .into_pyarray(py);
-        Ok((y, steps))
+        let opts = Options::parse(method, dt, rtol, atol, max_steps)?;
+        run_many(py, &self.body, &flat, n, t0, &times, &opts, parallel)
     }
 
     /// Integrates the body with its rotation and position, `s0 = (M, p, R row-major,
@@ -183,8 +130,8 @@ impl KirchhoffCore {
     ) -> PyResult<IntegrateOut<'py>> {
         let s0: [f64; SPACE_DIM] = array1(&s0, "s0")?;
         let times = vec1(&times, "times", None)?;
-        let opts = options(method, dt, rtol, atol, max_steps)?;
-        run(
+        let opts = Options::parse(method, dt, rtol, atol, max_steps)?;
+        run_partial(
             py,
             &SpaceMotion { body: &self.body },
             &s0,

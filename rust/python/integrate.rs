@@ -8,15 +8,60 @@ use super::arrays::{out_shape_err, vec1};
 use super::errors::py_cancel;
 use super::so4::{check_states, top_from_c, vec2};
 use crate::error::Error;
-use crate::integrate::{self, Method, Options};
+use crate::integrate::{self, Method, Options, VectorField};
 
-/// The result of `integrate`: `(l (S', m), steps, evals, error)`.
-type IntegrateOut<'py> = (
+/// The result of `integrate`: `(y (S', m), steps, evals, error)`.
+pub(super) type IntegrateOut<'py> = (
     Bound<'py, PyArray2<f64>>,
     u64,
     u64,
     Option<Bound<'py, PyAny>>,
 );
+
+/// Runs `integrate::integrate_partial` for any field with the GIL released and
+/// converts the result: the samples reached as `(S', m)`, the counts, and the
+/// error of a run that failed or was interrupted after it started (returned,
+/// not raised). A refused call (nothing computed) raises.
+pub(super) fn run_partial<'py, F: VectorField>(
+    py: Python<'py>,
+    f: &F,
+    y0: &[f64],
+    t0: f64,
+    times: &[f64],
+    opts: &Options,
+) -> PyResult<IntegrateOut<'py>> {
+    let cancel = py_cancel();
+    let (tr, res) = py.detach(|| integrate::integrate_partial(f, y0, t0, times, opts, &cancel))?;
+    let y = Array2::from_shape_vec((tr.t.len(), f.dim()), tr.y)
+        .map_err(out_shape_err)?
+        .into_pyarray(py);
+    let err = res
+        .err()
+        .map(|e| PyErr::from(e).into_value(py).into_any().into_bound(py));
+    Ok((y, tr.steps, tr.evals, err))
+}
+
+/// Runs `integrate::integrate_many_with` for any field on `rows` initial states
+/// (`y0s` row-major, `(rows, m)`) with the GIL released: `(y (rows, S, m), steps)`.
+#[allow(clippy::too_many_arguments)]
+pub(super) fn run_many<'py, F: VectorField>(
+    py: Python<'py>,
+    f: &F,
+    y0s: &[f64],
+    rows: usize,
+    t0: f64,
+    times: &[f64],
+    opts: &Options,
+    parallel: bool,
+) -> PyResult<(Bound<'py, PyArray3<f64>>, u64)> {
+    let cancel = py_cancel();
+    let (ys, steps) =
+        py.detach(|| integrate::integrate_many_with(f, y0s, t0, times, opts, parallel, &cancel))?;
+    let y = Array3::from_shape_vec((rows, times.len(), f.dim()), ys)
+        .map_err(out_shape_err)?
+        .into_pyarray(py);
+    Ok((y, steps))
+}
 
 /// Integrates (1) from l0 at t0, sampling at `times`; returns `(l (S', m), steps,
 /// evals, error)`: on a failure or Ctrl-C after the run started, `error` is the
@@ -40,17 +85,7 @@ fn integrate_py<'py>(
     let top = top_from_c(&c)?;
     let (l0, times) = (vec1(&l0, "l0", None)?, vec1(&times, "times", None)?);
     let opts = Options::parse(method, dt, rtol, atol, max_steps)?;
-    let cancel = py_cancel();
-    let (tr, res) =
-        py.detach(|| integrate::integrate_partial(&top, &l0, t0, &times, &opts, &cancel))?;
-    let m = top.dim();
-    let y = Array2::from_shape_vec((tr.t.len(), m), tr.y)
-        .map_err(out_shape_err)?
-        .into_pyarray(py);
-    let err = res
-        .err()
-        .map(|e| PyErr::from(e).into_value(py).into_any().into_bound(py));
-    Ok((y, tr.steps, tr.evals, err))
+    run_partial(py, &top, &l0, t0, &times, &opts)
 }
 
 /// Integrates a batch (B, m) of initial states; returns (l (B, S, m), steps).
@@ -75,14 +110,7 @@ fn integrate_many_py<'py>(
     check_states("l0s", cols, top.dim())?;
     let times = vec1(&times, "times", None)?;
     let opts = Options::parse(method, dt, rtol, atol, max_steps)?;
-    let cancel = py_cancel();
-    let (ys, steps) = py.detach(|| {
-        integrate::integrate_many_with(&top, &l0s, t0, &times, &opts, parallel, &cancel)
-    })?;
-    let y = Array3::from_shape_vec((rows, times.len(), cols), ys)
-        .map_err(out_shape_err)?
-        .into_pyarray(py);
-    Ok((y, steps))
+    run_many(py, &top, &l0s, rows, t0, &times, &opts, parallel)
 }
 
 /// Refuses, before any work, a run that needs more than `max_steps` steps (ValueError
