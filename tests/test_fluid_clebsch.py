@@ -37,6 +37,10 @@ CYC = ((0, 1, 2), (1, 2, 0), (2, 0, 1))
 CLOSED_FORM_RTOL = 1e-11
 #: Must-show on random states (tests/data/clebsch_random_stats.py runs 1000).
 RANDOM_RTOL = 1e-10
+#: The conjugate top's own check (manakov.Solution.self_check) on the four bodies:
+#: they leave ≤ 1.3e-14; the Solution refuses only above 1e-10, so this bound sees
+#: a loss of conditioning of the conjugacy long before a refusal would.
+SELF_CHECK_MAX = 1e-12
 #: Frequencies: every NAFF line ≥ 1e-6 of its component's largest is k·ν to this,
 #: relative to max ν (tests/tori_naff.py).
 LINE_RTOL = tori_naff.LINE_RTOL
@@ -178,6 +182,7 @@ def test_closed_form_matches_integration_on_0_100(name):
     scale = max(np.max(np.abs(pr.M0)), np.max(np.abs(pr.p0)))
     err = max(np.max(np.abs(M - tr.M)), np.max(np.abs(p - tr.p))) / scale
     assert err <= CLOSED_FORM_RTOL, err
+    assert sol.solution.self_check <= SELF_CHECK_MAX, sol.solution.self_check
     np.testing.assert_allclose(sol.M(0.0), pr.M0, rtol=0, atol=1e-14 * scale)
     assert sol.M(t).shape == (201, 3) and sol.p(2.5).shape == (3,)
     # (M, p) is a quotient of theta functions of v0 + U t (the explicit form).
@@ -341,6 +346,39 @@ def test_contraction_of_the_manakov_top():
     assert np.max(np.abs(np.stack([lt[:, 3], -lt[:, 1], lt[:, 0]], 1) - Mc)) > 0.1
 
 
+@pytest.mark.parametrize("name", CLEBSCH)
+def test_states_with_M_dot_p_zero_are_solved(name):
+    """``M·p = 0`` is the conjugate top's ``h0 = 0``, a regular level set whose
+    reduction takes its limit (rust/kotter/pairs.rs): generic such states are
+    solved, and their closed form follows the integration as any other state's."""
+    pr = manakov.fluid_problem(name)
+    body = pr.body
+    t = np.linspace(0.0, 20.0, 101)
+    # Exactly M·p = 0 in doubles (products and sums of these entries are exact).
+    for M0, p0 in (([1.0, 2.0, 0.0], [2.0, -1.0, 3.0]), ([0.5, 0.0, -1.0], [1.0, 0.75, 0.5])):
+        M0, p0 = np.array(M0), np.array(p0)
+        assert M0 @ p0 == 0.0
+        sol = body.solve(M0, p0)
+        tr = body.integrate(M0, p0, 20.0, t_eval=t, dt=body.default_dt(M0, p0) / 10)
+        M, p = sol.state(t)
+        scale = max(np.max(np.abs(M0)), np.max(np.abs(p0)))
+        err = max(np.max(np.abs(M - tr.M)), np.max(np.abs(p - tr.p))) / scale
+        assert err <= RANDOM_RTOL, err
+
+
+def test_a_failed_self_check_is_not_turned_into_a_value_error(monkeypatch):
+    """A conjugate top's solution refused by its own check (ClosedFormError) reaches
+    the caller as it is: it is no statement about the state."""
+
+    def refuse(*args):
+        raise manakov.ClosedFormError("no trustworthy solution: self-check 1e-3")
+
+    monkeypatch.setattr(manakov.fluid, "Solution", refuse)
+    pr = manakov.fluid_problem("clebsch_generic")
+    with pytest.raises(manakov.ClosedFormError, match="self-check"):
+        pr.body.solve(pr.M0, pr.p0)
+
+
 # --- refusals ----------------------------------------------------------------
 
 
@@ -351,8 +389,9 @@ def test_solve_refuses_other_bodies_and_singular_states():
     with pytest.raises(ValueError, match="Clebsch case only"):
         _ = gen.body.conjugate_top
     body = manakov.fluid_problem("clebsch_generic").body
-    # M·p = 0: h0 = 0 for the conjugate top, the genus drops.
-    with pytest.raises(ValueError, match=r"M0·p0 = 0.*h0"):
+    # M·p = 0 on two axes: the conjugate top's h0 = 0 with the double roots of F
+    # at an a_j (an so(3) block); the message translates h0 and gives the top's.
+    with pytest.raises(ValueError, match=r"M0·p0 = 0 is the conjugate top's h0 = 0.*a_j"):
         body.solve([1.0, 0.0, 0.0], [0.0, 1.0, 0.0])
     with pytest.raises(ValueError, match="p0 = 0"):
         body.solve([1.0, 0.5, 0.0], [0.0, 0.0, 0.0])

@@ -896,7 +896,11 @@ class KirchhoffBody:
         ------
         ValueError
             Not a Clebsch body, or a singular level set (the message names the
-            reason, as :meth:`manakov.ManakovTop.solve`).
+            reason, as :meth:`manakov.ManakovTop.solve`). ``M0·p0 = 0`` (the
+            conjugate top's ``h0 = 0``) is not singular by itself.
+        ClosedFormError
+            The conjugate top's solution did not pass its own check
+            (:attr:`manakov.Solution.self_check`); no solution is returned.
         """
         self._require_clebsch("solve")
         y, lead = _states(M0, p0, ("M0", "p0"))
@@ -969,10 +973,9 @@ class ClebschSolution:
             if not np.any(p0a):
                 hint = "p0 = 0: the body turns as Euler's top (elliptic functions), h0 = 0; "
             elif abs(M0a @ p0a) <= 1e-13 * np.linalg.norm(M0a) * np.linalg.norm(p0a):
-                hint = (
-                    "M0·p0 = 0, the conjugate top's h0 = 0: two branch points of the curve "
-                    "coincide and the genus drops; "
-                )
+                # h0 = 0 alone is a regular level set of the top (its reduction takes
+                # the limit there); this only translates the top's wording.
+                hint = "M0·p0 = 0 is the conjugate top's h0 = 0; "
             raise ValueError(
                 f"no genus-2 solution through M0 = {M0a.tolist()}, p0 = {p0a.tolist()}: "
                 f"{hint}the conjugate Manakov top says: {err}"

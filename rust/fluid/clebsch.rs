@@ -317,7 +317,9 @@ pub struct ClebschSolution {
 impl ClebschSolution {
     /// Sets up the solution (the conjugate top's [`Solution::new`] at `L y0`).
     ///
-    /// Errors: those of [`Solution::new`] (a singular level set, named).
+    /// Errors: those of [`Solution::new`]: `Singular` (a singular level set,
+    /// named; `M0·p0 = 0`, the top's `h0 = 0`, is not one by itself) and
+    /// `Unverified` (the top's solution failed its own check).
     pub fn new(conj: ClebschConjugacy, y0: &[f64; 6]) -> Result<Self> {
         check_finite("M0, p0", y0)?;
         let l0 = conj.to_so4(y0);
