@@ -27,6 +27,9 @@
 //!   `l(t)`, from [`kotter`], [`riemann`] and [`theta`].
 //! * [`tori`]: real Liouville tori, frequencies and frequency maps, on
 //!   [`solution`].
+//! * [`fluid`]: a rigid body in an ideal fluid, Kirchhoff's equations on
+//!   e(3) (a field for [`integrate`]), and the Clebsch case through a linear
+//!   conjugacy to a Manakov top solved by [`solution`].
 //!
 //! The crate is pure Rust; the Python bindings live behind the `python`
 //! feature in a private module.
