@@ -89,3 +89,15 @@ def test_rank_two_states_and_their_neighbourhood(name: str) -> None:
         l0 = base.copy()
         l0[5] = (target - rest) / base[0]
         assert _error(top, l0) <= SOLVED_RTOL, (k, l0)
+
+
+def test_kotter_fields_stay_finite_at_subnormal_h0() -> None:
+    """Below |h0| = 1e-100 h1 the fields are reported in the limit normalisation of
+    (20) (the paper's would overflow: Delta ~ 1/h0): finite, no overflow warning
+    (pytest turns warnings into errors)."""
+    k = manakov.kotter(
+        [0.3, 1.1, 2.0, 3.7], [0.5, -0.2, 1.4, 0.9], [[0.0, 2.2e-311, 1.0, 0.0, 1.0, 1.0]]
+    )
+    assert bool(np.all(k.ok))
+    for name in ("xi", "eta", "Delta", "alpha", "K", "g", "sqrt_fprime"):
+        assert np.all(np.isfinite(np.asarray(getattr(k, name)))), name

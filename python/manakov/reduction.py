@@ -275,6 +275,8 @@ class Kotter:
         common factor on ``l^(p)``, ``xi``, ``eta``, ``g`` and on ``alpha .. delta``,
         ``Delta``, ``K``, ``A``, ``B``, ``abgd39`` that leaves every relation
         (11)-(42) as it is (each is homogeneous in it); see docs/degenerate.md.
+        So is it for ``0 < |h0| < 1e-100 h1``, where the paper's normalisation
+        leaves the double range.
     Delta : ndarray (3, 3) complex
         ``Delta[p-1, j-1] = Delta_j^(p)`` (25), corrected (a determinant).
     xi, eta : ndarray (3,) complex
@@ -430,8 +432,11 @@ def _errors_mask(errors: str) -> bool:
 
 # The core normalises (20) by sqrt(F'(s_p)/|h0|), finite at h0 = 0 where
 # F'(s_p) = 0 (docs/degenerate.md); the fields are reported in the paper's
-# normalisation sqrt(F'(s_p)) wherever h0 != 0: each field is multiplied by
-# sqrt(|h0|) to this power (the relations (11)-(42) are homogeneous in it).
+# normalisation sqrt(F'(s_p)) wherever |h0| >= _PAPER_H0_MIN h1: each field is
+# multiplied by sqrt(|h0|) to this power (the relations (11)-(42) are homogeneous
+# in it). Below that the paper's normalisation leaves the double range (Delta
+# ~ 1/h0, K ~ h0^2), and the limit normalisation is reported, as at h0 = 0.
+_PAPER_H0_MIN = 1e-100
 _PAPER_POWER = {
     "sqrt_fprime": 1,
     "l_p": -1,
@@ -454,8 +459,10 @@ def _build(
     a: np.ndarray, b: np.ndarray, flat: np.ndarray, shape: tuple[int, ...], raw: Any
 ) -> Kotter:
     fields: dict[str, Any] = {}
-    h0 = np.asarray(raw["h"]).reshape(shape + (4,))[..., 0]
-    w = np.where(h0 == 0, 1.0, np.sqrt(np.abs(h0)))
+    h = np.asarray(raw["h"]).reshape(shape + (4,))
+    h0 = np.abs(h[..., 0])
+    paper = np.isfinite(h0) & (h0 >= _PAPER_H0_MIN * h[..., 1]) & (h0 > 0)
+    w = np.where(paper, np.sqrt(np.where(paper, h0, 1.0)), 1.0)
     for name, fshape in _FIELD_SHAPES.items():
         arr = np.asarray(raw[name]).reshape(shape + fshape)
         if name in _PAPER_POWER:
