@@ -1,5 +1,7 @@
 """Type stubs for the compiled module ``manakov._core`` (private; use ``manakov``)."""
 
+from collections.abc import Callable
+
 import numpy as np
 import numpy.typing as npt
 from numpy.typing import NDArray
@@ -19,6 +21,7 @@ __all__ = [
     "curve_xi_eta",
     "HyperellipticCore",
     "frequency_map",
+    "gauss_steps",
     "SolutionCore",
     "gauss_tableau",
     "hamiltonian",
@@ -146,10 +149,12 @@ def integrate(
     rtol: float,
     atol: float,
     max_steps: int,
+    progress: Callable[[int], object] | None = None,
 ) -> tuple[NDArray[np.float64], int, int, BaseException | None]: ...
 def check_budget(
     method: str, t0: float, times: NDArray[np.float64], dt: float, max_steps: int
 ) -> None: ...
+def gauss_steps(t0: float, times: NDArray[np.float64], dt: float) -> int: ...
 def integrate_many(
     c: NDArray[np.float64],
     l0s: NDArray[np.float64],
@@ -161,6 +166,7 @@ def integrate_many(
     atol: float,
     max_steps: int,
     parallel: bool,
+    progress: Callable[[int], object] | None = None,
 ) -> tuple[NDArray[np.float64], int]: ...
 def gauss_tableau(
     method: str,

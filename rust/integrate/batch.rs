@@ -173,6 +173,7 @@ fn gauss16_group_body<L: Lanes>(
                 o[k] = g.y[k][w];
             }
         }
+        cancel.advance(rows as u64);
     }
     Ok(steps)
 }
@@ -638,6 +639,7 @@ fn dop853_group_body(
                         dst[q] = y[q][w];
                     }
                     idx[w] += 1;
+                    cancel.advance(1);
                     if idx[w] < ns && hcur[w] == 0.0 {
                         hcur[w] = lane_starting_step(&y, &k[0], w, o);
                     }

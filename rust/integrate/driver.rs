@@ -218,6 +218,11 @@ fn explicit_into<E: Explicit, F: VectorField>(
         for &tk in times {
             out.steps += d.advance(f, y, &mut t, tk, max_steps - out.steps, cancel)?;
             out.y.extend_from_slice(y);
+            // One sample done; and a check: the step loop checks only every
+            // CHECK_EVERY attempts within one sample interval, so a run sampled
+            // more often than that would otherwise never see Ctrl-C.
+            cancel.advance(1);
+            cancel.check()?;
         }
         Ok(())
     })();

@@ -412,6 +412,7 @@ pub(super) fn run_gauss<S: Stepper, F: VectorField>(
                 t = tk;
             }
             out.y.extend_from_slice(y);
+            cancel.advance(1);
         }
         Ok(())
     })();

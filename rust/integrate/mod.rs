@@ -67,7 +67,7 @@ pub use driver::{
 };
 pub use gauss::{MAX_FIXED_POINT_ITER, STALL_RTOL};
 pub use options::{
-    check_budget, check_sample_times, Method, Options, Trajectory, MAX_STEPS, RTOL_MIN,
+    check_budget, check_sample_times, gauss_steps, Method, Options, Trajectory, MAX_STEPS, RTOL_MIN,
 };
 
 use gauss::StopRule;

@@ -252,6 +252,7 @@ fn taylor_group_body<L: Lanes>(
                         dst[k] = x[0][k][w] + comp[k][w];
                     }
                     idx[w] += 1;
+                    cancel.advance(1);
                     if j == 0 {
                         progress.samples0 = idx[w];
                     }
@@ -361,6 +362,7 @@ fn taylor_group_body<L: Lanes>(
                     dst[k] = x[0][k][w] + acc.mul_add(tau, comp[k][w]);
                 }
                 idx[w] += 1;
+                cancel.advance(1);
                 if j == 0 {
                     progress.samples0 = idx[w];
                 }

@@ -10,6 +10,11 @@
 //!
 //! A computation split over rayon's pool runs through [`poll_during`], so that
 //! the calling thread (which made the token) keeps polling while the pool works.
+//!
+//! A token also counts the work done ([`Cancel::advance`]; the integrators add
+//! one per sample written), and a poll made by [`Cancel::with_progress_poll`]
+//! sees that count: the Python binding reports it to a progress callback from
+//! the same poll, so watching a run neither splits it nor changes its result.
 
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::thread::ThreadId;
@@ -33,7 +38,7 @@ pub const CHECK_EVERY: u32 = 64;
 /// on time.
 pub const POLL_WAIT: Duration = Duration::from_millis(5);
 
-type Poll = Box<dyn Fn() -> bool + Send + Sync>;
+type Poll = Box<dyn Fn(u64) -> bool + Send + Sync>;
 
 /// A cancellation token shared by the threads of one computation.
 pub struct Cancel {
@@ -42,6 +47,7 @@ pub struct Cancel {
     owner: Option<ThreadId>,
     start: Instant,
     next_poll_ns: AtomicU64,
+    done: AtomicU64,
 }
 
 impl std::fmt::Debug for Cancel {
@@ -68,16 +74,33 @@ impl Cancel {
             owner: None,
             start: Instant::now(),
             next_poll_ns: AtomicU64::new(0),
+            done: AtomicU64::new(0),
         }
     }
 
     /// A token that also asks `poll` (true = stop) from the calling thread.
     pub fn with_poll(poll: impl Fn() -> bool + Send + Sync + 'static) -> Self {
+        Self::with_progress_poll(move |_| poll())
+    }
+
+    /// [`Cancel::with_poll`] whose `poll` also receives the work done so far
+    /// (the sum of [`Cancel::advance`]).
+    pub fn with_progress_poll(poll: impl Fn(u64) -> bool + Send + Sync + 'static) -> Self {
         Cancel {
             poll: Some(Box::new(poll)),
             owner: Some(std::thread::current().id()),
             ..Self::never()
         }
+    }
+
+    /// Counts `units` of work as done (any thread; the integrators count samples).
+    pub fn advance(&self, units: u64) {
+        self.done.fetch_add(units, Ordering::Relaxed);
+    }
+
+    /// The work counted by [`Cancel::advance`] so far.
+    pub fn done(&self) -> u64 {
+        self.done.load(Ordering::Relaxed)
     }
 
     /// Request cancellation; every later [`Cancel::check`] fails.
@@ -101,7 +124,7 @@ impl Cancel {
                 if now >= self.next_poll_ns.load(Ordering::Relaxed) {
                     self.next_poll_ns
                         .store(now + POLL_INTERVAL.as_nanos() as u64, Ordering::Relaxed);
-                    if poll() {
+                    if poll(self.done()) {
                         self.cancel();
                         return Err(Error::Interrupted);
                     }
@@ -153,6 +176,22 @@ mod tests {
         assert!(c.check().is_ok());
         c.cancel();
         assert_eq!(c.check(), Err(Error::Interrupted));
+    }
+
+    #[test]
+    fn the_poll_sees_the_work_done() {
+        let seen = Arc::new(AtomicU64::new(u64::MAX));
+        let k = seen.clone();
+        let c = Cancel::with_progress_poll(move |done| {
+            k.store(done, Ordering::Relaxed);
+            false
+        });
+        c.advance(3);
+        std::thread::scope(|s| {
+            s.spawn(|| c.advance(4)); // counted from any thread
+        });
+        assert!(c.check().is_ok());
+        assert_eq!((c.done(), seen.load(Ordering::Relaxed)), (7, 7));
     }
 
     #[test]

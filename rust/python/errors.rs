@@ -1,7 +1,10 @@
 //! The one map from the core's `Error` to Python exceptions.
 
+use std::sync::{Arc, Mutex};
+
 use pyo3::create_exception;
 use pyo3::exceptions::{PyKeyboardInterrupt, PyRuntimeError, PyValueError};
+use pyo3::prelude::*;
 use pyo3::PyErr;
 
 use crate::error::Error;
@@ -55,4 +58,44 @@ pub fn py_cancel() -> crate::numeric::cancel::Cancel {
     crate::numeric::cancel::Cancel::with_poll(|| {
         pyo3::Python::attach(|py| py.check_signals().is_err())
     })
+}
+
+/// The exception raised by a progress callback, kept until the call returns.
+pub type CallbackError = Arc<Mutex<Option<PyErr>>>;
+
+/// [`py_cancel`] that also calls `progress(done)` at each poll, `done` the work
+/// counted by the core (`Cancel::advance`: samples written, for the
+/// integrators). An exception raised by `progress` stops the call like Ctrl-C
+/// and is kept in the returned slot; [`callback_or`] raises it in place of the
+/// interruption.
+pub fn py_cancel_progress(
+    progress: Option<Py<PyAny>>,
+) -> (crate::numeric::cancel::Cancel, CallbackError) {
+    let slot: CallbackError = Arc::new(Mutex::new(None));
+    let kept = slot.clone();
+    let cancel = crate::numeric::cancel::Cancel::with_progress_poll(move |done| {
+        Python::attach(|py| {
+            if py.check_signals().is_err() {
+                return true;
+            }
+            match progress.as_ref().map(|f| f.call1(py, (done,))) {
+                Some(Err(e)) => {
+                    if let Ok(mut s) = kept.lock() {
+                        *s = Some(e);
+                    }
+                    true
+                }
+                _ => false,
+            }
+        })
+    });
+    (cancel, slot)
+}
+
+/// The exception of a progress callback that stopped the call, if any, else `e`.
+pub fn callback_or(slot: &CallbackError, e: Error) -> PyErr {
+    match slot.lock().ok().and_then(|mut s| s.take()) {
+        Some(err) if e == Error::Interrupted => err,
+        _ => PyErr::from(e),
+    }
 }

@@ -85,7 +85,7 @@ impl KirchhoffCore {
         let y0: [f64; DIM] = array1(&y0, "y0")?;
         let times = vec1(&times, "times", None)?;
         let opts = Options::parse(method, dt, rtol, atol, max_steps)?;
-        run_partial(py, &self.body, &y0, t0, &times, &opts)
+        run_partial(py, &self.body, &y0, t0, &times, &opts, None)
     }
 
     /// Integrates a batch `y0s` (B, 6); returns `(y (B, S, 6), steps)`.
@@ -109,7 +109,7 @@ impl KirchhoffCore {
         let flat: Vec<f64> = y0s.into_iter().flatten().collect();
         let times = vec1(&times, "times", None)?;
         let opts = Options::parse(method, dt, rtol, atol, max_steps)?;
-        run_many(py, &self.body, &flat, n, t0, &times, &opts, parallel)
+        run_many(py, &self.body, &flat, n, t0, &times, &opts, parallel, None)
     }
 
     /// Integrates the body with its rotation and position, `s0 = (M, p, R row-major,
@@ -138,6 +138,7 @@ impl KirchhoffCore {
             t0,
             &times,
             &opts,
+            None,
         )
     }
 }
