@@ -148,7 +148,8 @@ impl fmt::Display for Error {
             ),
             Error::RepeatedBranchPoints { i, j, value } => write!(
                 f,
-                "branch points d{i} and d{j} coincide (= {value}): the curve is singular, its genus drops"
+                "branch points d{i} and d{j} coincide (= {}): the curve is singular, its genus drops",
+                cnum(*value)
             ),
             // The same text as the `InvalidArgument` these once were.
             Error::Singular { what, reason, .. } | Error::InvalidArgument { what, reason } => {
@@ -173,6 +174,84 @@ impl fmt::Display for Error {
 
 impl std::error::Error for Error {}
 
+/// Significant digits of a computed number in a message ([`num`], [`cnum`]):
+/// enough to recognise a value, no more than a computed double carries after a
+/// few operations.
+pub const MESSAGE_DIGITS: usize = 10;
+
+/// `x` for a message: [`MESSAGE_DIGITS`] significant digits, trailing zeros
+/// dropped, scientific notation outside `1e-4 <= |x| < 1e10` (like C's `%.10g`),
+/// so that `1e-12` never prints as `0.000000000001`.
+pub fn num(x: f64) -> String {
+    num_digits(x, MESSAGE_DIGITS)
+}
+
+/// `x` to `digits` significant digits, as [`num`].
+fn num_digits(x: f64, digits: usize) -> String {
+    if x == 0.0 || !x.is_finite() {
+        return format!("{x}");
+    }
+    let digits = digits.max(1);
+    let sci = format!("{:.*e}", digits - 1, x);
+    let (mantissa, exp) = sci.split_once('e').unwrap_or((&sci, "0"));
+    let exp: i32 = exp.parse().unwrap_or(0);
+    if (-4..digits as i32).contains(&exp) {
+        let decimals = (digits as i32 - 1 - exp).max(0) as usize;
+        trim_zeros(&format!("{x:.decimals$}")).to_string()
+    } else {
+        format!("{}e{exp}", trim_zeros(mantissa))
+    }
+}
+
+/// A complex number for a message: each part as [`num`], and a part smaller
+/// than the last digit shown of the other (`10^-MESSAGE_DIGITS |z|`) left out
+/// as rounding noise, so a real root carrying `-6e-40i` prints as real.
+/// Written like Python's complex numbers (`1.5-2j`).
+pub fn cnum(z: Complex64) -> String {
+    cnum_digits(z, MESSAGE_DIGITS, 0.0)
+}
+
+/// `z` known only to about `noise` (absolute; a double root from its computed
+/// separation): the digits stop near `noise` (at most [`MESSAGE_DIGITS`]) and a
+/// part below it is left out.
+pub fn cnum_within(z: Complex64, noise: f64) -> String {
+    let size = z.norm();
+    let digits = if noise > 0.0 && size > noise {
+        ((size / noise).log10().floor() as usize + 1).min(MESSAGE_DIGITS)
+    } else if noise > 0.0 {
+        1
+    } else {
+        MESSAGE_DIGITS
+    };
+    cnum_digits(z, digits, noise)
+}
+
+fn cnum_digits(z: Complex64, digits: usize, noise: f64) -> String {
+    let cut = (z.norm() * 10f64.powi(-(MESSAGE_DIGITS as i32))).max(noise);
+    let re = if z.re.abs() > cut { z.re } else { 0.0 };
+    let im = if z.im.abs() > cut { z.im } else { 0.0 };
+    match (re == 0.0, im == 0.0) {
+        (_, true) => num_digits(re, digits),
+        (true, false) => format!("{}j", num_digits(im, digits)),
+        (false, false) => {
+            let sign = if im < 0.0 { '-' } else { '+' };
+            format!(
+                "{}{sign}{}j",
+                num_digits(re, digits),
+                num_digits(im.abs(), digits)
+            )
+        }
+    }
+}
+
+fn trim_zeros(s: &str) -> &str {
+    if s.contains('.') {
+        s.trim_end_matches('0').trim_end_matches('.')
+    } else {
+        s
+    }
+}
+
 /// Checks that every entry of `x` is finite.
 pub fn check_finite(what: &'static str, x: &[f64]) -> Result<()> {
     match x.iter().position(|v| !v.is_finite()) {
@@ -184,6 +263,26 @@ pub fn check_finite(what: &'static str, x: &[f64]) -> Result<()> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn numbers_in_messages_keep_the_digits_that_matter() {
+        assert_eq!(num(1.4070413458937996), "1.407041346");
+        assert_eq!(num(1e-12), "1e-12");
+        assert_eq!(num(-2.5e20), "-2.5e20");
+        assert_eq!(num(0.5), "0.5");
+        assert_eq!(num(123456.0), "123456");
+        assert_eq!(num(0.00012), "0.00012");
+        assert_eq!(num(f64::NAN), "NaN");
+        let noisy = Complex64::new(1.4070413458937996, -6.256420825295136e-40);
+        assert_eq!(cnum(noisy), "1.407041346");
+        assert_eq!(cnum(Complex64::new(-1e-30, 2.0)), "2j");
+        assert_eq!(cnum(Complex64::new(0.3, -1.25)), "0.3-1.25j");
+        assert_eq!(cnum(Complex64::new(0.0, 0.0)), "0");
+        // A double root split by 4.3e-7 into a conjugate pair: its mean, to 8 digits.
+        let pair = Complex64::new(5.288422876312, 0.0);
+        assert_eq!(cnum_within(pair, 4.3e-7), "5.2884229");
+        assert_eq!(cnum_within(Complex64::new(1.0, 2e-7), 4.3e-7), "1");
+    }
 
     #[test]
     fn check_finite_names_the_entry() {

@@ -8,7 +8,7 @@ use super::pairs::{self, PAIR_ROUTE_RTOL};
 use super::polish::{polish_root, Level, PolishedRoot};
 use super::roots::{check_repeated, quartic_f_den, quartic_roots};
 use super::{check_a, integrals, l_from_m_n, m_n, C, CYCLIC, ONE, ZERO};
-use crate::error::{check_finite, Error, Result, SingularKind};
+use crate::error::{check_finite, cnum, Error, Result, SingularKind};
 use crate::numeric::dd::Cdd;
 
 /// Residual (relative to the size of the terms) above which the existence
@@ -328,9 +328,9 @@ fn coefficients_20(
             let reason = format!(
                 "F'(s_{}) = {} (19) at the root s_{} = {} is zero or not finite",
                 p + 1,
-                roots[p].fprime,
+                cnum(roots[p].fprime),
                 p + 1,
-                s[p]
+                cnum(s[p])
             );
             // F'(s_p) = 0 is a repeated root of F, as in `check_repeated`; an
             // overflow is not a property of the state.
@@ -358,7 +358,7 @@ fn coefficients_20(
                         "the root s_{} = {} of F (19) coincides with a_{} = {aj}: sqrt(s_kl) = \
                          sqrt(G)/sqrt(s_j4) is 0/0 there",
                         p + 1,
-                        s[p],
+                        cnum(s[p]),
                         j + 1
                     ),
                 });
@@ -484,7 +484,7 @@ impl BranchConstants {
                 return Err(Error::Singular {
                     what: "state l",
                     kind: SingularKind::CoincidingBranchPoints,
-                    reason: format!("d_{} = {} (26) is zero or infinite", j + 1, bc.d[j]),
+                    reason: format!("d_{} = {} (26) is zero or infinite", j + 1, cnum(bc.d[j])),
                 });
             }
         }

@@ -6,7 +6,7 @@
 use super::constants::{l_p_dd, near_singular, Coefficients23, KotterConstants};
 use super::{integrals, kotter_constants, C, CYCLIC, ONE, ZERO};
 use crate::curve::{CurvePoint, KotterCurve, WurzelPoints};
-use crate::error::{check_finite, Error, Result};
+use crate::error::{check_finite, cnum, Error, Result};
 use crate::numeric::complex::sqrt_principal;
 use crate::numeric::dd::Cdd;
 
@@ -161,15 +161,19 @@ fn kotter_with_impl(constants: KotterConstants, l: &[f64; 6]) -> Result<KotterSt
             return Err(Error::InvalidArgument {
                 what: "state l",
                 reason: format!(
-                    "1 - eps P_0 is not finite (eps = {}, P_0 = {p0}): g (42) is undefined",
-                    constants.eps
+                    "1 - eps P_0 is not finite (eps = {}, P_0 = {}): g (42) is undefined",
+                    cnum(constants.eps),
+                    cnum(p0)
                 ),
             });
         }
         if one_m.norm() <= 1e-12 * size {
             return Err(Error::InvalidArgument {
                 what: "state l",
-                reason: format!("1 - eps P_0 = {one_m} vanishes: g (42) is infinite at this state"),
+                reason: format!(
+                    "1 - eps P_0 = {} vanishes: g (42) is infinite at this state",
+                    cnum(one_m)
+                ),
             });
         }
         Ok(sqrt_principal(C::new(constants.h[0], 0.0) / constants.k) / one_m)
@@ -205,9 +209,10 @@ fn kotter_with_impl(constants: KotterConstants, l: &[f64; 6]) -> Result<KotterSt
         return Err(Error::InvalidArgument {
             what: "state l",
             reason: format!(
-                "the corrected (42) g = sqrt(h0/K)/(1 - eps P0) = {g42} disagrees with g = {} \
-                 from (30a) (|difference| = {mis:e})",
-                points.g
+                "the corrected (42) g = sqrt(h0/K)/(1 - eps P0) = {} disagrees with g = {} \
+                 from (30a) (|difference| = {mis:.1e})",
+                cnum(g42),
+                cnum(points.g)
             ),
         });
     }

@@ -4,7 +4,7 @@
 //! (1973) 339–344) with Newton polishing, in the documented order.
 
 use super::{C, ONE, ZERO};
-use crate::error::{check_finite, Error, Result, SingularKind};
+use crate::error::{check_finite, cnum_within, num, Error, Result, SingularKind};
 use crate::numeric::tol::REDUCTION_FLOOR_RTOL;
 
 /// Roots of `F` closer than `REPEATED_ROOT_RTOL` times their scale are
@@ -33,16 +33,29 @@ pub fn quartic_f(a: &[f64; 4], h: &[f64; 4]) -> Result<[f64; 5]> {
 /// keeps its relative accuracy where the difference of squares loses it).
 pub(super) fn quartic_f_den(a: &[f64; 4], h: &[f64; 4], den: f64) -> Result<[f64; 5]> {
     let [h0, h1, h2, h3] = *h;
-    if den.abs() <= REDUCTION_FLOOR_RTOL * h1 * h1 || h1 == 0.0 {
+    if h1 == 0.0 {
+        // h1 = |l|^2: only the rest state, which has no curve (and no distance
+        // to the self-dual set to report).
+        return Err(Error::Singular {
+            what: "state l",
+            kind: SingularKind::ZeroState,
+            reason: "l = 0 (h1 = 0): the rest state; the motion is l(t) = 0, there is no \
+                     curve (8)"
+                .into(),
+        });
+    }
+    if den.abs() <= REDUCTION_FLOOR_RTOL * h1 * h1 {
         return Err(Error::Singular {
             what: "state l",
             kind: SingularKind::SelfDual,
             reason: format!(
-                "h1^2 - 4 h0^2 = {den:e} vanishes (h1 = {h1}, h0 = {h0}; the state is \
-                 self-dual or anti-self-dual, m = +-n, or at a relative distance \
-                 (h1^2 - 4 h0^2)/h1^2 = {:e} <= {REDUCTION_FLOOR_RTOL:e} from it): F(s) (19) is not \
-                 defined",
-                den / (h1 * h1)
+                "h1^2 - 4 h0^2 = {} vanishes (h1 = {}, h0 = {}; the state is self-dual or \
+                 anti-self-dual, m = +-n, or at a relative distance (h1^2 - 4 h0^2)/h1^2 = {} \
+                 <= {REDUCTION_FLOOR_RTOL:e} from it): F(s) (19) is not defined",
+                num(den),
+                num(h1),
+                num(h0),
+                num(den / (h1 * h1))
             ),
         });
     }
@@ -166,9 +179,10 @@ pub(super) fn check_repeated(z: &[C]) -> Result<()> {
                     what: "state l",
                     kind: SingularKind::RepeatedRoot,
                     reason: format!(
-                        "F(s) (19) has a repeated root s = {} (|s_{} - s_{}| = {:e}): l^(p) (20) \
-                         divides by sqrt(F'(s_p)) = 0",
-                        z[i],
+                        "F(s) (19) has a repeated root s = {} (|s_{} - s_{}| = {:.1e}): l^(p) \
+                         (20) divides by sqrt(F'(s_p)) = 0",
+                        // The pair's mean, to the digits its separation leaves.
+                        cnum_within((z[i] + z[j]) * 0.5, (z[i] - z[j]).norm()),
                         i + 1,
                         j + 1,
                         (z[i] - z[j]).norm()

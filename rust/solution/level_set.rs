@@ -159,8 +159,9 @@ pub(super) fn map_coinciding(e: Error) -> Error {
 
 fn coinciding(i: usize, j: usize, value: C) -> Error {
     let reason = format!(
-        "branch points d{i} and d{j} of the curve (8) coincide (= {value}){}: the genus drops, \
+        "branch points d{i} and d{j} of the curve (8) coincide (= {}){}: the genus drops, \
          the motion is degenerate (the solution exists as a limit in lower-genus functions)",
+        crate::error::cnum(value),
         if i == 0 || j == 0 {
             ", i.e. h0 = 0 or a vanishing d_j"
         } else {
