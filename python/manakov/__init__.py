@@ -16,6 +16,7 @@ from .fluid import (
     fluid_problem,
     fluid_problem_names,
 )
+from .integrate import METHODS, Trajectory
 from .problems import Problem, benchmark_setup, problem, problem_names
 from .reduction import Kotter, LevelSet, from_kotter, kotter
 from .riemann import HyperellipticCurve
@@ -31,15 +32,7 @@ from .theta import (
     theta_all,
     theta_jet,
 )
-from .top import (
-    METHODS,
-    FrahmTop,
-    ManakovTop,
-    Trajectory,
-    from_matrix,
-    poisson_tensor,
-    to_matrix,
-)
+from .top import FrahmTop, ManakovTop, from_matrix, poisson_tensor, to_matrix
 from .tori import FrequencyMap, Torus, frequency_map, real_torus
 
 __all__ = [

@@ -50,12 +50,63 @@ def _float_array(x: Any, what: str) -> np.ndarray:
 
 
 def _states(l: Any, m: int, what: str = "l") -> tuple[np.ndarray, tuple[int, ...]]:
-    """``l`` as a C-contiguous (N, m) float array and its leading shape."""
+    """``l`` as a C-contiguous (N, m) float array and its leading shape.
+
+    The one wording of a function that broadcasts over leading axes (see
+    ``docs/conventions.md``); :func:`_one_state` is that of one that does not.
+    """
     arr = _float_array(l, what)
-    if arr.ndim == 0 or arr.shape[-1] != m:
-        raise ValueError(f"{what} must have shape (..., {m}), got {arr.shape}")
+    _last_axis(arr, m, what)
     lead = arr.shape[:-1]
     return np.ascontiguousarray(arr.reshape(-1, m)), lead
+
+
+def _last_axis(arr: np.ndarray, m: int, what: str) -> None:
+    """The shape check of :func:`_states` alone (for callers that take NaN)."""
+    if arr.ndim == 0 or arr.shape[-1] != m:
+        raise ValueError(
+            f"{what} must have shape (..., {m}) (states on the last axis), got shape {arr.shape}"
+        )
+
+
+def _one_state(l: Any, m: int, what: str, func: str, instead: str | None = None) -> np.ndarray:
+    """``l`` as one real, finite state of shape (m,), for ``func``, which takes one.
+
+    The one wording of a function that does not broadcast over leading axes
+    (``docs/conventions.md``), naming what to use for many states when there is
+    such a function.
+    """
+    arr = _float_array(l, what)
+    if arr.shape != (m,):
+        more = f"; for many states use {instead}" if instead else ""
+        raise ValueError(
+            f"{what} must be one state of shape ({m},), got shape {arr.shape}: {func} takes "
+            f"one state and does not broadcast over leading axes{more}"
+        )
+    return np.array(arr, dtype=np.float64, order="C")
+
+
+#: Significant digits of a computed number in a message or a report (as in the
+#: core's messages): enough to recognise it, no more than a computed double
+#: carries after a few operations.
+MESSAGE_DIGITS = 10
+
+
+def _show(x: Any, digits: int = MESSAGE_DIGITS) -> str:
+    """``x`` (real or complex) to ``digits`` significant digits, like ``%g``, with a
+    real or imaginary part below the last digit shown of the other left out as
+    rounding noise (``3.19+7e-32j`` prints ``3.19``); NaN prints ``nan``."""
+    z = complex(x)
+    if not (math.isfinite(z.real) and math.isfinite(z.imag)):
+        return str(z.real) if z.imag == 0 else str(z)
+    cut = abs(z) * 10.0 ** (-digits)
+    re = z.real if abs(z.real) > cut else 0.0
+    im = z.imag if abs(z.imag) > cut else 0.0
+    if im == 0.0:
+        return f"{re:.{digits}g}"
+    if re == 0.0:
+        return f"{im:.{digits}g}j"
+    return f"{re:.{digits}g}{im:+.{digits}g}j"
 
 
 def _finite_result(values: np.ndarray, cause: str = "this l: rescale l") -> np.ndarray:

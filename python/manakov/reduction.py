@@ -29,7 +29,7 @@ from typing import Any
 import numpy as np
 
 from . import _core
-from ._checks import _finite_result, _float_array
+from ._checks import _finite_result, _float_array, _one_state
 from ._checks import _states as _top_states
 from .curve import KotterCurve
 
@@ -581,9 +581,8 @@ class LevelSet:
     def __init__(self, a: Any, b: Any, l0: Any) -> None:
         self._a = _check_a(a)
         self._b = _check_b(b)
-        flat, shape = _states(l0)
-        if shape != ():
-            raise ValueError(f"l0 must have shape (6,), got {shape + (6,)}")
+        one = _one_state(l0, 6, "l0", "LevelSet", "LevelSet(a, b, l0).kotter(l) for states on it")
+        flat = one[None]
         _check_range(flat)
         self._l0 = flat[0].copy()
         self._l0.setflags(write=False)

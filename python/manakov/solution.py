@@ -31,15 +31,19 @@ from typing import Any
 import numpy as np
 
 from . import _core
-from ._checks import _float_array
+from ._checks import _float_array, _one_state, _show, _states
 from ._torus import Torus, torus_of_state
 from .riemann import HyperellipticCurve
 
-__all__ = ["LABELS", "Solution", "plot_theorem"]
+__all__ = ["LABELS", "Solution"]
 
 #: Labels of the Wurzelfunktionen (27)–(28) entering (37) and (42), in the
 #: order of :attr:`Solution.constants` and :attr:`Solution.characteristics`.
 LABELS: tuple[str, ...] = ("P0", "P23", "P31", "P12", "P14", "P24", "P34")
+
+
+#: What the one-state calls of the solution point to for many states.
+_MANY_STATES = "manakov.frequency_map (frequencies) or top.integrate (trajectories)"
 
 
 def _frozen(a: np.ndarray) -> np.ndarray:
@@ -86,10 +90,10 @@ class Solution:
     def __init__(self, a: Any, b: Any, l0: Any) -> None:
         aa = _float_array(a, "a").astype(float)
         bb = _float_array(b, "b").astype(float)
-        ll = _float_array(l0, "l0").astype(float)
-        for name, arr, n in (("a", aa, 4), ("b", bb, 4), ("l0", ll, 6)):
-            if arr.shape != (n,):
-                raise ValueError(f"{name} must have shape ({n},), got {arr.shape}")
+        for name, arr in (("a", aa), ("b", bb)):
+            if arr.shape != (4,):
+                raise ValueError(f"{name} must have shape (4,), got {arr.shape}")
+        ll = _one_state(l0, 6, "l0", "solve", _MANY_STATES)
         self._a, self._b, self._l0 = _frozen(aa.copy()), _frozen(bb.copy()), _frozen(ll.copy())
         self._core = _core.SolutionCore(self._a, self._b, self._l0)
         self._curve: HyperellipticCurve | None = None
@@ -133,23 +137,30 @@ class Solution:
         return out.reshape(tt.shape + (6,))
 
     def abel(self, l: Any) -> np.ndarray:
-        """The Abel image ``u(P1) + u(P2)`` (modulo the lattice) of a state ``l``
+        """The Abel image ``u(P1) + u(P2)`` (modulo the lattice) of states ``l``
         on the same level set, with the branches of ``l0``'s reduction.
 
         Along a trajectory ``abel(l(t)) ≡ u0 + U t`` modulo the lattice.
 
         Parameters
         ----------
-        l : array_like, shape (6,)
+        l : array_like, shape (..., 6)
 
         Returns
         -------
-        ndarray, complex, shape (2,)
+        ndarray, complex, shape (..., 2)
+
+        Raises
+        ------
+        ValueError
+            Wrong last axis, complex or non-finite ``l``, or a state the reduction
+            of ``l0``'s level set refuses (the message names why).
         """
-        ll = _float_array(l, "l").astype(float)
-        if ll.shape != (6,):
-            raise ValueError(f"l must have shape (6,), got {ll.shape}")
-        return self._core.abel(np.ascontiguousarray(ll))
+        flat, lead = _states(l, 6, "l")
+        out = np.empty((flat.shape[0], 2), dtype=complex)
+        for i, x in enumerate(flat):
+            out[i] = self._core.abel(np.ascontiguousarray(x))
+        return out.reshape(lead + (2,))
 
     @property
     def u0(self) -> np.ndarray:
@@ -243,86 +254,3 @@ class Solution:
         d = ", ".join(_show(x, 6) for x in self._core.branch_points)
         u = ", ".join(_show(x, 12) for x in self._core.rate)
         return f"Solution(curve: y^2 = prod (x - d_j), d = [{d}]; U = [{u}])"
-
-
-def _show(x: complex, digits: int) -> str:
-    """``x`` to ``digits`` significant digits, without a real or imaginary part
-    below the shown precision (rounding noise such as ``3.19+7e-32j``)."""
-    x = complex(x)
-    cut = abs(x) * 10.0 ** (-digits)
-    re = x.real if abs(x.real) > cut else 0.0
-    im = x.imag if abs(x.imag) > cut else 0.0
-    if im == 0.0:
-        return f"{re:.{digits}g}"
-    if re == 0.0:
-        return f"{im:.{digits}g}j"
-    return f"{complex(re, im):.{digits}g}"
-
-
-def plot_theorem(
-    problem_name: str,
-    path: str,
-    *,
-    t_end: float = 100.0,
-    samples: int = 201,
-    dt: float = 1e-3,
-) -> float:
-    """Plot ``l(t)`` from the theta quotients against gauss16 integration, and
-    their difference on a log scale, as a PNG.
-
-    Parameters
-    ----------
-    problem_name : str
-        A name of :func:`manakov.problem_names`.
-    path : str
-        The PNG file to write.
-    t_end : float
-        End time (> 0).
-    samples : int
-        Number of times in ``[0, t_end]`` (≥ 2).
-    dt : float
-        The gauss16 step.
-
-    Returns
-    -------
-    float
-        ``max_t |l_theta − l_int| / |l0|``.
-    """
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    from .problems import problem
-
-    if not (t_end > 0 and np.isfinite(t_end)):
-        raise ValueError(f"t_end must be finite and > 0, got {t_end}")
-    if int(samples) < 2:
-        raise ValueError(f"samples must be >= 2, got {samples}")
-    p = problem(problem_name)
-    sol = Solution(p.a, p.b, p.l0)
-    t = np.linspace(0.0, float(t_end), int(samples))
-    c = _core.manakov_c(np.asarray(p.a, float), np.asarray(p.b, float))
-    l_int, _, _, err = _core.integrate(
-        c, np.asarray(p.l0, float), 0.0, t, "gauss16", float(dt), 0.0, 0.0, 10**9
-    )
-    if err is not None:
-        raise err
-    l_int = np.asarray(l_int).reshape(len(t), 6)
-    l_th = sol.l(t)
-    diff = np.max(np.abs(l_th - l_int), axis=1) / np.linalg.norm(p.l0)
-    fig, (ax1, ax2) = plt.subplots(2, 1, figsize=(8, 7), sharex=True)
-    names = ["l12", "l13", "l14", "l23", "l24", "l34"]
-    for q in range(6):
-        ax1.plot(t, l_th[:, q], label=names[q])
-        ax1.plot(t, l_int[:, q], "k:", lw=0.8)
-    ax1.set_ylabel("l(t): theta quotients (lines), gauss16 (dotted)")
-    ax1.legend(ncol=6, fontsize=7)
-    ax1.set_title(f"{problem_name}: {sol!r}"[:110], fontsize=8)
-    ax2.semilogy(t, np.maximum(diff, 1e-18))
-    ax2.set_xlabel("t")
-    ax2.set_ylabel("max |l_theta - l_int| / |l0|")
-    fig.tight_layout()
-    fig.savefig(path, dpi=100)
-    plt.close(fig)
-    return float(diff.max())

@@ -1,13 +1,20 @@
 # The state is called l, as in the paper (and ω, c, a, b): E741 does not apply.
 # ruff: noqa: E741
-"""The Euler–Frahm top on so(4) and so(n), Manakov's integrable case, and its integration.
+"""The Euler–Frahm top on so(4) and so(n) and Manakov's integrable case.
+
+The Python side of the core's ``so4`` layer (``rust/so4/``). The tops' methods
+also reach the layers above it: ``integrate`` (:mod:`manakov.integrate`),
+``kotter``/``level_set`` (:mod:`manakov.reduction`) and ``solve``
+(:mod:`manakov.solution`).
 
 State convention
 ----------------
 An angular momentum ``l`` in so(n) is a skew matrix, ``l_ji = -l_ij``. Arrays
 hold its strict upper triangle row by row, so the last axis has length
 ``n(n-1)/2``; for n = 4 it is ordered ``(l12, l13, l14, l23, l24, l34)``. Every
-function broadcasts over leading axes; a single state in gives scalars out.
+function that takes states broadcasts over leading axes; a single state in
+gives scalars out (``docs/conventions.md``; ``solve`` and ``level_set`` take
+one state and say so).
 
 Equations (numbers are those of Perelomov's paper)
 ---------------------------------------------------
@@ -23,13 +30,24 @@ Equations (numbers are those of Perelomov's paper)
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
 from typing import Any, Callable
 
 import numpy as np
 
 from . import _core
+from . import integrate as _integrate
 from ._checks import _finite_result, _float_array, _n_from_dim, _out, _states, state_dim
+from .integrate import (
+    ADAPTIVE_METHODS,
+    DEFAULT_MAX_STEPS,
+    DEFAULT_RTOL,
+    DEFAULT_SAMPLES,
+    DT_SCALE,
+    MAX_SAMPLES,
+    METHODS,
+    Trajectory,
+    check_method,
+)
 from .reduction import Kotter
 from .reduction import LevelSet as _LevelSet
 from .reduction import from_kotter as _from_kotter
@@ -37,6 +55,11 @@ from .reduction import kotter as _kotter
 from .solution import Solution
 
 __all__ = [
+    "DEFAULT_MAX_STEPS",
+    "DEFAULT_RTOL",
+    "DEFAULT_SAMPLES",
+    "DT_SCALE",
+    "MAX_SAMPLES",
     "FrahmTop",
     "ManakovTop",
     "Trajectory",
@@ -46,42 +69,6 @@ __all__ = [
     "from_matrix",
     "state_dim",
 ]
-
-#: Integration methods: Gauss–Legendre collocation with 2, 3 and 8 stages
-#: (orders 4, 6, 16), the explicit adaptive Dormand–Prince pairs 5(4) and 8(5,3),
-#: and Taylor's method (so(4) only; order and step from ``rtol``, Jorba & Zou 2005).
-METHODS = ("gauss4", "gauss6", "gauss16", "dopri5", "dop853", "taylor")
-#: The adaptive methods: their step follows from ``rtol`` (and ``atol``), not ``dt``.
-_EXPLICIT = ("dopri5", "dop853", "taylor")
-
-#: Default ``rtol`` of each adaptive method. Taylor's method at machine epsilon
-#: (order 20) is its most accurate setting and, per unit of accuracy, its fastest
-#: batch kernel (``docs/dynamics.md``); the Dormand–Prince pairs keep 1e-12.
-DEFAULT_RTOL = {"dopri5": 1e-12, "dop853": 1e-12, "taylor": float(np.finfo(float).eps)}
-
-#: Default step of each Gauss method in units of the top's time scale
-#: ``1/Ω``, ``Ω = (max c_ij - min c_ij) · ‖l0‖`` (a bound on the Lipschitz
-#: constant of (1) on the orbit). Chosen on the shared 'generic' top so that the error at
-#: t = 100 is ~1e-13 (gauss16: dt = 0.34, three steps per unit time) and the
-#: stage iteration converges in ~15 sweeps; see ``docs/dynamics.md``.
-DT_SCALE = {"gauss4": 0.01, "gauss6": 0.044, "gauss16": 1.5}
-
-#: Default number of samples when neither ``t_eval`` nor ``sample_every`` is given.
-DEFAULT_SAMPLES = 1001
-
-#: Most samples ``sample_every`` may ask for: 10^8 sample times are 0.8 GB, and
-#: the so(4) states at them 4.8 GB per trajectory.
-MAX_SAMPLES = 10**8
-
-#: Default step budget of one call to ``integrate``/``integrate_many`` (per
-#: trajectory): 10^8 steps bound a run to minutes (gauss16 ~1.3 µs a step on
-#: 'generic', dop853 ~0.3 µs) while leaving a 10x margin over the 10^7-step runs
-#: of the issue. Runs are interruptible (Ctrl-C). Pass ``max_steps`` (up to 10^11)
-#: for longer runs.
-DEFAULT_MAX_STEPS = 10**8
-
-#: The core's hard cap on ``max_steps`` (``integrate::MAX_STEPS``).
-_MAX_STEPS_CAP = 10**11
 
 
 def to_matrix(l: Any) -> np.ndarray:
@@ -172,59 +159,6 @@ def poisson_tensor(l: Any) -> np.ndarray:
     _n_from_dim(m)
     flat, lead = _states(arr, m)
     return _core.poisson_tensor(flat).reshape(lead + (m, m))
-
-
-@dataclass(frozen=True)
-class Trajectory:
-    """A sampled solution of (1).
-
-    Attributes
-    ----------
-    t : ndarray, shape (S,)
-        Sample times.
-    l : ndarray, shape (S, n(n-1)/2)
-        States at the sample times.
-    integrals : dict of str to ndarray (S,)
-        The top's integrals along the samples (see ``FrahmTop.integrals``).
-    method : str
-    dt : float
-        The largest step (Gauss methods) or the initial step (explicit; 0 = automatic).
-    steps, evals : int
-        Steps taken and vector-field evaluations.
-    """
-
-    t: np.ndarray
-    l: np.ndarray
-    integrals: dict[str, np.ndarray]
-    method: str
-    dt: float
-    steps: int
-    evals: int
-
-    def relative_drift(self) -> dict[str, np.ndarray]:
-        """``|I(t) - I(t0)| / |I(t0)|`` for each integral (absolute if ``I(t0) = 0``).
-
-        Returns
-        -------
-        dict of str to ndarray, shape (S,)
-        """
-        out = {}
-        for name, v in self.integrals.items():
-            if v.size == 0:
-                out[name] = np.zeros(0)
-                continue
-            ref = abs(v[0]) if v[0] != 0 else 1.0
-            out[name] = np.abs(v - v[0]) / ref
-        return out
-
-    def max_drift(self) -> dict[str, float]:
-        """The largest relative drift ``max_t |I(t) - I(t0)| / |I(t0)|`` of each integral.
-
-        Returns
-        -------
-        dict of str to float
-        """
-        return {k: float(np.max(v, initial=0.0)) for k, v in self.relative_drift().items()}
 
 
 class FrahmTop:
@@ -340,60 +274,68 @@ class FrahmTop:
 
     # -- integration ---------------------------------------------------------
 
-    def time_scale(self, l0: Any) -> float:
+    def time_scale(self, l0: Any) -> Any:
         """``1/Ω``, ``Ω = (max_{i≠j} c_ij - min_{i≠j} c_ij) · ‖l0‖₂``; ``inf`` if Ω = 0.
 
         ``Ω`` bounds ``|c_kj - c_ik| · ‖l‖``, the Lipschitz constant of (1) on the orbit.
 
         Parameters
         ----------
-        l0 : array_like, real
-            A state (any shape; only its norm enters).
+        l0 : array_like, real, shape (..., n(n-1)/2)
 
         Returns
         -------
-        float
+        float or ndarray, shape ``l0.shape[:-1]``
 
         Raises
         ------
         ValueError
-            Complex or non-finite ``l0``.
+            Wrong last axis, complex or non-finite ``l0``.
         """
-        l0a = _float_array(l0, "l0")
+        flat, lead = _states(l0, self.dim, "l0")
+        out = np.array([self._time_scale(x) for x in flat]).reshape(lead)
+        return float(out) if out.ndim == 0 else out
+
+    def _time_scale(self, l0: np.ndarray) -> float:
         n, c = self.n, self._c
         off = c[~np.eye(n, dtype=bool)]
         spread = float(np.max(off) - np.min(off)) if off.size else 0.0
-        big = float(np.max(np.abs(l0a), initial=0.0))
+        big = float(np.max(np.abs(l0), initial=0.0))
         # ‖l0‖ scaled by its largest entry, so that squaring cannot overflow.
-        norm = big * float(np.linalg.norm(l0a / big)) if big > 0 else 0.0
+        norm = big * float(np.linalg.norm(l0 / big)) if big > 0 else 0.0
         with np.errstate(over="ignore"):
             omega = float(np.float64(spread) * np.float64(norm))
         return math.inf if omega == 0 else 1.0 / omega
 
-    def default_dt(self, l0: Any, method: str = "gauss16") -> float:
+    def default_dt(self, l0: Any, method: str = "gauss16") -> Any:
         """The default step of ``method`` for this top from ``l0``: ``DT_SCALE[method] / Ω``.
 
         ``Ω`` as in :meth:`time_scale`; 1 if ``Ω = 0``; 0 (automatic) for explicit methods.
 
         Parameters
         ----------
-        l0 : array_like, real
+        l0 : array_like, real, shape (..., n(n-1)/2)
         method : str
             One of :data:`METHODS`.
 
         Returns
         -------
-        float
+        float or ndarray, shape ``l0.shape[:-1]``
 
         Raises
         ------
         ValueError
-            Unknown ``method``, complex or non-finite ``l0`` (for every method), or a
-            step that underflows.
+            Unknown ``method``, wrong last axis, complex or non-finite ``l0`` (for
+            every method), or a step that underflows.
         """
-        _check_method(method)
-        ts = self.time_scale(l0)  # checks l0 (real, finite) for every method
-        if method in _EXPLICIT:
+        check_method(method)
+        flat, lead = _states(l0, self.dim, "l0")
+        out = np.array([self._default_dt(x, method) for x in flat]).reshape(lead)
+        return float(out) if out.ndim == 0 else out
+
+    def _default_dt(self, l0: np.ndarray, method: str) -> float:
+        ts = self._time_scale(l0)
+        if method in ADAPTIVE_METHODS:
             return 0.0
         if not math.isfinite(ts):
             return 1.0
@@ -402,55 +344,19 @@ class FrahmTop:
             raise ValueError("l0 is too large: its time scale 1/Ω underflows; rescale l0")
         return dt
 
-    def _sample_times(self, t_end: Any, t_eval: Any, sample_every: Any) -> np.ndarray:
-        t_end_f = _scalar(t_end, "t_end")
-        if t_end_f < 0:
-            raise ValueError(f"t_end must be >= 0, got {t_end_f}")
-        if t_eval is not None and sample_every is not None:
-            raise ValueError("give at most one of t_eval and sample_every")
-        if t_eval is not None:
-            te = _float_array(t_eval, "t_eval")
-            if te.ndim != 1:
-                raise ValueError(f"t_eval must be 1-d, got shape {te.shape}")
-            if te.size and (np.any(np.diff(te) < 0) or te[0] < 0 or te[-1] > t_end_f):
-                raise ValueError("t_eval must be sorted and lie in [0, t_end]")
-            # A copy: the trajectory never shares memory with the caller's array.
-            return np.array(te, dtype=np.float64, order="C", copy=True)
-        if sample_every is not None:
-            every = _scalar(sample_every, "sample_every")
-            if every <= 0:
-                raise ValueError(f"sample_every must be > 0, got {every}")
-            with np.errstate(over="ignore"):
-                ratio = float(np.float64(t_end_f) / np.float64(every)) * (1 + 1e-12)
-            if not ratio <= MAX_SAMPLES:
-                raise ValueError(
-                    f"sample_every = {every} gives more than {MAX_SAMPLES:.0e} samples "
-                    f"on [0, {t_end_f}]"
-                )
-            k = math.floor(ratio)
-            times = np.arange(k + 1, dtype=float) * every
-            times = times[times <= t_end_f]
-            if times[-1] < t_end_f:
-                times = np.append(times, t_end_f)
-            return times
-        return np.linspace(0.0, t_end_f, DEFAULT_SAMPLES)
-
-    @staticmethod
-    def _max_steps(max_steps: Any) -> int:
-        if isinstance(max_steps, bool) or not isinstance(max_steps, (int, np.integer)):
-            raise ValueError(f"max_steps must be an integer, got {max_steps!r}")
-        if not 1 <= max_steps <= _MAX_STEPS_CAP:
-            raise ValueError(f"max_steps must be in [1, 10^11], got {max_steps}")
-        return int(max_steps)
-
-    @staticmethod
-    def _tolerances(method: str, rtol: Any, atol: Any) -> tuple[float, float]:
-        """``rtol``, ``atol`` of an adaptive method (checked; ``rtol = None`` is the
-        method's :data:`DEFAULT_RTOL`); Gauss methods ignore them."""
-        if method not in _EXPLICIT:
-            return 0.0, 0.0
-        rt = DEFAULT_RTOL[method] if rtol is None else _scalar(rtol, "rtol")
-        return rt, _scalar(atol, "atol")
+    def _batch_default_dt(self, flat: np.ndarray, method: str) -> float:
+        """The one default step of states ``flat`` (N, m): the smallest of their
+        defaults, that of the largest ``|l0|`` (the default is
+        ``DT_SCALE / ((max c - min c) |l0|)``)."""
+        if flat.shape[0] == 1:
+            return self._default_dt(flat[0], method)
+        big = np.max(np.abs(flat), axis=1, keepdims=True)
+        safe = np.where(big > 0, big, 1.0)
+        # Only the argmax is used: a norm overflowing to inf still picks the
+        # largest state, whose default step then names the cause.
+        with np.errstate(over="ignore"):
+            norms = big[:, 0] * np.linalg.norm(flat / safe, axis=1)
+        return self._default_dt(flat[int(np.argmax(norms))], method)
 
     def _refuse_default_step(
         self, l0s: np.ndarray, method: str, dt: float, t_end: float, budget: int
@@ -461,7 +367,7 @@ class FrahmTop:
         huge ``|l0|`` or a large spread of the ``c_ij`` (for Manakov's top, nearly
         equal ``a_i``) makes it small.
         """
-        if method in _EXPLICIT or not t_end / dt > budget:
+        if method in ADAPTIVE_METHODS or not t_end / dt > budget:
             return
         off = self._c[~np.eye(self.n, dtype=bool)]
         spread = float(np.max(off) - np.min(off))
@@ -486,15 +392,6 @@ class FrahmTop:
     def _spread_origin(self) -> str:
         return ""
 
-    def _options(self, l0: Any, method: str, dt: Any) -> float:
-        _check_method(method)
-        if dt is None:
-            return self.default_dt(l0, method)
-        dtf = _scalar(dt, "dt")
-        if dtf <= 0:
-            raise ValueError(f"dt must be > 0, got {dtf}")
-        return dtf
-
     def integrate(
         self,
         l0: Any,
@@ -506,9 +403,11 @@ class FrahmTop:
         method: str = "gauss16",
         rtol: float | None = None,
         atol: float = 1e-12,
-        progress: Callable[[float], None] | None = None,
+        progress: bool | Callable[[float], object] | None = None,
         chunks: int = 1,
         max_steps: int = DEFAULT_MAX_STEPS,
+        parallel: bool = True,
+        chunk_size: int | None = None,
     ) -> Trajectory:
         """Integrate (1) from ``l0`` at t = 0 to ``t_end``, keeping samples only.
 
@@ -517,14 +416,21 @@ class FrahmTop:
         machine precision: the quadratic integrals H0–H3 and H are conserved to
         roundoff, which grows like the square root of the number of steps.
 
+        Broadcasts over leading axes: ``l0`` of shape ``(..., n(n-1)/2)`` is a
+        batch, run with the GIL released on all cores (as :meth:`integrate_many`),
+        and every array of the result gains its leading axes.
+
         Parameters
         ----------
-        l0 : array_like, shape (n(n-1)/2,)
+        l0 : array_like, shape (..., n(n-1)/2)
+            One initial state, or a batch.
         t_end : float, >= 0
+            ``t_end = 0`` gives the one sample ``l0`` at t = 0 (unless ``t_eval``
+            asks for more).
         dt : float, optional
-            Largest step of a Gauss method (default: ``default_dt``); initial
-            step of ``dopri5``/``dop853`` (default automatic); largest step of
-            ``taylor`` (default: none).
+            Largest step of a Gauss method (default: ``default_dt``; for a batch
+            the smallest over its states); initial step of ``dopri5``/``dop853``
+            (default automatic); largest step of ``taylor`` (default: none).
         t_eval : array_like, optional
             Sorted sample times in [0, t_end].
         sample_every : float, optional
@@ -541,36 +447,48 @@ class FrahmTop:
             error per step ``ε`` (default and smallest: ``eps``; at most 1e-3) and
             ``atol`` is ignored. Gauss methods ignore both (they are neither used
             nor checked).
-        progress : callable, optional
-            Called with the fraction done after each chunk.
+        progress : bool or callable, optional
+            ``True``: a progress bar on stderr; ``False``: none; a callable: called
+            with the fraction of samples written (0 to 1, non-decreasing; at most
+            every ~20 ms and once at the end). Default: a bar on a terminal for a
+            Gauss run of at least 10^6 steps. Watching does not change the run.
         chunks : int
-            Split the run into this many calls to the core (for ``progress``); an
-            integer >= 1 (capped at the number of samples), else ValueError.
+            Split one state's run into this many calls to the core, at sample
+            times (an integer >= 1, capped at the number of samples). Not needed
+            for ``progress``; results agree with one call to roundoff, not bit for
+            bit (each call starts its step control afresh). One state only.
         max_steps : int
-            Step budget of the whole run (default :data:`DEFAULT_MAX_STEPS`, at most
-            10^11). Checked before the first step: more sample intervals than
+            Step budget of each trajectory (default :data:`DEFAULT_MAX_STEPS`, at
+            most 10^11). Checked before the first step: more sample intervals than
             ``max_steps`` (each needs a step), or for Gauss methods more steps than
             ``max_steps`` (known in advance), is refused with a ValueError naming
             the cause (the sample spacing, a huge ``|l0|`` behind the default step,
             or ``dt``). Explicit methods stop once they exceed it.
+        parallel : bool
+            Split a batch over threads (rayon).
+        chunk_size : int, optional
+            States per call to the core in a batch (default
+            :data:`~manakov.integrate.BATCH_CHUNK`): what an interruption keeps.
 
         Returns
         -------
         Trajectory
+            ``t`` (S,), ``l`` (..., S, n(n-1)/2), ``integrals``, ``steps``, ...
 
         Raises
         ------
         ValueError
             Bad shapes, non-finite values, ``t_end`` < 0 or NaN, ``dt`` <= 0,
             an unknown ``method``, ``rtol`` below ``100 eps`` or ``atol`` < 0 for
-            an explicit method, ``chunks`` not an integer >= 1, or a run over
-            ``max_steps`` (refused before any step, or for an explicit method when
-            it runs out).
+            an explicit method, ``chunks`` or ``chunk_size`` not an integer >= 1,
+            ``progress`` not a bool or callable, an output too large to allocate,
+            or a run over ``max_steps`` (refused before any step, or for an
+            explicit method when it runs out).
         manakov.ConvergenceError
             A Gauss step whose stage equations do not converge (``dt`` too large).
         KeyboardInterrupt
             Ctrl-C (SIGINT) during the run: the call stops within a few
-            milliseconds.
+            milliseconds; no thread outlives it.
 
         Notes
         -----
@@ -587,69 +505,38 @@ class FrahmTop:
         t = 1e4 (``docs/dynamics.md``). Looser ``rtol`` lowers the order and the
         integrals drift; ``gauss16`` conserves them at any step.
 
+        For so(4) with ``gauss16``, ``dop853`` or ``taylor`` a batch runs on a
+        kernel whose vector lanes carry different trajectories (4 per AVX2
+        register); the results equal those of each state alone, bit for bit
+        (``docs/dynamics.md``).
+
         An error raised after the run started (KeyboardInterrupt, an explicit
-        method's ``max_steps``, ConvergenceError) carries the samples computed up
-        to that point as ``err.partial``, a :class:`Trajectory` (possibly with
-        zero samples)::
+        method's ``max_steps``, ConvergenceError, the ``progress`` callable's own)
+        carries what was computed as ``err.partial``, a :class:`Trajectory` with
+        ``ok`` false: one state's samples up to that point (possibly none), or a
+        batch's trajectories finished before it (NaN elsewhere)::
 
             try:
                 tr = top.integrate(l0, 1e7)
             except KeyboardInterrupt as err:
                 tr = err.partial  # the samples before Ctrl-C
         """
-        l0a, _ = _states(l0, self.dim, "l0")
-        if l0a.shape[0] != 1 or np.ndim(l0) != 1:
-            raise ValueError(f"l0 must have shape ({self.dim},), got {np.shape(l0)}")
-        times = self._sample_times(t_end, t_eval, sample_every)
-        dtf = self._options(l0a[0], method, dt)
-        rt, at = self._tolerances(method, rtol, atol)
-        budget = self._max_steps(max_steps)
-        n_chunks = _chunks(chunks)
-        if times.size and dt is None:
-            self._refuse_default_step(l0a, method, dtf, float(times[-1]), budget)
-        # The whole run's budget, before the first step of the first chunk.
-        _core.check_budget(method, 0.0, times, dtf, budget)
-        out: list[np.ndarray] = []
-        steps = evals = 0
-
-        def trajectory(partial: bool = False) -> Trajectory:
-            ls = np.concatenate(out) if out else np.empty((0, self.dim))
-            try:
-                integrals = self.integrals(ls)
-            except ValueError:
-                if not partial:
-                    raise
-                # The samples before a failure may overflow the integrals: keep the
-                # samples, without integrals.
-                integrals = {}
-            return Trajectory(
-                t=times[: ls.shape[0]].copy(),
-                l=ls,
-                integrals=integrals,
-                method=method,
-                dt=dtf,
-                steps=int(steps),
-                evals=int(evals),
-            )
-
-        if times.size:
-            pieces = np.array_split(times, min(n_chunks, times.size))
-            y, t0 = l0a[0], 0.0
-            for piece in pieces:
-                ys, s, e, err = _core.integrate(
-                    self._c, y, t0, piece, method, dtf, rt, at, budget - steps
-                )
-                out.append(ys)
-                steps, evals = steps + s, evals + e
-                if err is not None:
-                    # Ctrl-C, max_steps or a failed step: the samples reached so far
-                    # ride on the exception (documented as ``err.partial``).
-                    err.partial = trajectory(partial=True)  # type: ignore[attr-defined]
-                    raise err
-                y, t0 = ys[-1], float(piece[-1])
-                if progress is not None:
-                    progress(t0 / float(times[-1]) if times[-1] > 0 else 1.0)
-        return trajectory()
+        return _integrate.run(
+            self,
+            l0,
+            t_end,
+            dt=dt,
+            t_eval=t_eval,
+            sample_every=sample_every,
+            method=method,
+            rtol=rtol,
+            atol=atol,
+            progress=progress,
+            chunks=chunks,
+            max_steps=max_steps,
+            parallel=parallel,
+            chunk_size=chunk_size,
+        )
 
     def integrate_many(
         self,
@@ -664,73 +551,52 @@ class FrahmTop:
         atol: float = 1e-12,
         parallel: bool = True,
         max_steps: int = DEFAULT_MAX_STEPS,
-    ) -> tuple[np.ndarray, np.ndarray]:
-        """Integrate a batch of initial states in one call, GIL released.
+        progress: bool | Callable[[float], object] | None = None,
+        chunk_size: int | None = None,
+    ) -> Trajectory:
+        """Integrate a batch of initial states in one call, GIL released: :meth:`integrate`.
+
+        The batch spelling of :meth:`integrate`, which broadcasts over leading
+        axes itself: the same arguments (except ``chunks``), the same result, bit
+        for bit.
 
         Parameters
         ----------
         l0s : array_like, shape (..., n(n-1)/2)
-        t_end, dt, t_eval, sample_every, method, rtol, atol
+        t_end, dt, t_eval, sample_every, method, rtol, atol, max_steps, progress
             As in :meth:`integrate`; ``dt`` defaults to the smallest default
-            step over the batch.
+            step over the batch, ``max_steps`` is the budget of each trajectory.
         parallel : bool
             Split the batch over threads (rayon).
-        max_steps : int
-            Step budget of each trajectory, as in :meth:`integrate`; with the
-            output size, checked before any work or allocation.
-
-        Notes
-        -----
-        For so(4) with ``gauss16``, ``dop853`` or ``taylor`` the batch runs on a
-        kernel whose vector lanes carry different trajectories (4 per AVX2
-        register); the results equal :meth:`integrate` state by state, bit for bit
-        (see ``docs/dynamics.md``). ``taylor`` (default ``rtol = eps``) is the
-        fastest batch method at equal accuracy; ``gauss16`` stays the default (it
-        conserves the integrals at any step, and is the faster single-trajectory
-        method). The call is interruptible (Ctrl-C raises
-        KeyboardInterrupt; no thread outlives the call).
+        chunk_size : int, optional
+            As in :meth:`integrate`.
 
         Returns
         -------
-        t : ndarray, shape (S,)
-        l : ndarray, shape (..., S, n(n-1)/2)
+        Trajectory
+            ``t`` (S,) and ``l`` (..., S, n(n-1)/2), ... (``t, l = ...`` unpacks).
 
         Raises
         ------
-        ValueError
-            As :meth:`integrate`, and an output too large to allocate.
-        manakov.ConvergenceError
-            As :meth:`integrate`.
-        KeyboardInterrupt
-            Ctrl-C during the run.
+        ValueError, manakov.ConvergenceError, KeyboardInterrupt
+            As :meth:`integrate` (with ``err.partial``).
         """
-        flat, lead = _states(l0s, self.dim, "l0s")
-        times = self._sample_times(t_end, t_eval, sample_every)
-        _check_method(method)
-        if dt is None:
-            # One step for the whole batch: the smallest default over its members,
-            # that of the largest |l0| (the default is DT_SCALE / ((max c - min c) |l0|)).
-            if flat.shape[0] == 0:
-                dtf = 1.0
-            else:
-                big = np.max(np.abs(flat), axis=1, keepdims=True)
-                safe = np.where(big > 0, big, 1.0)
-                # Only the argmax is used: a norm overflowing to inf still picks the
-                # largest state, whose default_dt then names the cause.
-                with np.errstate(over="ignore"):
-                    norms = big[:, 0] * np.linalg.norm(flat / safe, axis=1)
-                dtf = self.default_dt(flat[int(np.argmax(norms))], method)
-        else:
-            dtf = self._options(np.zeros(self.dim), method, dt)
-        rt, at = self._tolerances(method, rtol, atol)
-        budget = self._max_steps(max_steps)
-        if times.size and flat.shape[0] and dt is None:
-            self._refuse_default_step(flat, method, dtf, float(times[-1]), budget)
-        # The core checks the budget and the output size before allocating.
-        ys, _ = _core.integrate_many(
-            self._c, flat, 0.0, times, method, dtf, rt, at, budget, bool(parallel)
+        return _integrate.run(
+            self,
+            l0s,
+            t_end,
+            dt=dt,
+            t_eval=t_eval,
+            sample_every=sample_every,
+            method=method,
+            rtol=rtol,
+            atol=atol,
+            progress=progress,
+            chunks=1,
+            max_steps=max_steps,
+            parallel=parallel,
+            chunk_size=chunk_size,
         )
-        return times, ys.reshape(lead + (times.size, self.dim))
 
 
 class ManakovTop(FrahmTop):
@@ -958,24 +824,3 @@ class ManakovTop(FrahmTop):
 
     def __repr__(self) -> str:
         return f"ManakovTop(a={self._a.tolist()}, b={self._b.tolist()})"
-
-
-def _check_method(method: Any) -> None:
-    if not isinstance(method, str) or method not in METHODS:
-        raise ValueError(f"unknown method {method!r}; known: {', '.join(METHODS)}")
-
-
-def _chunks(chunks: Any) -> int:
-    if isinstance(chunks, bool) or not isinstance(chunks, (int, np.integer)) or chunks < 1:
-        raise ValueError(f"chunks must be an integer >= 1, got {chunks!r}")
-    return int(chunks)
-
-
-def _scalar(x: Any, what: str) -> float:
-    arr = np.asarray(x)
-    if arr.ndim != 0 or arr.dtype.kind not in "biuf":
-        raise ValueError(f"{what} must be a real scalar, got {x!r}")
-    v = float(arr)
-    if not math.isfinite(v):
-        raise ValueError(f"{what} must be finite, got {v}")
-    return v
