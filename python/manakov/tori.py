@@ -30,14 +30,14 @@ from typing import Any, Callable, NamedTuple
 import numpy as np
 
 from . import _core
-from ._progress import ProgressBar
+from ._checks import _last_axis, _one_state
+from ._progress import Progress
 from ._torus import Torus, real_torus, second_flow_b, torus_of_state
-from .problems import problem
-from .top import ManakovTop
 
 __all__ = [
     "STATUS_NAMES",
     "OK",
+    "NOT_COMPUTED",
     "FrequencyMap",
     "Torus",
     "real_torus",
@@ -45,11 +45,15 @@ __all__ = [
     "torus_of_state",
     "frequency_map",
     "casimir_slice",
-    "plot_frequency_map",
 ]
 
+#: The status codes of the core's frequency map, indexed by code.
+_CORE_STATUS_NAMES: tuple[str, ...] = tuple(_core.tori_status_names())
+#: A state an interrupted map did not reach (only in ``err.partial``): one past
+#: the core's codes, so it can never be one of them.
+NOT_COMPUTED = len(_CORE_STATUS_NAMES)
 #: Names of the status codes of :func:`frequency_map`, indexed by code.
-STATUS_NAMES: tuple[str, ...] = tuple(_core.tori_status_names())
+STATUS_NAMES: tuple[str, ...] = (*_CORE_STATUS_NAMES, "not computed")
 
 #: The status code of a state whose frequencies were computed.
 OK = 0
@@ -96,17 +100,43 @@ PROGRESS_MIN_STATES = 20000
 class FrequencyMap(NamedTuple):
     """Result of :func:`frequency_map` (unpacks as ``nu, status``).
 
+    Every array has the leading shape of the states it was computed from
+    (``docs/conventions.md``).
+
     Attributes
     ----------
     nu : ndarray, shape (..., 2)
         ``(ν1, ν2)`` per state (cycles per unit time); NaN exactly where
-        ``status != OK``.
+        ``status != OK``. Also :attr:`frequencies`, the name of
+        :attr:`Torus.frequencies` and ``Solution.frequencies``.
     status : ndarray, uint8, shape (...)
-        A code of :data:`STATUS_NAMES` per state.
+        A code of :data:`STATUS_NAMES` per state (:data:`NOT_COMPUTED` only in
+        the ``err.partial`` of an interrupted map).
     """
 
     nu: np.ndarray
     status: np.ndarray
+
+    @property
+    def frequencies(self) -> np.ndarray:
+        """``(ν1, ν2)`` per state: :attr:`nu`, by the name :class:`Torus` uses."""
+        return self.nu
+
+    @property
+    def ok(self) -> Any:
+        """Which states have frequencies (``status == OK``), as ``Kotter.ok``."""
+        ok = np.asarray(self.status) == OK
+        return bool(ok) if ok.ndim == 0 else ok
+
+    @property
+    def rotation_number(self) -> Any:
+        """``ν1/ν2`` per state (``inf`` where ``ν2 = 0``, NaN where not :attr:`ok`),
+        as :attr:`Torus.rotation_number`."""
+        nu = np.asarray(self.nu)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            r = np.where(nu[..., 1] != 0, nu[..., 0] / nu[..., 1], np.inf)
+        r = np.where(np.asarray(self.status) == OK, r, np.nan)
+        return float(r) if r.ndim == 0 else r
 
     def counts(self) -> dict[str, int]:
         """How many states have each status (names of :data:`STATUS_NAMES`)."""
@@ -124,6 +154,25 @@ def _split(n: int, chunk: int) -> list[tuple[int, int]]:
     return [(i, min(i + chunk, n)) for i in range(0, n, chunk)]
 
 
+def _check_client(client: Any) -> None:
+    """``client`` is None or a ``dask.distributed.Client`` (else ValueError naming it)."""
+    if client is None:
+        return
+    try:
+        from distributed import Client
+    except ImportError:
+        raise ValueError(
+            f"client must be a dask.distributed.Client, got {client!r} "
+            f"({type(client).__name__}); dask.distributed is not installed "
+            "(pip install 'manakov[dask]')"
+        ) from None
+    if not isinstance(client, Client):
+        raise ValueError(
+            f"client must be a dask.distributed.Client or None, got {client!r} "
+            f"({type(client).__name__})"
+        )
+
+
 def _run_chunks(
     fn: Callable[..., Any],
     args: Sequence[Any],
@@ -131,7 +180,7 @@ def _run_chunks(
     *,
     client: Any,
     chunk_size: int,
-    progress: bool | None,
+    progress: Any,
     label: str,
 ) -> list[Any]:
     """``[fn(*args, states[i:j]) for each chunk]`` in order, locally or on ``client``.
@@ -140,40 +189,50 @@ def _run_chunks(
     function parallelises within a chunk); dask is not imported. With a
     ``dask.distributed`` client every chunk is a task; a task lost with its
     worker is rerun by the scheduler, so the list is complete and in order.
+    ``progress`` as in :func:`frequency_map`.
+
+    An exception (Ctrl-C included) carries the chunks finished before it as
+    ``err.chunks_done`` (the list, ``None`` for a chunk not finished); the tasks
+    still queued on ``client`` are cancelled.
     """
     n = states.shape[0]
     spans = _split(n, chunk_size)
-    show = n >= PROGRESS_MIN_STATES if progress is None else bool(progress)
-    bar = ProgressBar(label, force=bool(progress)) if show else None
     out: list[Any] = [None] * len(spans)
-    try:
-        if client is None:
-            done = 0
-            for k, (i, j) in enumerate(spans):
-                out[k] = fn(*args, states[i:j])
-                done += j - i
-                if bar is not None:
-                    bar.update(done / n)
-        else:
-            from distributed import as_completed  # only with a client
+    futures: list[Any] = []
+    with Progress(progress, label, long=n >= PROGRESS_MIN_STATES) as report:
+        try:
+            if client is None:
+                done = 0
+                for k, (i, j) in enumerate(spans):
+                    out[k] = fn(*args, states[i:j])
+                    done += j - i
+                    report(done / n)
+            else:
+                from distributed import as_completed  # only with a client
 
-            futures = [
-                client.submit(
-                    fn, *args, states[i:j], pure=False, key=f"{label}-{k}-{os.urandom(6).hex()}"
-                )
-                for k, (i, j) in enumerate(spans)
-            ]
-            index = {f.key: k for k, f in enumerate(futures)}
-            done = 0
-            for fut in as_completed(futures):
-                k = index[fut.key]
-                out[k] = fut.result()
-                done += spans[k][1] - spans[k][0]
-                if bar is not None:
-                    bar.update(done / n)
-    finally:
-        if bar is not None:
-            bar.close()
+                futures = [
+                    client.submit(
+                        fn,
+                        *args,
+                        states[i:j],
+                        pure=False,
+                        key=f"{label}-{k}-{os.urandom(6).hex()}",
+                    )
+                    for k, (i, j) in enumerate(spans)
+                ]
+                index = {f.key: k for k, f in enumerate(futures)}
+                done = 0
+                for fut in as_completed(futures):
+                    k = index[fut.key]
+                    out[k] = fut.result()
+                    done += spans[k][1] - spans[k][0]
+                    report(done / n)
+        except BaseException as err:
+            if futures:
+                client.cancel([f for k, f in enumerate(futures) if out[k] is None])
+            err.chunks_done = out  # type: ignore[attr-defined]
+            raise
+        report(1.0)
     return out
 
 
@@ -183,7 +242,7 @@ def frequency_map(
     *,
     client: Any = None,
     chunk_size: int | None = None,
-    progress: bool | None = None,
+    progress: bool | Callable[[float], object] | None = None,
 ) -> FrequencyMap:
     """Frequencies ``(ν1, ν2)`` of the real tori through many initial states.
 
@@ -205,61 +264,88 @@ def frequency_map(
     top : ManakovTop
         The top (its ``a`` and ``b``).
     states : array_like, real, shape (..., 6)
-        Initial states ``(l12, l13, l14, l23, l24, l34)``. Not modified.
+        Initial states ``(l12, l13, l14, l23, l24, l34)``, any leading shape.
+        Not modified. A NaN or infinite state gets its status code, not an
+        exception.
     client : distributed.Client, optional
         Run the chunks as tasks on this dask cluster. Results are identical
         to the local run, bit for bit, and in order. Without a client the
         work runs in this process across all cores, and dask is not imported.
     chunk_size : int, optional
         States per chunk (default :data:`LOCAL_CHUNK` locally,
-        :data:`DASK_CHUNK` with a client).
-    progress : bool, optional
-        Show a progress bar on stderr; by default shown on a terminal for
-        maps of at least :data:`PROGRESS_MIN_STATES` states.
+        :data:`DASK_CHUNK` with a client): the unit of progress and of what an
+        interruption keeps.
+    progress : bool or callable, optional
+        ``True``: a progress bar on stderr; ``False``: none; a callable: called
+        with the fraction of states done after each chunk. Default: a bar on a
+        terminal for maps of at least :data:`PROGRESS_MIN_STATES` states.
 
     Returns
     -------
     FrequencyMap
-        ``nu`` of shape (..., 2) and ``status`` of shape (...). A state on a
-        singular level set (``h1² = 4h0²``, coinciding branch points, ...)
-        gets its code of :data:`STATUS_NAMES` and NaN frequencies; no exception
-        is raised for it. (Codes 3, 10 and 11 belong to the solution's route,
-        ``sol.torus``; the map meets them only where it falls back on that
-        route, when the auxiliary divisors do not agree; no such state is known.)
+        ``nu`` of shape (..., 2) and ``status`` of shape (...) (also ``ok``,
+        ``frequencies``, ``rotation_number``). A state on a singular level set
+        (``h1² = 4h0²``, coinciding branch points, ...) gets its code of
+        :data:`STATUS_NAMES` and NaN frequencies; no exception is raised for it.
+        (Codes 3, 10 and 11 belong to the solution's route, ``sol.torus``; the
+        map meets them only where it falls back on that route, when the
+        auxiliary divisors do not agree; no such state is known.)
 
     Raises
     ------
     ValueError
-        If ``states`` does not have shape (..., 6) or is not real, or
-        ``chunk_size`` is not a positive integer.
+        ``states`` not of shape (..., 6) or not real, ``chunk_size`` not a
+        positive integer, ``client`` not a ``dask.distributed.Client``, or
+        ``progress`` not a bool or callable.
     KeyboardInterrupt
-        On Ctrl-C (locally).
+        On Ctrl-C, within a fraction of a second (locally). It carries the map
+        of the chunks finished before it as ``err.partial``, a
+        :class:`FrequencyMap` of the full shape whose other states have status
+        :data:`NOT_COMPUTED` and NaN frequencies; so does any other exception
+        raised during the map (the ``progress`` callable's, a lost cluster).
     """
     a = np.ascontiguousarray(np.asarray(top.a, dtype=float))
     b = np.ascontiguousarray(np.asarray(top.b, dtype=float))
     arr = np.asarray(states)
-    if np.iscomplexobj(arr) or arr.dtype == object or arr.ndim == 0 or arr.shape[-1] != 6:
-        raise ValueError(f"states must be a real array of shape (..., 6), got {arr.shape}")
+    # NaN and infinity are allowed (they get a status): only the type and the
+    # shape are checked.
+    if arr.dtype.kind not in "biuf":
+        raise ValueError(f"states must be a real numeric array, got dtype {arr.dtype}")
+    _last_axis(arr, 6, "states")
     lead = arr.shape[:-1]
     flat = np.ascontiguousarray(arr.reshape(-1, 6), dtype=float)
+    _check_client(client)
     default = LOCAL_CHUNK if client is None else DASK_CHUNK
     size = default if chunk_size is None else chunk_size
     if isinstance(size, bool) or not isinstance(size, (int, np.integer)) or size < 1:
         raise ValueError(f"chunk_size must be a positive integer, got {chunk_size!r}")
-    parts = _run_chunks(
-        _frequency_chunk,
-        (a, b),
-        flat,
-        client=client,
-        chunk_size=int(size),
-        progress=progress,
-        label="frequency map",
-    )
-    if parts:
-        nu = np.concatenate([p.nu for p in parts])
-        status = np.concatenate([p.status for p in parts])
-    else:
-        nu, status = np.empty((0, 2)), np.empty(0, dtype=np.uint8)
+    try:
+        parts = _run_chunks(
+            _frequency_chunk,
+            (a, b),
+            flat,
+            client=client,
+            chunk_size=int(size),
+            progress=progress,
+            label="frequency map",
+        )
+    except BaseException as err:
+        done = getattr(err, "chunks_done", None)
+        if done is not None:
+            err.partial = _assemble(done, flat.shape[0], int(size), lead)  # type: ignore[attr-defined]
+        raise
+    return _assemble(parts, flat.shape[0], int(size), lead)
+
+
+def _assemble(
+    parts: Sequence[FrequencyMap | None], n: int, size: int, lead: tuple[int, ...]
+) -> FrequencyMap:
+    """The map of shape ``lead`` from its chunks (:data:`NOT_COMPUTED` for ``None``)."""
+    nu = np.full((n, 2), np.nan)
+    status = np.full(n, NOT_COMPUTED, dtype=np.uint8)
+    for (i, j), part in zip(_split(n, size), parts):
+        if part is not None:
+            nu[i:j], status[i:j] = part.nu, part.status
     return FrequencyMap(nu.reshape(*lead, 2), status.reshape(lead))
 
 
@@ -285,9 +371,7 @@ def casimir_slice(l0: Any, grid: int) -> tuple[np.ndarray, np.ndarray, np.ndarra
     states : ndarray, shape (grid, grid, 6)
         ``states[i, j]`` at ``cos ϑ = cos_theta[i]``, ``φ = phi[j]``.
     """
-    x = np.asarray(l0, dtype=float)
-    if x.shape != (6,) or not np.all(np.isfinite(x)):
-        raise ValueError(f"l0 must be a finite array of shape (6,), got {x!r}")
+    x = _one_state(l0, 6, "l0", "casimir_slice")
     if isinstance(grid, bool) or not isinstance(grid, (int, np.integer)) or grid < 2:
         raise ValueError(f"grid must be an integer >= 2, got {grid!r}")
     l12, l13, l14, l23, l24, l34 = x
@@ -310,99 +394,3 @@ def casimir_slice(l0: Any, grid: int) -> tuple[np.ndarray, np.ndarray, np.ndarra
     N = (P - q) / 2
     states = np.stack([M[..., 2], -M[..., 1], N[..., 0], M[..., 0], N[..., 1], N[..., 2]], axis=-1)
     return phi, ct, states
-
-
-def plot_frequency_map(
-    problem_name: str,
-    grid: int,
-    path: str | os.PathLike[str],
-    *,
-    client: Any = None,
-    max_order: int = 5,
-    progress: bool | None = None,
-    dpi: int = 120,
-) -> FrequencyMap:
-    """Plot the rotation number ``ν1/ν2`` over a Casimir slice of a shared problem.
-
-    The slice is :func:`casimir_slice` of the problem's ``l0`` (so every
-    state has the problem's ``h0``, ``h1``); the colour is ``ν1/ν2``, singular
-    states are grey, and the resonances ``k1 ν1 + k2 ν2 = 0`` with
-    ``|k1| + |k2| ≤ max_order`` are drawn as contour lines ``ν1/ν2 = −k2/k1``.
-
-    Parameters
-    ----------
-    problem_name : str
-        A name of :func:`manakov.problem_names`.
-    grid : int
-        Points per axis; the map has ``grid²`` states.
-    path : str or PathLike
-        Where to write the PNG.
-    client : distributed.Client, optional
-        Passed to :func:`frequency_map`.
-    max_order : int
-        Largest ``|k1| + |k2|`` of the resonance lines drawn.
-    progress : bool, optional
-        Passed to :func:`frequency_map`.
-    dpi : int
-        Resolution of the PNG.
-
-    Returns
-    -------
-    FrequencyMap
-        The map, of shape (grid, grid).
-    """
-    from fractions import Fraction
-
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-    from matplotlib.colors import LogNorm
-
-    pr = problem(problem_name)
-    top = ManakovTop(pr.a, pr.b)
-    phi, ct, states = casimir_slice(pr.l0, grid)
-    fm = frequency_map(top, states, client=client, progress=progress)
-    ok = fm.status == OK
-    ratio = np.full(ok.shape, np.nan)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        ratio[ok] = fm.nu[..., 0][ok] / fm.nu[..., 1][ok]
-    fig, ax = plt.subplots(figsize=(7, 5.5))
-    ax.set_facecolor("0.6")
-    masked = np.ma.masked_invalid(ratio)
-    norm = None
-    good = ratio[np.isfinite(ratio) & (ratio > 0)]
-    if good.size:
-        # Log scale between the 1st and 99th percentiles: the rotation number
-        # spans decades near separatrices (one frequency goes to zero).
-        lo, hi = np.percentile(good, [1, 99])
-        if hi > lo:
-            norm = LogNorm(vmin=lo, vmax=hi)
-    mesh = ax.pcolormesh(phi, ct, masked, shading="nearest", cmap="viridis", norm=norm)
-    fig.colorbar(mesh, ax=ax, label="rotation number ν1/ν2")
-    if good.size:
-        lo, hi = float(good.min()), float(good.max())
-        levels = sorted(
-            {
-                float(Fraction(k2, k1))
-                for k1 in range(1, max_order + 1)
-                for k2 in range(1, max_order + 1 - k1)
-                if lo < k2 / k1 < hi
-            }
-        )
-        if levels:
-            ax.contour(phi, ct, masked, levels=levels, colors="w", linewidths=0.6)
-    ax.set_xlabel("φ (direction of p = m + n)")
-    ax.set_ylabel("cos ϑ")
-    counts = fm.counts()
-    ax.set_title(
-        f"{problem_name}: ν1/ν2 at fixed h0, h1, {grid}×{grid}; resonances |k| ≤ {max_order}"
-        + (
-            "" if counts.get("ok", 0) == ok.size else f" (grey: {ok.size - int(ok.sum())} singular)"
-        ),
-        fontsize=9,
-    )
-    fig.tight_layout()
-    fig.savefig(os.fspath(path), dpi=dpi)
-    plt.close(fig)
-    return fm
