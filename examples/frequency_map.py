@@ -15,13 +15,14 @@ import numpy as np
 
 import manakov
 from manakov import tori
+from manakov.plots import plot_frequency_map
 
 name = sys.argv[1] if len(sys.argv) > 1 else "generic"
 grid = int(sys.argv[2]) if len(sys.argv) > 2 else 32
 path = f"frequency_map_{name}.png"
 
 start = time.perf_counter()
-fm = tori.plot_frequency_map(name, grid, path, progress=grid >= 128)
+fm = plot_frequency_map(name, grid, path, progress=grid >= 128)
 elapsed = time.perf_counter() - start
 print(f"{name}: {grid}x{grid} states in {elapsed:.2f} s ({1e6 * elapsed / grid**2:.0f} us/state)")
 print("status:", fm.counts())

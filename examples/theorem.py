@@ -1,14 +1,14 @@
 """The Theorem (9)-(10): l(t) from theta functions against gauss16 integration.
 
 Writes a PNG with l(t) from the theta quotients (lines) and from integration
-(dotted), and their difference on a log scale; prints the largest difference.
+(dots), and their difference on a log scale; prints the largest difference.
 
     python examples/theorem.py [problem] [out.png] [t_end]
 """
 
 import sys
 
-from manakov.solution import plot_theorem
+from manakov.plots import plot_theorem
 
 name = sys.argv[1] if len(sys.argv) > 1 else "generic"
 path = sys.argv[2] if len(sys.argv) > 2 else "theorem.png"

@@ -441,8 +441,9 @@ def test_theorem_subcommand_writes_png_and_reports_the_error(tmp_path, capsys):
 
 
 def test_theorem_subcommand_rejects_unknown_problem():
+    # As every subcommand that takes a top: the package's message, naming the known ones.
     r = _run("theorem", "nope")
-    assert r.returncode == 2 and "invalid choice" in r.stderr
+    assert r.returncode == 2 and "unknown problem 'nope'; known: generic" in r.stderr
 
 
 def test_frequency_map_subcommand_writes_png_and_counts_states(tmp_path, capsys):

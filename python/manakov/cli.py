@@ -5,8 +5,7 @@
 Subcommands (``manakov <command> --help`` shows each with an example):
 
 ``simulate``
-    Integrate a built-in reference top (``manakov.problem_names()``) or any
-    Manakov top (2) on so(n); write the trajectory to ``.npz`` (arrays ``t``,
+    Integrate a top (2) on so(n); write the trajectory to ``.npz`` (arrays ``t``,
     ``l``, ``a``, ``b`` and one array per integral), ``.csv`` (columns t, l..,
     integrals..) or, with ``-o -``, CSV on standard output; and, when matplotlib
     is importable, a PNG with l(t) and the relative drift of every integral.
@@ -14,17 +13,29 @@ Subcommands (``manakov <command> --help`` shows each with an example):
     The reduction of a state of a top on so(4) (equations (11)-(42)): the
     curve (8) with its branch points d_j, the divisor (z1, y1), (z2, y2), eps, g,
     and the round trip l -> Kötter -> l; a PNG of the branch points and the
-    divisor in the complex x-plane.
+    divisor.
 ``theta``
     Values of the theta functions (34)-(36) at a point.
+``theorem``
+    l(t) from theta functions (9)-(10) against integration, as a PNG.
+``frequency-map``
+    Frequencies of the invariant tori over a slice of states, as a PNG.
 ``fluid-simulate``, ``fluid-theorem``
     A rigid body in an ideal fluid (Kirchhoff's equations) and the Clebsch case
     in theta functions; see ``manakov._cli_fluid``.
 
-Ctrl-C stops any command: ``simulate`` writes the samples computed so far
-(to ``<output stem>.partial<suffix>``, marked partial), prints one line and
-exits with status 130; other commands exit with 130 at once. A closed output
-pipe (``manakov ... | head``) ends the command quietly.
+Every command that takes a top takes it in one of three ways: a built-in
+problem name (``manakov.problem_names()``; ``--l0`` may replace its state),
+``--a --b --l0``, or ``--problem-file`` (JSON or TOML with the keys of
+problems.json: ``a``, ``b``, ``l0``, or a ``tops`` table of them, picked by the
+problem name).
+
+Ctrl-C stops any command within a fraction of a second with status 130 and one
+line on stderr; the long ones keep their work: ``simulate`` writes the samples
+computed so far (to ``<output stem>.partial<suffix>``, marked partial),
+``theorem`` and ``frequency-map`` the figure of what was computed (to
+``<output stem>.partial.png``). A closed output pipe (``manakov ... | head``)
+ends the command quietly.
 
 Adding a subcommand: write ``_add_<name>(parser)`` and ``_run_<name>(args) -> int``
 and add one :class:`Command` to :data:`COMMANDS` (description, example and the
@@ -46,9 +57,11 @@ from typing import Any, TextIO
 
 import numpy as np
 
-from . import __version__, _cli_fluid, problem, problem_names
-from ._progress import ProgressBar
-from .top import DEFAULT_MAX_STEPS, METHODS, ManakovTop, state_dim
+from . import __version__, _cli_fluid, problem_names
+from ._checks import _show
+from .integrate import ADAPTIVE_METHODS, DEFAULT_MAX_STEPS, METHODS, Trajectory, gauss_steps
+from .problems import Problem, as_problem, read_problem
+from .top import ManakovTop, state_dim
 
 #: Default t_end of ``manakov simulate``: 1000 time units of 'generic' run in
 #: about 10 ms of integration.
@@ -58,21 +71,6 @@ DEFAULT_T_END = 1000.0
 #: a smaller step than the method's (they did: 20001 samples of 'physical' cut
 #: its step from 0.1 to 0.05).
 DEFAULT_SAMPLES = 20001
-#: The l(t) panel of the PNG shows at most this initial stretch (oscillations
-#: have periods of a few time units; a longer window is a solid band).
-PLOT_WINDOW = 40.0
-#: Runs longer than this many steps show the progress bar (on a terminal).
-PROGRESS_MIN_STEPS = 200_000
-#: Steps per segment of a run. The run is integrated segment by segment (each
-#: segment a whole number of sample intervals), so that Ctrl-C leaves the
-#: finished segments to write and the progress bar moves; 3·10^4 Gauss steps take
-#: 30–90 ms (1–3 µs a step on a loaded machine), so a segment boundary (where
-#: Python sees the signal) comes well within 0.5 s even before the core checks
-#: signals itself.
-SEGMENT_STEPS = 30_000
-#: Explicit (adaptive) methods: their step is not known before the run; the
-#: first sample interval is integrated alone to measure it.
-EXPLICIT_METHODS = ("dopri5", "dop853", "taylor")
 #: Exit status after Ctrl-C (128 + SIGINT, as a shell reports it).
 EXIT_INTERRUPTED = 130
 #: Exit status when the reader of standard output went away (128 + SIGPIPE).
@@ -112,31 +110,70 @@ def _complexes(text: str) -> list[complex]:
 
 
 def _add_top_arguments(p: argparse.ArgumentParser, n_hint: str) -> None:
-    p.add_argument("problem", nargs="?", help=f"built-in problem: {', '.join(problem_names())}")
+    p.add_argument(
+        "problem",
+        nargs="?",
+        help=f"built-in problem: {', '.join(problem_names())} (with --problem-file: the "
+        "name of a top in the file's 'tops' table)",
+    )
     p.add_argument("--a", type=_floats, help="a_1..a_n, comma separated")
     p.add_argument("--b", type=_floats, help="b_1..b_n, comma separated")
     p.add_argument("--l0", type=_floats, help=f"initial state, {n_hint} numbers")
+    p.add_argument(
+        "--problem-file",
+        type=Path,
+        default=None,
+        metavar="FILE",
+        help="a top and state from a JSON or TOML file with the keys of problems.json "
+        "(a, b, l0; or a 'tops' table of them)",
+    )
+
+
+def _problem_from_args(args: argparse.Namespace) -> Problem:
+    """The top and state the user named: a problem, a file, or --a/--b/--l0."""
+    if args.problem_file is not None:
+        if args.a is not None or args.b is not None:
+            raise ValueError("give either --problem-file or --a/--b/--l0, not both")
+        pr = read_problem(args.problem_file, args.problem)
+    elif args.problem is not None:
+        if args.a is not None or args.b is not None:
+            raise ValueError("give either a problem name or --a/--b/--l0, not both")
+        pr = as_problem(args.problem)
+    else:
+        if args.a is None or args.b is None or args.l0 is None:
+            raise ValueError("give a problem name, --problem-file, or all of --a, --b and --l0")
+        a, b, l0 = (np.asarray(x, dtype=float) for x in (args.a, args.b, args.l0))
+        return Problem("custom", a, b, l0, "")
+    if args.l0 is not None:
+        pr = pr._replace(l0=np.asarray(args.l0, dtype=float))
+    return pr
 
 
 def _top_from_args(args: argparse.Namespace) -> tuple[ManakovTop, np.ndarray, str]:
-    if args.problem is not None:
-        if args.a is not None or args.b is not None:
-            raise ValueError("give either a problem name or --a/--b/--l0, not both")
-        p = problem(args.problem)
-        a, b = p.a, p.b
-        l0 = np.asarray(args.l0, dtype=float) if args.l0 is not None else p.l0
-        name = p.name
-    else:
-        if args.a is None or args.b is None or args.l0 is None:
-            raise ValueError("give a problem name, or all of --a, --b and --l0")
-        a, b, l0 = (np.asarray(x, dtype=float) for x in (args.a, args.b, args.l0))
-        name = "custom"
-    top = ManakovTop(a, b)
+    pr = _problem_from_args(args)
+    top = ManakovTop(pr.a, pr.b)
+    l0 = np.asarray(pr.l0, dtype=float)
     if l0.shape != (state_dim(top.n),):
         raise ValueError(
             f"--l0 must have {state_dim(top.n)} numbers for n = {top.n}, got {l0.size}"
         )
-    return top, l0, name
+    return top, l0, pr.name
+
+
+def _add_progress_arguments(p: argparse.ArgumentParser) -> None:
+    show = p.add_mutually_exclusive_group()
+    show.add_argument(
+        "--progress", action="store_true", help="always show the progress bar (on stderr)"
+    )
+    show.add_argument("--no-progress", action="store_true", help="never show the progress bar")
+
+
+def _progress(args: argparse.Namespace) -> bool | None:
+    """The library's ``progress``: a bar when asked, none when asked or quiet, else
+    automatic (on a terminal, for a long run)."""
+    if getattr(args, "quiet", False) or args.no_progress:
+        return False
+    return True if args.progress else None
 
 
 # --------------------------------------------------------------------- simulate
@@ -177,7 +214,7 @@ def _add_simulate(sim: argparse.ArgumentParser) -> None:
         "(default: <problem>.npz)",
     )
     sim.add_argument("--no-plot", action="store_true", help="do not write the PNG")
-    sim.add_argument("--progress", action="store_true", help="always show the progress bar")
+    _add_progress_arguments(sim)
     sim.add_argument("-q", "--quiet", action="store_true", help="print nothing but errors")
 
 
@@ -214,126 +251,26 @@ def _write(
     np.savetxt(target, data, delimiter=",", header=header, comments="", fmt="%.17g")
 
 
-def _plot(
-    path: Path,
-    t: np.ndarray,
-    l: np.ndarray,
-    drift: dict[str, np.ndarray],
-    title: str,
-) -> bool:
+def _try_plot(draw: Callable[[], None]) -> bool:
+    """Draw a figure; False (and no figure) when matplotlib is not installed."""
     try:
-        import matplotlib
-
-        matplotlib.use("Agg")
-        import matplotlib.pyplot as plt
+        import matplotlib  # noqa: F401
     except ImportError:
         return False
-    n = int(round((1 + math.sqrt(1 + 8 * l.shape[1])) / 2))
-    names = [f"$l_{{{i + 1}{j + 1}}}$" for i in range(n) for j in range(i + 1, n)]
-    fig, (ax1, ax2) = plt.subplots(2, 1, figsize=(10, 7), constrained_layout=True)
-    window = t <= t[0] + PLOT_WINDOW
-    for k in range(l.shape[1]):
-        ax1.plot(t[window], l[window, k], lw=0.9, label=names[k])
-    ax1.set_ylabel("angular momentum l(t)")
-    ax1.set_xlabel("t" + (f" (first {PLOT_WINDOW:g} time units)" if not window.all() else ""))
-    ax1.legend(ncol=min(6, len(names)), fontsize=8, loc="upper right")
-    ax1.set_title(title)
-    floor = np.finfo(float).eps / 4
-    for name, d in drift.items():
-        ax2.semilogy(t[1:], np.maximum(np.maximum.accumulate(d[1:]), floor), lw=1, label=name)
-    ax2.axhline(np.finfo(float).eps, color="gray", ls=":", lw=0.8)
-    ax2.text(t[-1], np.finfo(float).eps, " machine eps", va="bottom", ha="right", fontsize=8)
-    ax2.set_ylabel("max over [0, t] of |I - I(0)| / |I(0)|")
-    ax2.set_xlabel("t")
-    ax2.legend(ncol=5, fontsize=8, loc="upper left")
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
+    draw()
     return True
-
-
-@dataclass
-class _Run:
-    """Samples of a run integrated segment by segment (the finished part so far)."""
-
-    t: list[np.ndarray]
-    l: list[np.ndarray]
-    steps: int = 0
-    method: str = ""
-
-    def arrays(self) -> tuple[np.ndarray, np.ndarray]:
-        return np.concatenate(self.t), np.concatenate(self.l)
 
 
 def _sample_times(t_end: float, samples: int | None, dt: float, explicit: bool) -> np.ndarray:
     if samples is None:
         samples = DEFAULT_SAMPLES
         if not explicit:
-            # never more sample intervals than steps: one step of at most dt per
-            # interval, as close to dt as the equal spacing allows
-            samples = max(2, min(samples, math.ceil(t_end / dt * (1 - 1e-12)) + 1))
+            # Never more sample intervals than the steps the method takes over
+            # [0, t_end] (the core's count): one step of at most dt per interval.
+            samples = max(2, min(samples, gauss_steps([t_end], dt) + 1))
     elif samples < 2:
         raise ValueError(f"--samples must be >= 2, got {samples}")
     return np.linspace(0.0, t_end, samples)
-
-
-def _integrate_segments(
-    top: ManakovTop,
-    l0: np.ndarray,
-    times: np.ndarray,
-    args: argparse.Namespace,
-    dt: float,
-    run: _Run,
-    progress: Callable[[float], None] | None,
-) -> None:
-    """Integrate through ``times`` in segments of about :data:`SEGMENT_STEPS` steps,
-    appending each finished segment to ``run`` (Ctrl-C keeps what is in ``run``).
-
-    Every segment starts at a sample time from the last sample, so a Gauss run
-    takes the same steps (between consecutive samples) as one call would.
-    """
-    explicit = args.method in EXPLICIT_METHODS
-    nint = times.size - 1
-    spacing = times[-1] / nint
-    if explicit:
-        per_interval = 1.0  # measured after the first segment
-        per_segment = 1
-    else:
-        per_interval = math.ceil(spacing / dt * (1 - 1e-12))
-        need = per_interval * nint
-        if need > args.max_steps:
-            raise ValueError(
-                f"the run needs {need} steps (t_end / dt = {times[-1]:g} / {dt:.4g}, at "
-                f"least one step per sample interval of {spacing:.4g}), more than "
-                f"--max-steps {args.max_steps}: increase --dt or --max-steps, or shorten "
-                f"--t-end"
-            )
-        per_segment = max(1, SEGMENT_STEPS // per_interval)
-    run.t.append(times[:1])
-    run.l.append(l0[None, :])
-    i = 0
-    state = l0
-    while i < nint:
-        j = min(nint, i + per_segment)
-        seg = times[i : j + 1]
-        tr = top.integrate(
-            state,
-            seg[-1] - seg[0],
-            t_eval=seg - seg[0],
-            dt=args.dt,
-            method=args.method,
-            max_steps=max(1, args.max_steps - run.steps),
-        )
-        run.t.append(seg[1:])
-        run.l.append(tr.l[1:])
-        run.steps += tr.steps
-        run.method = tr.method
-        state = tr.l[-1]
-        if explicit:
-            per_interval = max(1.0, run.steps / j)
-            per_segment = max(1, int(SEGMENT_STEPS / per_interval))
-        i = j
-        if progress is not None:
-            progress(i / nint)
 
 
 def _run_simulate(args: argparse.Namespace) -> int:
@@ -344,7 +281,7 @@ def _run_simulate(args: argparse.Namespace) -> int:
         raise ValueError(
             f"--t-end must be finite and > 0, got {t_end} (the state at t = 0 is --l0)"
         )
-    explicit = args.method in EXPLICIT_METHODS
+    explicit = args.method in ADAPTIVE_METHODS
     if args.dt is not None and not (args.dt > 0 and math.isfinite(args.dt)):
         raise ValueError(f"--dt must be finite and > 0, got {args.dt}")
     dt = args.dt if args.dt is not None else top.default_dt(l0, args.method)
@@ -359,56 +296,59 @@ def _run_simulate(args: argparse.Namespace) -> int:
             raise ValueError(f"cannot write {out}: {out.parent} is not a directory")
     # With CSV on stdout, the report goes to stderr.
     report = sys.stderr if to_stdout else sys.stdout
-    est_steps = t_end / dt if dt > 0 else 0.0
-    bar = ProgressBar(f"simulate {name}", force=args.progress and not args.quiet)
-    if args.quiet or not (est_steps >= PROGRESS_MIN_STEPS or args.progress):
-        bar.enabled = False
-    run = _Run(t=[], l=[])
     start = time.perf_counter()
     try:
-        _integrate_segments(top, l0, times, args, dt, run, bar.update)
-    except KeyboardInterrupt:
-        bar.close()
-        t, l = run.arrays()
+        tr = top.integrate(
+            l0,
+            t_end,
+            t_eval=times,
+            dt=args.dt,
+            method=args.method,
+            max_steps=args.max_steps,
+            progress=_progress(args),
+        )
+    except KeyboardInterrupt as e:
+        part: Trajectory | None = getattr(e, "partial", None)
+        t = part.t if part is not None else np.empty(0)
         where = "no samples" if t.size == 0 else f"{t.size} samples up to t = {t[-1]:.6g}"
-        if out is None or t.size == 0:
-            if to_stdout and t.size:
-                _write(None, t, l, top.integrals(l), a, b, partial=True, stream=sys.stdout)
+        if part is None or t.size == 0:
             raise Interrupted(f"interrupted: {where}") from None
-        part = out.with_name(out.stem + ".partial" + out.suffix)
-        _write(part, t, l, top.integrals(l), a, b, partial=True)
-        raise Interrupted(f"interrupted: wrote {where} to {part} (partial)") from None
+        if out is None:
+            _write(None, t, part.l, part.integrals, a, b, partial=True, stream=sys.stdout)
+            raise Interrupted(f"interrupted: {where}") from None
+        partial = out.with_name(out.stem + ".partial" + out.suffix)
+        _write(partial, t, part.l, part.integrals, a, b, partial=True)
+        raise Interrupted(f"interrupted: wrote {where} to {partial} (partial)") from None
     elapsed = time.perf_counter() - start
-    bar.close()
-    t, l = run.arrays()
-    integrals = top.integrals(l)
-    _write(out, t, l, integrals, a, b, stream=sys.stdout)
-    drift = _relative_drift(integrals)
-    step = t_end / run.steps if run.steps else float("nan")
+    _write(out, tr.t, tr.l, tr.integrals, a, b, stream=sys.stdout)
+    step = t_end / tr.steps if tr.steps else float("nan")
     kind = "mean step" if explicit else "step"
     png = out.with_suffix(".png") if out is not None else None
+    title = f"{name}: {tr.method}, {kind} {step:.3g}, {tr.steps} steps to t = {t_end:g}"
     plotted = (
         png is not None
         and not args.no_plot
-        and _plot(png, t, l, drift, f"{name}: {run.method}, {kind} {step:.3g}, {run.steps} steps")
+        and _try_plot(lambda: _plots().plot_trajectory(png, top, tr, title=title))
     )
     if not args.quiet:
         print(f"{name}: a = {a.tolist()}, b = {b.tolist()}", file=report)
         print(
-            f"integrated to t = {t_end:g} with {run.method}: {run.steps} steps, "
-            f"{kind} {step:.4g} ({t.size} samples), in {elapsed:.3f} s",
+            f"integrated to t = {t_end:g} with {tr.method}: {tr.steps} steps, "
+            f"{kind} {step:.4g} ({tr.t.size} samples), in {elapsed:.3f} s",
             file=report,
         )
-        for k, v in drift.items():
-            print(f"  max relative drift of {k:>2}: {float(np.max(v)):.2e}", file=report)
+        for k, v in tr.max_drift().items():
+            print(f"  max relative drift of {k:>2}: {v:.2e}", file=report)
         if out is not None:
             print(f"wrote {out}" + (f" and {png}" if plotted else ""), file=report)
     return 0
 
 
-def _relative_drift(integrals: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
-    """As :meth:`Trajectory.relative_drift`: ``|I - I(0)| / |I(0)|`` (absolute if ``I(0) = 0``)."""
-    return {k: np.abs(v - v[0]) / (abs(v[0]) if v[0] != 0 else 1.0) for k, v in integrals.items()}
+def _plots() -> Any:
+    """The figures module (imports matplotlib only when a figure is drawn)."""
+    from . import plots
+
+    return plots
 
 
 # ----------------------------------------------------------------------- kotter
@@ -417,13 +357,6 @@ def _relative_drift(integrals: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
 def _add_kotter(p: argparse.ArgumentParser) -> None:
     _add_top_arguments(p, "6")
     p.add_argument("--plot", type=Path, default=None, help="write a PNG of the curve's data")
-
-
-def _fmt(z: Any) -> str:
-    z = complex(z)
-    if z.imag == 0:
-        return f"{z.real:.10g}"
-    return f"{z.real:.10g}{z.imag:+.10g}j"
 
 
 def _run_kotter(args: argparse.Namespace) -> int:
@@ -438,48 +371,24 @@ def _run_kotter(args: argparse.Namespace) -> int:
     lines = [
         f"{name}: a = {top.a.tolist()}, b = {top.b.tolist()}",
         f"l = {l0.tolist()}",
-        "integrals (6)-(7): h0..h3 = " + ", ".join(f"{x:.10g}" for x in k.h),
-        "roots of F (19): s = " + ", ".join(_fmt(x) for x in k.s),
+        "integrals (6)-(7): h0..h3 = " + ", ".join(_show(x) for x in k.h),
+        "roots of F (19): s = " + ", ".join(_show(x) for x in k.s),
         "curve (8): y^2 = x (x - d1)(x - d2)(x - d3)(x - d4), d4 = d1 d2 d3",
-        "  d = " + ", ".join(_fmt(x) for x in k.d) + f", d4 = {_fmt(np.prod(k.d))}",
-        "divisor (37): (z1, y1) = " + f"({_fmt(k.z1)}, {_fmt(k.y1)})",
-        "              (z2, y2) = " + f"({_fmt(k.z2)}, {_fmt(k.y2)})",
-        f"eps (41) = {_fmt(k.eps)}, g (42) = {_fmt(k.g)}, P0 = {_fmt(k.P0)}",
-        "xi (22) = " + ", ".join(_fmt(x) for x in k.xi),
-        "eta (22) = " + ", ".join(_fmt(x) for x in k.eta),
+        "  d = " + ", ".join(_show(x) for x in k.d) + f", d4 = {_show(np.prod(k.d))}",
+        "divisor (37): (z1, y1) = " + f"({_show(k.z1)}, {_show(k.y1)})",
+        "              (z2, y2) = " + f"({_show(k.z2)}, {_show(k.y2)})",
+        f"eps (41) = {_show(k.eps)}, g (42) = {_show(k.g)}, P0 = {_show(k.P0)}",
+        "xi (22) = " + ", ".join(_show(x) for x in k.xi),
+        "eta (22) = " + ", ".join(_show(x) for x in k.eta),
         f"round trip l -> Kotter -> l: max relative error {err:.2e}",
     ]
     print("\n".join(lines))
     if args.plot is not None:
-        if _plot_kotter(args.plot, k, name):
+        if _try_plot(lambda: _plots().plot_kotter(args.plot, k, name)):
             print(f"wrote {args.plot}")
         else:
             print("matplotlib is not installed: no plot", file=sys.stderr)
     return 0
-
-
-def _plot_kotter(path: Path, k: Any, name: str) -> bool:
-    try:
-        import matplotlib
-
-        matplotlib.use("Agg")
-        import matplotlib.pyplot as plt
-    except ImportError:
-        return False
-    d = np.concatenate([[0.0], k.d, [np.prod(k.d)]])
-    fig, ax = plt.subplots(figsize=(7, 5), constrained_layout=True)
-    ax.scatter(d.real, d.imag, marker="x", s=60, label="branch points $d_0 .. d_4$")
-    for j, dj in enumerate(d):
-        ax.annotate(f"$d_{j}$", (dj.real, dj.imag), textcoords="offset points", xytext=(5, 5))
-    zs = np.array([k.z1, k.z2])
-    ax.scatter(zs.real, zs.imag, marker="o", s=40, label="divisor $z_1, z_2$")
-    ax.set_xlabel("Re x")
-    ax.set_ylabel("Im x")
-    ax.set_title(f"{name}: the curve (8) of the state and its divisor")
-    ax.legend()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-    return True
 
 
 # ------------------------------------------------------------------------ theta
@@ -532,9 +441,9 @@ def _run_theta(args: argparse.Namespace) -> int:
         char = _parse_char(args.char)
         if args.log_scale:
             om, log = theta(z, tau, char, log_scale=True)
-            print(f"Omega = {_fmt(om)}, L = {float(log):.17g}")
+            print(f"Omega = {_show(om)}, L = {float(log):.17g}")
         else:
-            print(_fmt(theta(z, tau, char)))
+            print(_show(theta(z, tau, char)))
         return 0
     if args.log_scale:
         vals, log = theta_all(z, tau, log_scale=True)
@@ -543,32 +452,46 @@ def _run_theta(args: argparse.Namespace) -> int:
         vals = theta_all(z, tau)
     print("# index  a  b  value")
     for idx, ((a, b), v) in enumerate(zip(characteristics(g), vals)):
-        print(f"{idx:>3}  {''.join(map(str, a))} {''.join(map(str, b))}  {_fmt(v)}")
+        print(f"{idx:>3}  {''.join(map(str, a))} {''.join(map(str, b))}  {_show(v)}")
     return 0
 
 
 def _add_theorem(p: argparse.ArgumentParser) -> None:
-    p.add_argument("problem", choices=problem_names(), help="a built-in top")
+    _add_top_arguments(p, "6")
     p.add_argument("-o", "--output", default=None, help="PNG path (default: <problem>-theorem.png)")
     p.add_argument("--t-end", type=float, default=100.0, help="end time (default 100)")
-    p.add_argument("--samples", type=int, default=201, help="sample times (default 201)")
+    p.add_argument("--samples", type=int, default=201, help="comparison times (default 201)")
     p.add_argument(
         "--dt", type=float, default=1e-3, help="gauss16 step of the comparison (default 1e-3)"
     )
+    _add_progress_arguments(p)
 
 
 def _run_theorem(args: argparse.Namespace) -> int:
-    from .solution import plot_theorem
-
-    out = Path(args.output or f"{args.problem}-theorem.png")
-    err = plot_theorem(args.problem, str(out), t_end=args.t_end, samples=args.samples, dt=args.dt)
-    print(f"{args.problem}: max |l_theta - l_int| / |l0| on [0, {args.t_end:g}] = {err:.3g}")
+    pr = _problem_from_args(args)
+    out = Path(args.output or f"{pr.name}-theorem.png")
+    if not out.parent.is_dir():
+        raise ValueError(f"cannot write {out}: {out.parent} is not a directory")
+    try:
+        err = _plots().plot_theorem(
+            pr, out, t_end=args.t_end, samples=args.samples, dt=args.dt, progress=_progress(args)
+        )
+    except KeyboardInterrupt as e:
+        part = getattr(e, "partial", None)
+        where = getattr(e, "partial_path", None)
+        if part is None or where is None:
+            raise Interrupted("interrupted: no comparison samples yet") from None
+        raise Interrupted(
+            f"interrupted: wrote the comparison at {part.t.size} samples up to "
+            f"t = {part.t[-1]:.6g} to {where} (partial)"
+        ) from None
+    print(f"{pr.name}: max |l_theta - l_int| / |l0| on [0, {args.t_end:g}] = {err:.3g}")
     print(f"wrote {out}")
     return 0
 
 
 def _add_frequency_map(p: argparse.ArgumentParser) -> None:
-    p.add_argument("problem", choices=problem_names(), help="a built-in top")
+    _add_top_arguments(p, "6")
     p.add_argument("--grid", type=int, default=64, help="states per side of the slice (default 64)")
     p.add_argument(
         "-o", "--output", default=None, help="PNG path (default: <problem>-frequency-map.png)"
@@ -576,26 +499,34 @@ def _add_frequency_map(p: argparse.ArgumentParser) -> None:
     p.add_argument(
         "--max-order", type=int, default=5, help="resonances k1 nu1 + k2 nu2 = 0, |k1|+|k2| <= this"
     )
-    p.add_argument("--no-progress", action="store_true", help="no progress bar")
+    _add_progress_arguments(p)
+
+
+def _counts(fm: Any) -> str:
+    return ", ".join(f"{k}: {v}" for k, v in fm.counts().items())
 
 
 def _run_frequency_map(args: argparse.Namespace) -> int:
-    from .tori import STATUS_NAMES, plot_frequency_map
-
     if args.grid < 2:
         raise ValueError(f"--grid must be >= 2, got {args.grid}")
-    out = Path(args.output or f"{args.problem}-frequency-map.png")
-    fm = plot_frequency_map(
-        args.problem,
-        args.grid,
-        out,
-        max_order=args.max_order,
-        progress=False if args.no_progress else None,
-    )
-    status = np.asarray(fm.status)
-    codes, counts = np.unique(status, return_counts=True)
-    summary = ", ".join(f"{STATUS_NAMES[int(c)]}: {int(n)}" for c, n in zip(codes, counts))
-    print(f"{args.problem}: {status.size} states ({summary})")
+    pr = _problem_from_args(args)
+    out = Path(args.output or f"{pr.name}-frequency-map.png")
+    if not out.parent.is_dir():
+        raise ValueError(f"cannot write {out}: {out.parent} is not a directory")
+    try:
+        fm = _plots().plot_frequency_map(
+            pr, args.grid, out, max_order=args.max_order, progress=_progress(args)
+        )
+    except KeyboardInterrupt as e:
+        part = getattr(e, "partial", None)
+        where = getattr(e, "partial_path", None)
+        if part is None or where is None:
+            raise Interrupted("interrupted: no states done yet") from None
+        raise Interrupted(
+            f"interrupted: wrote the map of {part.status.size} states ({_counts(part)}) "
+            f"to {where} (partial)"
+        ) from None
+    print(f"{pr.name}: {fm.status.size} states ({_counts(fm)})")
     print(f"wrote {out}")
     return 0
 
@@ -642,9 +573,11 @@ COMMANDS: tuple[Command, ...] = (
         "l(t) from theta functions (9)-(10) against integration, as a PNG",
         "The Theorem (9)-(10): l(t) as quotients of genus-2 theta functions at "
         "v = v0 + U t (docs/theorem.md), plotted against gauss16, with their "
-        "difference on a log scale.",
+        "difference on a log scale. Ctrl-C writes the figure of the samples computed so "
+        "far to <output stem>.partial.png and exits with status 130.",
         "manakov theorem physical -o physical-theorem.png\n"
-        "  manakov theorem generic --t-end 1000 --samples 2001",
+        "  manakov theorem generic --t-end 1000 --samples 2001\n"
+        "  manakov theorem --a 0.1,0.9,2.3,3.1 --b 0.4,-0.6,1.1,2.5 --l0 0.7,-0.2,0.6,1,-0.5,0.3",
         _add_theorem,
         _run_theorem,
     ),
@@ -653,8 +586,11 @@ COMMANDS: tuple[Command, ...] = (
         "frequencies of the invariant tori over a slice of states, as a PNG",
         "The frequencies (nu1, nu2) of the real Liouville tori from the Theorem "
         "(docs/tori.md) over a grid of states at fixed Casimirs h0, h1; the colour is "
-        "nu1/nu2, with the resonance lines k1 nu1 + k2 nu2 = 0 overlaid.",
-        "manakov frequency-map generic --grid 128 -o generic-fmap.png",
+        "nu1/nu2, with the resonance lines k1 nu1 + k2 nu2 = 0 overlaid. Ctrl-C writes "
+        "the map of the states done so far to <output stem>.partial.png and exits with "
+        "status 130.",
+        "manakov frequency-map generic --grid 128 -o generic-fmap.png\n"
+        "  manakov frequency-map --problem-file mytop.toml --grid 96",
         _add_frequency_map,
         _run_frequency_map,
     ),
@@ -691,7 +627,7 @@ def _parser() -> argparse.ArgumentParser:
         epilog="Run 'manakov <command> --help' for each command's options and an example.",
     )
     ap.add_argument("--version", action="version", version=f"manakov {__version__}")
-    sub = ap.add_subparsers(dest="command", required=True, metavar="command")
+    sub = ap.add_subparsers(dest="command", metavar="command")
     for cmd in COMMANDS:
         p = sub.add_parser(
             cmd.name,
@@ -720,6 +656,12 @@ def main(argv: Sequence[str] | None = None) -> int:
     try:
         ap = _parser()
         args = ap.parse_args(argv)
+        if args.command is None:
+            # `manakov` or `python -m manakov` alone: the version and the commands.
+            print(f"manakov {__version__}")
+            print("commands: " + ", ".join(c.name for c in COMMANDS))
+            print("run 'manakov <command> --help' for its options and an example")
+            return 0
         run = {c.name: c.run for c in COMMANDS}[args.command]
         try:
             status = run(args)

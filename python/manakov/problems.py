@@ -9,13 +9,15 @@ problems: four Manakov tops (``generic``, ``physical``, ``wide``,
 from __future__ import annotations
 
 import json
+import os
 from functools import lru_cache
 from importlib import resources
+from pathlib import Path
 from typing import Any, NamedTuple
 
 import numpy as np
 
-__all__ = ["Problem", "problem", "problem_names", "benchmark_setup"]
+__all__ = ["Problem", "as_problem", "problem", "problem_names", "read_problem", "benchmark_setup"]
 
 
 class Problem(NamedTuple):
@@ -97,3 +99,114 @@ def benchmark_setup(name: str) -> dict[str, Any]:
     if name not in bench:
         raise ValueError(f"unknown benchmark {name!r}; known: {', '.join(bench)}")
     return dict(bench[name])
+
+
+def as_problem(p: str | Problem) -> Problem:
+    """``p`` as a :class:`Problem`: a built-in name (:func:`problem`) or a Problem itself.
+
+    Raises
+    ------
+    ValueError
+        An unknown name, or neither a name nor a Problem.
+    """
+    if isinstance(p, Problem):
+        return p
+    if isinstance(p, str):
+        return problem(p)
+    raise ValueError(f"expected a problem name or a manakov.Problem, got {p!r}")
+
+
+def read_problem(path: str | os.PathLike[str], name: str | None = None) -> Problem:
+    """A top and its initial state from a JSON or TOML file (by suffix; TOML needs
+    Python >= 3.11 or the ``tomli`` package).
+
+    The file holds the keys of the built-in problems (``data/problems.json``):
+    either one top at the top level, ``{"a": [...], "b": [...], "l0": [...]}``
+    (optionally ``"name"`` and ``"note"``), or a table of named tops under
+    ``"tops"`` as in ``problems.json`` itself, from which ``name`` picks one
+    (it may be left out when the table has one top)::
+
+        # mytop.toml
+        name = "mytop"
+        a = [0.1, 0.9, 2.3, 3.1]
+        b = [0.4, -0.6, 1.1, 2.5]
+        l0 = [0.7, -0.2, 0.6, 1.0, -0.5, 0.3]
+
+    Parameters
+    ----------
+    path : str or PathLike
+    name : str, optional
+        The top to take from a ``"tops"`` table.
+
+    Returns
+    -------
+    Problem
+        ``a``, ``b``, ``l0`` as float arrays (their shapes are checked by the
+        functions that use them), ``name`` (the file's, the table key, or the
+        file's stem), ``note``.
+
+    Raises
+    ------
+    ValueError
+        A suffix other than .json or .toml, a file that does not parse, a
+        missing key, or an unknown or missing ``name``.
+    OSError
+        The file cannot be read.
+    """
+    path = Path(path)
+    text = path.read_text(encoding="utf-8")
+    try:
+        if path.suffix.lower() == ".json":
+            data = json.loads(text)
+        elif path.suffix.lower() == ".toml":
+            data = _toml(text)
+        else:
+            raise ValueError(f"{path}: a problem file ends in .json or .toml, got {path.suffix!r}")
+    except (json.JSONDecodeError, _TomlError) as e:
+        raise ValueError(f"{path} does not parse: {e}") from None
+    if not isinstance(data, dict):
+        raise ValueError(f"{path}: expected a table of keys a, b, l0, got {type(data).__name__}")
+    default = data.get("name", path.stem)
+    if "tops" in data:
+        tops = data["tops"]
+        if not isinstance(tops, dict) or not tops:
+            raise ValueError(f"{path}: 'tops' must be a non-empty table of named tops")
+        if name is None:
+            if len(tops) != 1:
+                raise ValueError(
+                    f"{path} has {len(tops)} tops ({', '.join(tops)}): name the one to use"
+                )
+            name = next(iter(tops))
+        if name not in tops:
+            raise ValueError(f"{path} has no top {name!r}; it has {', '.join(tops)}")
+        data, default = tops[name], name
+    elif name is not None and name != default:
+        raise ValueError(f"{path} holds one top ({default!r}), not {name!r}")
+    missing = [k for k in ("a", "b", "l0") if k not in data]
+    if missing:
+        raise ValueError(f"{path}: missing key(s) {', '.join(missing)} (the keys of problems.json)")
+    try:
+        a, b, l0 = (np.array(data[k], dtype=float) for k in ("a", "b", "l0"))
+    except (TypeError, ValueError) as e:
+        raise ValueError(f"{path}: a, b and l0 must be lists of numbers ({e})") from None
+    return Problem(name=str(default), a=a, b=b, l0=l0, note=str(data.get("note", "")))
+
+
+class _TomlError(Exception):
+    pass
+
+
+def _toml(text: str) -> Any:
+    try:
+        import tomllib  # Python >= 3.11
+    except ImportError:
+        try:
+            import tomli as tomllib  # type: ignore[no-redef,import-not-found,unused-ignore]
+        except ImportError:
+            raise ValueError(
+                "reading TOML needs Python >= 3.11 or the tomli package; or write the file as JSON"
+            ) from None
+    try:
+        return tomllib.loads(text)
+    except tomllib.TOMLDecodeError as e:
+        raise _TomlError(str(e)) from None
