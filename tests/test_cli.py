@@ -460,3 +460,283 @@ def test_frequency_map_subcommand_writes_png_and_counts_states(tmp_path, capsys)
 def test_frequency_map_subcommand_rejects_a_tiny_grid():
     r = _run("frequency-map", "generic", "--grid", "1")
     assert r.returncode != 0 and "--grid must be >= 2" in r.stderr
+
+
+# --- one convention for the command line: any top, partial work, figures that read ---
+
+#: A user's top that is none of the built-in problems (a, b as floats, l0 of so(4)).
+CUSTOM_A = "0.1,0.9,2.3,3.1"
+CUSTOM_B = "0.4,-0.6,1.1,2.5"
+CUSTOM_L0 = "0.7,-0.2,0.6,1.0,-0.5,0.3"
+CUSTOM = ["--a", CUSTOM_A, "--b", CUSTOM_B, "--l0", CUSTOM_L0]
+
+
+def _custom_top():
+    a, b, l0 = (np.array([float(x) for x in s.split(",")]) for s in (CUSTOM_A, CUSTOM_B, CUSTOM_L0))
+    return manakov.ManakovTop(a, b), l0
+
+
+def _is_png(path):
+    return Path(path).read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+def test_python_dash_m_alone_shows_the_version():
+    # `python -m manakov` printed "the following arguments are required" and exited 2.
+    r = _run()
+    assert r.returncode == 0, r.stderr
+    lines = r.stdout.splitlines()
+    assert lines[0] == f"manakov {manakov.__version__}"
+    assert all(c.name in r.stdout for c in cli.COMMANDS)
+
+
+def test_theorem_runs_on_a_top_that_is_not_built_in(tmp_path):
+    # theorem took only the built-in problems (no --a/--b/--l0).
+    png = tmp_path / "custom-theorem.png"
+    r = _run("theorem", *CUSTOM, "--t-end", "10", "--samples", "21", "-o", str(png))
+    assert r.returncode == 0, r.stderr
+    assert _is_png(png) and r.stdout.startswith("custom: max |l_theta - l_int| / |l0|")
+    printed = float(re.search(r"= ([0-9.e+-]+)", r.stdout).group(1))
+    # The same comparison made here: the theta solution against a gauss16 run.
+    top, l0 = _custom_top()
+    t = np.linspace(0.0, 10.0, 21)
+    ref = top.integrate(l0, 10.0, t_eval=t, dt=1e-3).l
+    mine = float(np.max(np.abs(top.solve(l0).l(t) - ref)) / np.linalg.norm(l0))
+    assert printed <= THEOREM_CLI_RTOL and mine <= THEOREM_CLI_RTOL
+    assert printed == pytest.approx(mine, rel=1e-2)
+
+
+def test_frequency_map_runs_on_a_top_that_is_not_built_in(tmp_path):
+    png = tmp_path / "custom-fm.png"
+    r = _run("frequency-map", *CUSTOM, "--grid", "4", "-o", str(png), "--no-progress")
+    assert r.returncode == 0, r.stderr
+    assert _is_png(png) and r.stdout.startswith("custom: 16 states (")
+    # The counts are those of the library on the same slice.
+    top, l0 = _custom_top()
+    fm = manakov.frequency_map(top, manakov.tori.casimir_slice(l0, 4)[2])
+    assert ", ".join(f"{k}: {v}" for k, v in fm.counts().items()) in r.stdout
+
+
+@pytest.mark.parametrize("suffix", [".json", ".toml"])
+def test_every_top_command_takes_a_problem_file(tmp_path, suffix):
+    a, b, l0 = CUSTOM_A, CUSTOM_B, CUSTOM_L0
+    if suffix == ".json":
+        text = f'{{"name": "mytop", "a": [{a}], "b": [{b}], "l0": [{l0}]}}'
+    else:
+        text = f'name = "mytop"\na = [{a}]\nb = [{b}]\nl0 = [{l0}]\n'
+    path = tmp_path / f"mytop{suffix}"
+    path.write_text(text)
+    top, l0v = _custom_top()
+    for argv in (
+        ["simulate", "--t-end", "2", "--no-plot", "-o", str(tmp_path / "s.npz")],
+        ["kotter"],
+        ["theorem", "--t-end", "2", "--samples", "5", "-o", str(tmp_path / "t.png")],
+        ["frequency-map", "--grid", "2", "-o", str(tmp_path / "f.png"), "--no-progress"],
+    ):
+        r = _run(*argv, "--problem-file", str(path), cwd=tmp_path)
+        assert r.returncode == 0, (argv, r.stderr)
+        assert "mytop" in r.stdout, (argv, r.stdout)
+    np.testing.assert_array_equal(np.load(tmp_path / "s.npz")["l"][0], l0v)
+
+
+def test_a_problem_file_with_a_table_of_tops_is_picked_by_name(tmp_path):
+    # problems.json itself: its 'tops' table, a name picks one.
+    src = Path(manakov.__file__).parent / "data" / "problems.json"
+    r = _run("kotter", "physical", "--problem-file", str(src))
+    assert r.returncode == 0, r.stderr
+    assert r.stdout == _run("kotter", "physical").stdout
+    r = _run("kotter", "--problem-file", str(src))
+    assert r.returncode == 2 and "name the one to use" in r.stderr
+
+
+@pytest.mark.parametrize(
+    "text, match",
+    [
+        ('{"a": [1, 2, 3, 4], "b": [0, 1, 2, 3]}', "missing key(s) l0"),
+        ("{not json", "does not parse"),
+        ('{"a": "x", "b": [0], "l0": [1]}', "lists of numbers"),
+    ],
+)
+def test_a_bad_problem_file_is_an_error_naming_the_file(tmp_path, text, match):
+    path = tmp_path / "bad.json"
+    path.write_text(text)
+    r = _run("kotter", "--problem-file", str(path))
+    assert r.returncode == 2 and "manakov: error:" in r.stderr
+    assert match in r.stderr and "bad.json" in r.stderr
+
+
+@pytest.mark.parametrize("command", ["theorem", "frequency-map"])
+def test_long_commands_show_a_progress_bar(command, tmp_path):
+    out = str(tmp_path / "x.png")
+    extra = ["--t-end", "20", "--samples", "11"] if command == "theorem" else ["--grid", "8"]
+    r = _run(command, "generic", *extra, "-o", out, "--progress")
+    assert r.returncode == 0, r.stderr
+    assert "100.0%" in r.stderr
+
+
+#: After Ctrl-C a long command stops (within STOP_WITHIN_S, the library's
+#: guarantee) and then draws the figure of the work done; the figure of a
+#: 600 x 600 map takes ~0.3 s to draw here: 3 s is a bound on both, with margin.
+PARTIAL_FIGURE_WITHIN_S = 3.0
+
+
+@pytest.mark.skipif(sys.platform == "win32", reason="POSIX signals")
+@pytest.mark.parametrize(
+    "argv, kept",
+    [
+        # The two runs of the trip-up report: minutes long, Ctrl-C after 2.5 s.
+        (["theorem", "generic", "--t-end", "1e5", "--samples", "400001"], "samples up to t ="),
+        (["frequency-map", "generic", "--grid", "600"], "not computed:"),
+    ],
+)
+def test_sigint_writes_the_partial_figure_and_exits_130(argv, kept, tmp_path):
+    out = tmp_path / "long.png"
+    code, stdout, err, stopped = _sigint_after([*argv, "-o", str(out)], tmp_path, 2.5)
+    assert code == cli.EXIT_INTERRUPTED, (stdout, err)
+    assert "Traceback" not in err and len(err.strip().splitlines()) == 1, err
+    part = tmp_path / "long.partial.png"
+    assert f"to {part} (partial)" in err and kept in err
+    assert _is_png(part) and not out.exists()
+    assert stopped < PARTIAL_FIGURE_WITHIN_S, f"line after {stopped:.3f} s"
+
+
+def test_messages_print_the_digits_that_matter():
+    # The rest state: "relative distance ... = NaN <= 1e-12".
+    r = _run("kotter", "generic", "--l0", "0,0,0,0,0,0")
+    assert r.returncode == 2 and "rest state" in r.stderr
+    assert "nan" not in r.stderr.lower()
+    # A repeated root: 17 digits and a rounding-noise imaginary part.
+    r = _run("kotter", "generic", "--l0", "1,0,0,0,0,0.5")
+    assert r.returncode == 2
+    root = re.search(r"repeated root s = (\S+) ", r.stderr).group(1)
+    assert re.fullmatch(r"-?[0-9.]+", root) and len(re.sub(r"\D", "", root)) <= 10, root
+    # The reduction of a state whose curve is real: real numbers print as real.
+    r = _run("kotter", "generic")
+    assert r.returncode == 0
+    d_line = next(x for x in r.stdout.splitlines() if x.strip().startswith("d = "))
+    assert "j" not in d_line and "e-" not in d_line, d_line
+
+
+# The figures, inspected as they are saved: a user's command run with a hook on
+# matplotlib's Figure.savefig that records the drawn figure's geometry.
+_FIGURE_HOOK = r"""
+import json, sys
+import numpy as np
+import matplotlib
+matplotlib.use("Agg")
+from matplotlib.figure import Figure
+from matplotlib.text import Annotation, Text
+
+figures = []
+drawn = []
+_save, _draw_text = Figure.savefig, Text.draw
+
+def draw_text(self, renderer):
+    drawn.append(self)
+    return _draw_text(self, renderer)
+
+def savefig(self, *args, **kwargs):
+    _save(self, *args, **kwargs)
+    drawn.clear()
+    self.canvas.draw()  # measured at the figure's own dpi, as its bbox is
+    r = self.canvas.get_renderer()
+    # The texts drawn (tick labels outside the view limits exist but are not drawn).
+    texts = [t for t in dict.fromkeys(drawn) if t.get_visible() and t.get_text().strip()]
+    def box(t):
+        b = t.get_window_extent(r)
+        return [b.x0, b.y0, b.x1, b.y1]
+    fig = {
+        "bbox": [self.bbox.x0, self.bbox.y0, self.bbox.x1, self.bbox.y1],
+        "texts": [[t.get_text(), box(t)] for t in texts if not isinstance(t, Annotation)],
+        "labels": [[t.get_text(), box(t)] for t in texts if isinstance(t, Annotation)],
+        "axes": [],
+    }
+    for ax in self.axes:
+        if not ax.get_visible() or ax.get_label() == "<colorbar>":
+            continue
+        # Drawn curves only (a marker-only line shows samples, not a curve).
+        steps = [float(np.max(np.diff(np.asarray(l.get_xdata(), float))))
+                 for l in ax.get_lines()
+                 if len(l.get_xdata()) > 2 and l.get_linestyle() not in ("None", "")]
+        fig["axes"].append({
+            "xlim": list(ax.get_xlim()), "ylim": list(ax.get_ylim()),
+            "xticks": len(ax.get_xticks()), "yticks": len(ax.get_yticks()),
+            "max_step": max(steps) if steps else None,
+        })
+    figures.append(fig)
+
+Figure.savefig = savefig
+Text.draw = draw_text
+from manakov.cli import main
+status = main(sys.argv[1:])
+print("FIGURES " + json.dumps(figures))
+sys.exit(status)
+"""
+
+
+def _figures(*argv, cwd):
+    r = subprocess.run(
+        [sys.executable, "-c", _FIGURE_HOOK, *argv],
+        capture_output=True,
+        text=True,
+        timeout=300,
+        cwd=cwd,
+    )
+    assert r.returncode == 0, r.stderr
+    line = next(x for x in r.stdout.splitlines() if x.startswith("FIGURES "))
+    import json
+
+    return json.loads(line[len("FIGURES ") :])
+
+
+def _inside(box, fig, slack=1.0):
+    return (
+        box[0] >= fig[0] - slack
+        and box[1] >= fig[1] - slack
+        and box[2] <= fig[2] + slack
+        and box[3] <= fig[3] + slack
+    )
+
+
+def _overlap(a, b):
+    return a[0] < b[2] and b[0] < a[2] and a[1] < b[3] and b[1] < a[3]
+
+
+@pytest.mark.parametrize("name", ["generic", "wide", "near_degenerate"])
+def test_the_kotter_figure_has_axes_of_the_data_and_labels_that_read(name, tmp_path):
+    # `manakov kotter generic --plot` scaled the imaginary axis to rounding noise
+    # (labels 1e-30, the divisor at +-3e-30) and wrote d0 over d2.
+    pytest.importorskip("matplotlib")
+    (fig,) = _figures("kotter", name, "--plot", "k.png", cwd=tmp_path)
+    p = manakov.problem(name)
+    k = manakov.kotter(p.a, p.b, p.l0)
+    extent = max(float(np.max(np.abs(k.d))), abs(complex(np.prod(k.d))))
+    for ax in fig["axes"]:
+        for lim, ticks in ((ax["xlim"], ax["xticks"]), (ax["ylim"], ax["yticks"])):
+            if ticks:  # a drawn axis spans a part of the data, never its rounding noise
+                assert abs(lim[1] - lim[0]) >= 1e-3 * extent, (lim, extent)
+    labels = fig["labels"]
+    assert len(labels) == 7
+    for i in range(len(labels)):
+        for j in range(i + 1, len(labels)):
+            assert not _overlap(labels[i][1], labels[j][1]), (labels[i][0], labels[j][0])
+    for text, box in fig["texts"] + labels:
+        assert _inside(box, fig["bbox"]), text
+
+
+def test_the_theorem_figure_title_fits_and_its_curves_are_smooth(tmp_path):
+    # The theorem PNG's title was cut off at the right edge.
+    pytest.importorskip("matplotlib")
+    (fig,) = _figures("theorem", "generic", "--t-end", "100", "-o", "t.png", cwd=tmp_path)
+    for text, box in fig["texts"]:
+        assert _inside(box, fig["bbox"]), text
+    # l(t) drawn densely: the fastest oscillation of 'generic' has a period ~2.
+    assert fig["axes"][0]["max_step"] <= 0.05
+
+
+def test_the_simulate_figure_is_smooth_at_a_short_t_end(tmp_path):
+    # `simulate` at a short --t-end drew a polyline through samples 0.34 apart.
+    pytest.importorskip("matplotlib")
+    (fig,) = _figures("simulate", "generic", "--t-end", "10", "-o", "s.npz", cwd=tmp_path)
+    assert fig["axes"][0]["max_step"] <= 0.05
+    for text, box in fig["texts"]:
+        assert _inside(box, fig["bbox"]), text

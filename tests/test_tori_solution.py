@@ -247,7 +247,7 @@ SINGULAR_STATES = [
         [1.0, 0, 0, 0, 0, 0.5],
         # The root's digits belong to the root finder: start and end only.
         (
-            "invalid state l: F(s) (19) has a repeated root s = 5.28842287",
+            "invalid state l: F(s) (19) has a repeated root s = 5.28842",
             # (the separation of a double root is rounding noise: no digits)
             "(|s_1 - s_4| = ",
             "e-7): l^(p) (20) divides by sqrt(F'(s_p)) = 0",

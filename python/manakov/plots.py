@@ -256,7 +256,6 @@ def plot_kotter(path: str | os.PathLike[str], k: Kotter, name: str, *, dpi: int 
                 xytext=(0, 9 + 15 * row),
                 ha="center",
                 fontsize=10,
-                arrowprops={"arrowstyle": "-", "color": "0.6", "lw": 0.6} if row else None,
             )
         ax.set_ylim(-0.8, 2.4)
         ax.set_yticks([])
