@@ -211,3 +211,28 @@ def test_a_killed_worker_is_retried_and_the_result_is_complete(client):
     assert np.array_equal(np.concatenate(parts), local)
     client.wait_for_workers(2, timeout=60)
     assert victim not in client.run(os.getpid).values()
+
+
+def test_an_interrupted_dask_map_keeps_its_chunks_and_cancels_the_rest(client):
+    # Ctrl-C (here: the progress callable) during a map on a cluster: the chunks
+    # finished so far ride on the exception, and the queued tasks are cancelled.
+    states = np.random.default_rng(4).normal(size=(2000, 6))
+    local = _local(states, 2000)
+
+    def stop(fraction):
+        if fraction >= 0.2:
+            raise KeyboardInterrupt
+
+    with pytest.raises(KeyboardInterrupt) as e:
+        tori._run_chunks(
+            slow_mix, (1.7,), states, client=client, chunk_size=50, progress=stop, label="i"
+        )
+    done = e.value.chunks_done
+    assert len(done) == 40 and 8 <= sum(c is not None for c in done) < 40
+    for k, chunk in enumerate(done):
+        if chunk is not None:
+            assert np.array_equal(chunk, local[50 * k : 50 * (k + 1)])
+    deadline = time.perf_counter() + 10
+    while client.processing() and any(client.processing().values()):
+        assert time.perf_counter() < deadline, client.processing()
+        time.sleep(0.05)
