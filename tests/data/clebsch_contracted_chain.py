@@ -24,6 +24,8 @@ reference bodies.
 
 from __future__ import annotations
 
+import inspect
+
 import mpmath as mp
 import numpy as np
 
@@ -110,7 +112,11 @@ def reduce(a, M, p, dps: int = 50):
         num = [sq[0], sq[1] + 4 * h0**2 * g[0], sq[2] + 4 * h0**2 * g[1]]
         num += [sq[3] + 4 * h0**2 * g[2], sq[4] + 4 * h0**2 * g[3]]
         coef = [c / h1**2 for c in num]
-        roots = mp.polyroots(coef, maxsteps=200, extraprec=2 * dps)
+        # mpmath >= 1.4 deprecates descending coefficients unless asc= is given
+        if "asc" in inspect.signature(mp.polyroots).parameters:
+            roots = mp.polyroots(coef[::-1], maxsteps=200, extraprec=2 * dps, asc=True)
+        else:
+            roots = mp.polyroots(coef, maxsteps=200, extraprec=2 * dps)
         scale = max(1.0, float(max(abs(x) for x in a)))
         order = order_roots(np.array([complex(r) for r in roots]), scale)
         s = [min(roots, key=lambda r, o=o: abs(complex(r) - o)) for o in order]
