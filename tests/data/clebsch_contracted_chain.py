@@ -32,6 +32,15 @@ import numpy as np
 CYC = ((0, 1, 2), (1, 2, 0), (2, 0, 1))
 
 
+def _horner(coef, x):
+    """The polynomial with descending ``coef`` at ``x`` (mpmath >= 1.4 deprecates
+    descending coefficients in polyval)."""
+    acc = 0
+    for c in coef:
+        acc = acc * x + c
+    return acc
+
+
 def integrals(a, M, p):
     """``(h0, h1, h2, h3)`` of the contracted (15)."""
     a, M, p = (np.asarray(x, dtype=float) for x in (a, M, p))
@@ -124,7 +133,7 @@ def reduce(a, M, p, dps: int = 50):
         if abs(mp.im(s[0])) > 0:
             s[1] = mp.conj(s[0])
         dcoef = [c * (4 - i) for i, c in enumerate(coef[:-1])]
-        fp = [mp.polyval(dcoef, x) for x in s]
+        fp = [_horner(dcoef, x) for x in s]
         sigma = [-(h1 * x * x - h2 * x + h3) / (2 * h0) for x in s]
         sqf = [mp.sqrt(x) for x in fp]
         u = [[mp.sqrt(a[j] - s[q]) / sqf[q] for j in range(3)] for q in range(4)]
