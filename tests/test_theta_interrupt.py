@@ -19,14 +19,21 @@ STOP_WITHIN_S = 0.5
 
 TAU = np.array([[0.3 + 1.1j, 0.1 + 0.4j], [0.1 + 0.4j, -0.2 + 1.3j]])
 
-# A batch of ~20 s: small Im tau (many terms per point), 10^6 points.
+# A batch of >= 10 s on any machine: genus 4 (256 thetas per point), its length
+# calibrated in the child on a small batch, since machines differ by 2-3x.
 CHILD = textwrap.dedent(
     """
     import sys, time
     import numpy as np
     import manakov
-    tau = 0.02 * np.array([[1.1j, 0.4j], [0.4j, 1.3j]]) + 0.3
-    z = np.broadcast_to(np.array([0.1 + 0.05j, 0.2]), (10**6, 2))
+    tau = 1j * (np.eye(4) + 0.2 * np.ones((4, 4))) + 0.1 * np.arange(16).reshape(4, 4) % 3
+    tau = (tau + tau.T) / 2
+    probe = np.broadcast_to(0.1 * np.ones(4) + 0.05j, (2000, 4))
+    t0 = time.perf_counter()
+    manakov.theta_all(probe, tau, parallel={parallel})
+    per_point = (time.perf_counter() - t0) / 2000
+    n = int(min(max(10.0 / per_point, 2 * 10**4), 4 * 10**5))
+    z = np.broadcast_to(0.1 * np.ones(4) + 0.05j, (n, 4))
     print("ready", flush=True)
     t0 = time.perf_counter()
     try:
