@@ -30,6 +30,7 @@
 //! in waves between which the caller's [`Cancel`] is checked; the results do
 //! not depend on the number of threads or on how the batch is split.
 
+pub mod motion;
 pub mod solve;
 #[cfg(test)]
 mod tests;
@@ -559,6 +560,12 @@ status_table! {
     /// equations (1) at `v0` for no velocity: its set-up is wrong at this
     /// state (one of the Theorem's outliers), so are its frequencies.
     InconsistentQuotients = 11, "inconsistent quotients";
+    /// The state is at rest: an equilibrium of (1) (a stationary rotation),
+    /// or any state of a spherical top (all `c_ij` equal).
+    Equilibrium = 12, "equilibrium";
+    /// The state lies on the separatrix of an Euler top (an so(3) block or a
+    /// self-dual state): its motion is asymptotic, with no period.
+    Separatrix = 13, "separatrix";
 }
 
 // The codes are the indices of the table (so that `STATUS_NAMES[code]` is the name).
