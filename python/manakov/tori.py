@@ -84,6 +84,13 @@ DEGENERATE_GRADIENTS = 10
 #: velocity: its set-up is wrong there (one of the Theorem's outliers), so
 #: would its frequencies be (the solution's route).
 INCONSISTENT_QUOTIENTS = 11
+#: The state is at rest: an equilibrium of (1) (a stationary rotation), or any
+#: state of a spherical top (all ``c_ij`` equal). NaN frequencies: the
+#: neighbouring tori tend to the linearized motion's frequencies instead.
+EQUILIBRIUM = 12
+#: The state lies on the separatrix of an Euler top (an so(3) block or a
+#: self-dual state): its motion is asymptotic, with no period.
+SEPARATRIX = 13
 
 #: States per chunk without a client: the unit between progress updates and
 #: Ctrl-C checks of the Python loop (the Rust core also polls within a chunk).
