@@ -280,6 +280,11 @@ impl EulerTop {
             });
         }
         if on_separatrix {
+            // sech > 0: M_r and M_s keep their signs, so R̃ takes the sign of
+            // M_r and the equations fix the direction of the motion instead:
+            // −R̃ ω = χ (W_s − W_b) S̃ X gives the sign of ω.
+            let r_amp = if mr < 0.0 { -r2.sqrt() } else { r2.sqrt() };
+            let omega = -chi * dsb.signum() * (s_amp * r_amp).signum() * omega;
             // tanh u0 = M_b/X, sech u0 = |M_s|/S: sinh u0 = (M_b/X)(S/|M_s|).
             let u0 = (mb / x * (s_amp.abs() / ms.abs())).asinh();
             return Ok(EulerTop {
@@ -287,12 +292,12 @@ impl EulerTop {
                 w,
                 motion: Motion::Separatrix {
                     idx,
-                    amp,
+                    amp: [x, r_amp, s_amp],
                     omega,
                     u0,
                 },
                 regime: EulerRegime::Separatrix,
-                params: [1.0, 0.0, omega],
+                params: [1.0, 0.0, omega.abs()],
             });
         }
         let m1 = (delta.value().abs() * c_ / omega2).min(1.0);

@@ -164,14 +164,32 @@ fn an_exact_separatrix_state_moves_on_the_separatrix() {
     // W = (1, 2, 3): middle axis 2; Δ = (1 − 2) M_1² + (3 − 2) M_3² = 0 for
     // |M_1| = |M_3| (exact in doubles).
     let w = [Dd2::new(1.0), Dd2::new(2.0), Dd2::new(3.0)];
+    // The four heteroclinic orbits through the signs of (M_1, M_3), and both
+    // directions of travel (M_2 of either sign).
+    let c4 = [-3.0, -2.0, 0.0, -1.0, 0.0, 0.0];
+    let emb = Embedding::Block([0, 1, 2]);
+    let times: Vec<f64> = (1..=20).map(|k| 0.25 * k as f64).collect();
+    for m0 in [
+        [0.5, 0.25, 0.5],
+        [0.5, -0.25, 0.5],
+        [-0.5, 0.25, 0.5],
+        [0.5, 0.75, -0.5],
+        [-0.5, -0.1, -0.5],
+    ] {
+        let top = EulerTop::new(w, m0).unwrap();
+        assert_eq!(top.regime(), EulerRegime::Separatrix);
+        let start = top.m(0.0);
+        assert!((0..3).all(|i| (start[i] - m0[i]).abs() < 1e-15), "{m0:?}: {start:?}");
+        let reference = gauss16(&c4, &emb.state(&m0), &times);
+        let dev = max_dev(emb, &top, &reference, &times);
+        assert!(dev < AGREE, "{m0:?}: {dev:e}");
+    }
     let m0 = [0.5, 0.25, -0.5];
     let top = EulerTop::new(w, m0).unwrap();
     assert_eq!(top.regime(), EulerRegime::Separatrix);
     assert_eq!(top.frequency(), 0.0);
     // Against the integrator (the block {1,2,3} of c = (1, 2, ·, 3, ·, ·) with
     // W = −(c23, c13, c12)).
-    let c4 = [-3.0, -2.0, 0.0, -1.0, 0.0, 0.0];
-    let emb = Embedding::Block([0, 1, 2]);
     assert_eq!(emb.w_of(&c4).map(|x| x.hi), [1.0, 2.0, 3.0]);
     let times: Vec<f64> = (1..=20).map(|k| 0.5 * k as f64).collect();
     let reference = gauss16(&c4, &emb.state(&m0), &times);
