@@ -266,6 +266,15 @@ def frequency_map(
     frequencies agree to 2.4e-15 (median) and 4e-12 (max) relative on the
     100 random states of ``tests/data/tori_naff_random100.py``).
 
+    Each state is first normalized and classified, as :meth:`ManakovTop.solve`
+    does (docs/degenerate.md): an exactly self-dual or so(3)-block state (an
+    Euler top, a closed orbit) gets status ``ok`` with ``(ν1, ν2) = (ν_⊥, ν_E)``,
+    the transverse rotation number and the Euler frequency (the limit of the
+    neighbouring tori's frequencies up to ``ν1 → |ν_⊥ + k ν_E|``); an equilibrium
+    of (1) or any state of a spherical top gets :data:`EQUILIBRIUM`, an Euler
+    top's separatrix :data:`SEPARATRIX`; genus-2 states are computed on the
+    normalized data, their frequencies in the user's time.
+
     Parameters
     ----------
     top : ManakovTop
