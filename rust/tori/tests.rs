@@ -687,11 +687,16 @@ fn moderate_genus2_states_keep_the_map_bits() {
     let shared = crate::solution::tests::TOPS;
     for (a, b, l0) in shared {
         for k in 0..8 {
-            let l: [f64; 6] = std::array::from_fn(|q| l0[q] * (1.0 + 0.05 * ((k * 7 + q) % 5) as f64));
+            let l: [f64; 6] =
+                std::array::from_fn(|q| l0[q] * (1.0 + 0.05 * ((k * 7 + q) % 5) as f64));
             let e = state_frequencies(&a, &b, &l);
             let o = state_frequencies_level_set(&a, &b, &l);
             assert_eq!(e.status, o.status);
-            assert_eq!(e.nu.map(f64::to_bits), o.nu.map(f64::to_bits), "{a:?} {l:?}");
+            assert_eq!(
+                e.nu.map(f64::to_bits),
+                o.nu.map(f64::to_bits),
+                "{a:?} {l:?}"
+            );
         }
     }
 }

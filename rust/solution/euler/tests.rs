@@ -179,7 +179,10 @@ fn an_exact_separatrix_state_moves_on_the_separatrix() {
         let top = EulerTop::new(w, m0).unwrap();
         assert_eq!(top.regime(), EulerRegime::Separatrix);
         let start = top.m(0.0);
-        assert!((0..3).all(|i| (start[i] - m0[i]).abs() < 1e-15), "{m0:?}: {start:?}");
+        assert!(
+            (0..3).all(|i| (start[i] - m0[i]).abs() < 1e-15),
+            "{m0:?}: {start:?}"
+        );
         let reference = gauss16(&c4, &emb.state(&m0), &times);
         let dev = max_dev(emb, &top, &reference, &times);
         assert!(dev < AGREE, "{m0:?}: {dev:e}");
