@@ -11,7 +11,7 @@ use super::solution::SolutionCore;
 use crate::error::Error;
 use crate::solution::jacobi::Jacobi;
 use crate::solution::motion::{Kind, Motion};
-use crate::solution::transverse::euler_frequencies;
+use crate::solution::transverse::euler_frequencies_with;
 use crate::tori::motion::torus_of_motion;
 
 type C = Complex64;
@@ -124,7 +124,10 @@ impl MotionCore {
     /// separatrix (no period: the limit of both) and for the constant kinds.
     fn closed_form_frequencies(&self, py: Python<'_>) -> PyResult<[f64; 2]> {
         match self.motion.kind() {
-            Kind::Euler => Ok(py.detach(|| euler_frequencies(&self.motion))?),
+            Kind::Euler => {
+                let cancel = py_cancel();
+                Ok(py.detach(|| euler_frequencies_with(&self.motion, &cancel))?)
+            }
             Kind::Genus2 => Err(Error::InvalidArgument {
                 what: "frequencies",
                 reason: "a genus-2 motion's frequencies are its torus's".into(),

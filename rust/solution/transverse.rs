@@ -35,6 +35,7 @@
 use super::euler::{Embedding, EulerRegime, EulerTop};
 use super::motion::Motion;
 use crate::error::{Error, Result};
+use crate::numeric::cancel::Cancel;
 
 /// First number of Magnus steps per period, at least: the count starts at
 /// the power of two with `h max‖A‖ ≤ 1` (`A` the coefficient matrix, its
@@ -161,12 +162,24 @@ fn coefficient(emb: Embedding, c4: &[f64; 6], m: &[f64; 3]) -> M3 {
 }
 
 /// `Φ(T)` with `n` sixth-order Magnus steps.
-fn propagate(emb: Embedding, c4: &[f64; 6], top: &EulerTop, period: f64, n: usize) -> M3 {
+///
+/// `cancel` is checked every [`CANCEL_STEPS`] steps.
+fn propagate(
+    emb: Embedding,
+    c4: &[f64; 6],
+    top: &EulerTop,
+    period: f64,
+    n: usize,
+    cancel: &Cancel,
+) -> Result<M3> {
     match emb {
-        Embedding::SelfDual(_) => propagate_so3(c4, top, period, n),
-        Embedding::Block(_) => propagate_general(emb, c4, top, period, n),
+        Embedding::SelfDual(_) => propagate_so3(c4, top, period, n, cancel),
+        Embedding::Block(_) => propagate_general(emb, c4, top, period, n, cancel),
     }
 }
+
+/// Magnus steps between two checks of the cancellation token (~1 ms).
+const CANCEL_STEPS: usize = 4096;
 
 /// The three Gauss–Legendre nodes of a step, as fractions of it.
 fn nodes() -> [f64; 3] {
@@ -174,10 +187,20 @@ fn nodes() -> [f64; 3] {
     [0.5 - r, 0.5, 0.5 + r]
 }
 
-fn propagate_general(emb: Embedding, c4: &[f64; 6], top: &EulerTop, period: f64, n: usize) -> M3 {
+fn propagate_general(
+    emb: Embedding,
+    c4: &[f64; 6],
+    top: &EulerTop,
+    period: f64,
+    n: usize,
+    cancel: &Cancel,
+) -> Result<M3> {
     let h = period / n as f64;
     let mut phi = ID;
     for k in 0..n {
+        if k % CANCEL_STEPS == 0 {
+            cancel.check()?;
+        }
         let t0 = h * k as f64;
         let a: [M3; 3] = nodes().map(|c| coefficient(emb, c4, &top.m(t0 + c * h)));
         let a1 = lin(h, &a[1], 0.0, &a[1]);
@@ -205,7 +228,7 @@ fn propagate_general(emb: Embedding, c4: &[f64; 6], top: &EulerTop, period: f64,
         );
         phi = mul(&expm(&omega), &phi);
     }
-    phi
+    Ok(phi)
 }
 
 type V3 = [f64; 3];
@@ -225,11 +248,20 @@ fn vlin(x: f64, a: &V3, y: f64, b: &V3) -> V3 {
 /// The same Magnus method on so(3) ≅ (R³, ×) for the self-dual case
 /// (`A = [w]×`, `[a]×[b]× − [b]×[a]× = [a × b]×`), with Rodrigues' formula
 /// for the exponential: the product stays a rotation to rounding.
-fn propagate_so3(c4: &[f64; 6], top: &EulerTop, period: f64, n: usize) -> M3 {
+fn propagate_so3(
+    c4: &[f64; 6],
+    top: &EulerTop,
+    period: f64,
+    n: usize,
+    cancel: &Cancel,
+) -> Result<M3> {
     let d = [c4[3] - c4[2], c4[1] - c4[4], c4[0] - c4[5]];
     let h = period / n as f64;
     let mut phi = ID;
     for k in 0..n {
+        if k % CANCEL_STEPS == 0 {
+            cancel.check()?;
+        }
         let t0 = h * k as f64;
         let w: [V3; 3] = nodes().map(|c| {
             let m = top.m(t0 + c * h);
@@ -279,7 +311,7 @@ fn propagate_so3(c4: &[f64; 6], top: &EulerTop, period: f64, n: usize) -> M3 {
         let r = lin(1.0, &lin(1.0, &ID, s1, &kx), s2, &mul(&kx, &kx));
         phi = mul(&r, &phi);
     }
-    phi
+    Ok(phi)
 }
 
 /// The invariant of `Φ(T)` that fixes `θ`: for a rotation `(cos θ, sin θ)`
@@ -312,6 +344,12 @@ fn size(phi: &M3) -> f64 {
 /// Errors: a motion of another kind, a motion without period (separatrix,
 /// rest), or no convergence within [`MAX_STEPS`] steps.
 pub fn monodromy(m: &Motion) -> Result<Monodromy> {
+    monodromy_with(m, &Cancel::never())
+}
+
+/// [`monodromy`], checking `cancel` every few thousand steps (a map of many
+/// Euler states must stop on Ctrl-C; one state can take up to ~0.1 s).
+pub fn monodromy_with(m: &Motion, cancel: &Cancel) -> Result<Monodromy> {
     let (emb, top) = m.euler().ok_or(Error::InvalidArgument {
         what: "state l0",
         reason: format!(
@@ -348,11 +386,11 @@ pub fn monodromy(m: &Motion) -> Result<Monodromy> {
     let cap = (n << MAX_DOUBLINGS).min(MAX_STEPS);
     // Values at n, 2n, 4n, … and their Richardson extrapolations
     // r = v_2n + (v_2n − v_n)/63 (sixth order: the error of r is O(h^8)).
-    let mut prev = invariant(*emb, &propagate(*emb, c4, top, period, n));
+    let mut prev = invariant(*emb, &propagate(*emb, c4, top, period, n, cancel)?);
     let mut prev_r: Option<(f64, f64)> = None;
     loop {
         let next_n = 2 * n;
-        let phi = propagate(*emb, c4, top, period, next_n);
+        let phi = propagate(*emb, c4, top, period, next_n, cancel)?;
         let cur = invariant(*emb, &phi);
         n = next_n;
         // Clearly hyperbolic at both counts: θ does not exist, ν_⊥ = 0; the
@@ -422,7 +460,12 @@ pub fn monodromy(m: &Motion) -> Result<Monodromy> {
 ///
 /// Errors: those of [`monodromy`].
 pub fn euler_frequencies(m: &Motion) -> Result<[f64; 2]> {
-    let mono = monodromy(m)?;
+    euler_frequencies_with(m, &Cancel::never())
+}
+
+/// [`euler_frequencies`] with a cancellation token ([`monodromy_with`]).
+pub fn euler_frequencies_with(m: &Motion, cancel: &Cancel) -> Result<[f64; 2]> {
+    let mono = monodromy_with(m, cancel)?;
     let (_, top) = m.euler().ok_or(Error::InvalidArgument {
         what: "state l0",
         reason: "not an Euler top".into(),

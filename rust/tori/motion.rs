@@ -18,13 +18,21 @@ use num_complex::Complex64 as C;
 use super::solve::{classify as classify_error, flow_data, level_set_entry};
 use super::{real_torus, MapEntry, RealTorus, Status};
 use crate::error::{Error, Result};
+use crate::numeric::cancel::Cancel;
 use crate::solution::motion::{classify, Kind, Motion};
 use crate::solution::normalize::TopFrame;
-use crate::solution::transverse::euler_frequencies;
+use crate::solution::transverse::euler_frequencies_with;
 
 /// Status and `(ν1, ν2)` of the state `l0` of the top with frame `frame`
 /// (see the module table). Nothing here panics or raises.
 pub fn state_frequencies_in(frame: &TopFrame, l0: &[f64; 6]) -> MapEntry {
+    state_frequencies_in_with(frame, l0, &Cancel::never())
+}
+
+/// [`state_frequencies_in`] with a cancellation token, checked inside the
+/// (up to ~0.1 s) monodromy of an Euler state; when it fires the entry is a
+/// failure and the caller's next check stops the map.
+pub fn state_frequencies_in_with(frame: &TopFrame, l0: &[f64; 6], cancel: &Cancel) -> MapEntry {
     if l0.iter().any(|v| !v.is_finite()) {
         return MapEntry::failed(Status::NonFinite);
     }
@@ -35,7 +43,9 @@ pub fn state_frequencies_in(frame: &TopFrame, l0: &[f64; 6]) -> MapEntry {
         Kind::Spherical | Kind::Equilibrium => MapEntry::failed(Status::Equilibrium),
         Kind::Separatrix => MapEntry::failed(Status::Separatrix),
         Kind::Euler => {
-            match Motion::in_frame(frame.clone(), l0).and_then(|m| euler_frequencies(&m)) {
+            match Motion::in_frame(frame.clone(), l0)
+                .and_then(|m| euler_frequencies_with(&m, cancel))
+            {
                 Ok(nu) if nu.iter().all(|v| v.is_finite()) => MapEntry {
                     status: Status::Ok,
                     nu,

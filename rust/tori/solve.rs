@@ -195,7 +195,7 @@ pub fn frequency_map(
     let frame = crate::solution::normalize::TopFrame::new(a, b)?;
     super::map_states(
         states,
-        |l0| super::motion::state_frequencies_in(&frame, l0),
+        |l0| super::motion::state_frequencies_in_with(&frame, l0, cancel),
         cancel,
     )
 }
