@@ -343,6 +343,29 @@ def test_nearly_axisymmetric_self_dual_tops() -> None:
         assert err < 1e-12, (m, err)
 
 
+def test_extreme_component_ratios() -> None:
+    # Components 1e-100 … 1e-300 beside O(1) ones (their squares underflow):
+    # solved, on the Euler orbit they are on, as gauss16 has them (relative to
+    # |l0|; near the middle axis a tiny component grows like cosh(λ t), and the
+    # closed form keeps it to its absolute, not relative, accuracy).
+    p = manakov.problem("generic")
+    top = manakov.ManakovTop(p.a, p.b)
+    t = np.linspace(0.0, 20.0, 41)
+    for l0 in (
+        [1e-170, 1.0, 0, 0, 0, 0],
+        [1.0, 1e-300, 0, 0, 0, 0],
+        [0, 0, 0, 1.0, 1e-200, 0],
+        [0.3, 1e-150, 0, -0.7, 0, 0],
+    ):
+        l0 = np.array(l0, float)
+        sol = top.solve(l0)
+        assert sol.kind == "euler", (l0, sol.kind)
+        err = np.max(np.abs(sol.l(t) - _gauss16(top, l0, t))) / np.linalg.norm(l0)
+        assert err < 1e-13, (l0, err)
+        fm = tori.frequency_map(top, l0)
+        assert fm.status == tori.OK
+
+
 # --- invariances --------------------------------------------------------------------
 
 #: Two solutions of one motion, one through normalized data: the genus-2 route's

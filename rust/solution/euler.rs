@@ -25,7 +25,8 @@
 //! axisymmetric limit, `m → 0`) or `Δ → 0` (the separatrix, `m → 1`; `1 − m`
 //! carries `|Δ|`, evaluated in double-double). `S̃ = sign(M_s) S`,
 //! `R̃ = −χ sign(W_s − W_b) sign(S̃) R` with `χ = +1` if `(b, s, r)` is a cyclic
-//! order and `−1` otherwise, and `u0 = F(atan2(M_b/X, M_r/R̃) | m)`. The period
+//! order and `−1` otherwise, and `u0` the argument with `sn u0 = M_b/X`,
+//! `cn u0 = M_r/R̃`, `dn u0 = M_s/S̃` ([`Jacobi::arg_from`]). The period
 //! of `M` is `4K(m)/ω`, its frequency `ν = ω/(4K)`.
 //!
 //! The other regimes: two equal `W` (axisymmetric): `M_z` constant and
@@ -242,12 +243,20 @@ impl EulerTop {
         // The exact order of the double-double W (their sums may round alike).
         order.sort_by(|&i, &j| diff(i, j).signum0().total_cmp(&0.0));
         let (lo, b, hi) = (order[0], order[1], order[2]);
-        let sq = |i: usize| Dd2::prod(m0[i], m0[i]);
+        // Δ with the two outer components scaled by a power of two μ (exact),
+        // so that their squares do not underflow when they are tiny beside
+        // M_b (a state within 1e-154 of the middle axis): Δ = μ² Δ'.
+        let big = m0[hi].abs().max(m0[lo].abs());
+        let mu = big.log2().floor().max(-1074.0).exp2();
+        let sq = |i: usize| {
+            let v = m0[i] / mu;
+            Dd2::prod(v, v)
+        };
         let t_hi = diff(hi, b).mul(sq(hi));
         let t_lo = diff(lo, b).mul(sq(lo));
         let delta = t_hi.add(t_lo);
         let scale = t_hi.value().abs() + t_lo.value().abs();
-        let on_separatrix = delta.value().abs() <= SEPARATRIX_RTOL * scale;
+        let mut on_separatrix = delta.value().abs() <= SEPARATRIX_RTOL * scale;
         let (s, r) = if on_separatrix || delta.signum0() > 0.0 {
             (hi, lo)
         } else {
@@ -259,19 +268,18 @@ impl EulerTop {
         let b_ = diff(b, r).value().abs();
         let c_ = diff(s, r).value().abs();
         let (mb, mr, ms) = (m0[b], m0[r], m0[s]);
-        let x2 = mb * mb + (c_ / a_) * mr * mr;
-        let r2 = mr * mr + (a_ / c_) * mb * mb;
-        let s2 = ms * ms + (b_ / c_) * mb * mb;
-        let omega2 = a_ * (b_ * mb * mb + c_ * ms * ms);
-        let omega = omega2.sqrt();
-        let x = x2.sqrt();
-        let s_amp = if ms < 0.0 { -s2.sqrt() } else { s2.sqrt() };
-        let r_amp = -chi * dsb.signum() * s_amp.signum() * r2.sqrt();
+        // Amplitudes as hypotenuses: no square underflows or overflows.
+        let x = mb.hypot((c_ / a_).sqrt() * mr);
+        let r_abs = mr.hypot((a_ / c_).sqrt() * mb);
+        let s_abs = ms.hypot((b_ / c_).sqrt() * mb);
+        let omega = a_.sqrt() * (b_.sqrt() * mb).hypot(c_.sqrt() * ms);
+        let s_amp = if ms < 0.0 { -s_abs } else { s_abs };
+        let r_amp = -chi * dsb.signum() * s_amp.signum() * r_abs;
         let idx = [b, r, s];
         let amp = [x, r_amp, s_amp];
-        if !(omega > 0.0 && x > 0.0 && r_amp != 0.0 && s_amp != 0.0) {
-            // Unreachable for finite M off the axes (each amplitude is at
-            // least one non-zero |M_i|); a guard against underflow.
+        if !(omega > 0.0 && x > 0.0 && r_abs > 0.0 && s_abs > 0.0) {
+            // Unreachable for finite M off the axes: each amplitude is at
+            // least one non-zero |M_i| (off the axes two are non-zero).
             return Err(Error::InvalidArgument {
                 what: "Euler top",
                 reason: format!(
@@ -279,14 +287,19 @@ impl EulerTop {
                 ),
             });
         }
+        // k' = √(1 − m) = (μ/ω) √(|Δ'| C): no underflow down to μ ~ 1e-308.
+        let kc = (mu / omega) * (delta.value().abs() * c_).sqrt();
+        // A k' below the double range (μ subnormal): the separatrix to the
+        // last bit; its period would exceed ~1400/ω.
+        on_separatrix |= kc == 0.0;
         if on_separatrix {
             // sech > 0: M_r and M_s keep their signs, so R̃ takes the sign of
             // M_r and the equations fix the direction of the motion instead:
             // −R̃ ω = χ (W_s − W_b) S̃ X gives the sign of ω.
-            let r_amp = if mr < 0.0 { -r2.sqrt() } else { r2.sqrt() };
+            let r_amp = if mr < 0.0 { -r_abs } else { r_abs };
             let omega = -chi * dsb.signum() * (s_amp * r_amp).signum() * omega;
             // tanh u0 = M_b/X, sech u0 = |M_s|/S: sinh u0 = (M_b/X)(S/|M_s|).
-            let u0 = (mb / x * (s_amp.abs() / ms.abs())).asinh();
+            let u0 = (mb / x * (s_abs / ms.abs())).asinh();
             return Ok(EulerTop {
                 m0,
                 w,
@@ -300,11 +313,17 @@ impl EulerTop {
                 params: [1.0, 0.0, omega.abs()],
             });
         }
-        let m1 = (delta.value().abs() * c_ / omega2).min(1.0);
-        let m = (a_ * b_ * x2 / omega2).min(1.0);
-        let jac = Jacobi::new(m, m1)?;
-        let phi0 = (mb / x).atan2(mr / r_amp);
-        let u0 = jac.f(phi0)?;
+        let q = (a_ * b_).sqrt() * x / omega;
+        let m = (q * q).min(1.0);
+        let jac = Jacobi::with_kc(m, kc.min(1.0))?;
+        let m1 = kc * kc;
+        // The initial point from its own sn, cn, dn (not from an amplitude,
+        // which near ±K loses ε/dn; see Jacobi::arg_from).
+        let u0 = jac.arg_from(
+            (mb / x).clamp(-1.0, 1.0),
+            (mr / r_amp).clamp(-1.0, 1.0),
+            (ms / s_amp).clamp(0.0, 1.0),
+        )?;
         let period = 4.0 * jac.quarter_period();
         let nu = omega / period;
         Ok(EulerTop {

@@ -68,7 +68,32 @@ impl Jacobi {
                 reason: format!("m = {m:e} and 1 - m = {m1:e} do not add up to 1"),
             });
         }
-        let kc = m1.sqrt();
+        Self::build(m, m1.sqrt())
+    }
+
+    /// The functions of parameter `m` with `k' = √(1 − m)` given directly
+    /// (so that a `k'` below `1e-154`, whose square underflows, keeps its
+    /// digits; such a `k'` arises within `1e-154` of a separatrix).
+    ///
+    /// Errors: `m` outside `[0, 1]`, `k'` outside `[0, 1]`, not finite, or
+    /// `m + k'²` not 1.
+    pub fn with_kc(m: f64, kc: f64) -> Result<Self> {
+        if !(0.0..=1.0).contains(&m) || !(0.0..=1.0).contains(&kc) {
+            return Err(Error::InvalidArgument {
+                what: "elliptic parameter",
+                reason: format!("m = {m:e}, k' = {kc:e} must lie in [0, 1]"),
+            });
+        }
+        if (m + kc * kc - 1.0).abs() > COMPLEMENT_TOL {
+            return Err(Error::InvalidArgument {
+                what: "elliptic parameter",
+                reason: format!("m = {m:e} and k'^2 = {:e} do not add up to 1", kc * kc),
+            });
+        }
+        Self::build(m, kc)
+    }
+
+    fn build(m: f64, kc: f64) -> Result<Self> {
         let mut a = [0.0; AGM_MAX + 1];
         let mut b = [0.0; AGM_MAX + 1];
         let mut c = [0.0; AGM_MAX + 1];
@@ -141,18 +166,14 @@ impl Jacobi {
         let half = 0.5 * self.quarter;
         if v <= half {
             let (s, c) = self.sn_cn_agm(v);
-            // dn ≤ 1; the sum of squares may round just above it.
-            (s, c, (c * c + self.m1() * s * s).sqrt().min(1.0))
+            // dn = √(cn² + k'² sn²) ≤ 1 (hypot: k' sn may be below 1e-154).
+            (s, c, c.hypot(self.kc * s).min(1.0))
         } else {
             let w = (self.quarter - v).max(0.0);
             let (s, c) = self.sn_cn_agm(w);
-            let d = (c * c + self.m1() * s * s).sqrt().min(1.0);
+            let d = c.hypot(self.kc * s).min(1.0);
             (c / d, self.kc * s / d, (self.kc / d).min(1.0))
         }
-    }
-
-    fn m1(&self) -> f64 {
-        self.kc * self.kc
     }
 
     /// `(sn, cn, dn)(u)` for `u` in `[−2K, 2K]` (`m < 1`).
@@ -226,12 +247,53 @@ impl Jacobi {
             });
         }
         let (s, c) = r.sin_cos();
-        let base = s * carlson_rf(c * c, c * c + self.m1() * s * s, 1.0)?;
+        let y = c.hypot(self.kc * s);
+        if y * y == 0.0 {
+            // cos φ and k' both below 1e-154: F(±π/2) = ±K to that precision.
+            return Ok(s.signum() * self.quarter + 2.0 * n * self.quarter);
+        }
+        let base = s * carlson_rf(c * c, y * y, 1.0)?;
         Ok(if n == 0.0 {
             base
         } else {
             base + 2.0 * n * self.quarter
         })
+    }
+}
+
+impl Jacobi {
+    /// The argument `u ∈ (−2K, 2K]` with `(sn u, cn u, dn u) = (sn, cn, dn)`
+    /// (values of one point, `sn² + cn² = 1`, `dn² + m sn² = 1`), from the
+    /// values themselves: `u = sn R_F(cn², dn², 1)` for `cn ≥ 0`,
+    /// `sign(sn) 2K − sn R_F(cn², dn², 1)` for `cn < 0`. Unlike
+    /// `F(atan2(sn, cn))` it needs no amplitude: near `u = ±K` with `k'`
+    /// tiny, `F` changes by `ε/dn` per ulp of the amplitude (by `ln(δ/k')`
+    /// for `cos φ = δ ≫ k'`), while `cn` and `dn` carry the point exactly.
+    /// Where `cn²` and `dn²` underflow, `R_F(x, y, 1) = ln(4/(√x + √y))`
+    /// (to `O((x + y) ln)`, below `1e-300`).
+    ///
+    /// Errors: non-finite or out-of-range values.
+    pub fn arg_from(&self, sn: f64, cn: f64, dn: f64) -> Result<f64> {
+        let ok = |v: f64| v.is_finite() && v.abs() <= 1.0 + 4.0 * f64::EPSILON;
+        if !(ok(sn) && ok(cn) && ok(dn)) || dn < 0.0 {
+            return Err(Error::InvalidArgument {
+                what: "elliptic function values",
+                reason: format!("sn = {sn:e}, cn = {cn:e}, dn = {dn:e} are not of one point"),
+            });
+        }
+        let (x, y) = (cn * cn, dn * dn);
+        let rf = if x + y < 1e-300 {
+            (4.0 / (cn.abs() + dn)).ln()
+        } else {
+            carlson_rf(x, y, 1.0)?
+        };
+        let base = sn * rf;
+        if cn >= 0.0 {
+            Ok(base)
+        } else {
+            let k2 = 2.0 * self.quarter;
+            Ok(if sn < 0.0 { -k2 - base } else { k2 - base })
+        }
     }
 }
 
@@ -329,6 +391,32 @@ mod tests {
                     "m1 {m1}: F(am u) = u: u={u} back={back} phi={phi} d={d} K={}",
                     j.quarter_period()
                 );
+            }
+        }
+    }
+
+    #[test]
+    fn arg_from_inverts_sncndn() {
+        for &m1 in &[1.0, 0.5, 1e-8, 1e-30, 1e-300] {
+            let j = Jacobi::with_kc(1.0 - m1, m1.sqrt()).unwrap();
+            let k = j.quarter_period();
+            for frac in [-1.9, -1.0, -0.7, -0.2, 0.0, 0.3, 0.99, 1.0, 1.5, 2.0] {
+                let u = frac * k;
+                let (s, c, d) = j.sncndn(u);
+                let back = j.arg_from(s, c, d).unwrap();
+                // The point, not the argument, is what must come back: near
+                // ±K with k' tiny many arguments share the doubles (s, c, d).
+                let (s2, c2, d2) = j.sncndn(back);
+                let tol = 1e-14;
+                assert!(
+                    (s2 - s).abs() < tol && (c2 - c).abs() < tol,
+                    "m1 {m1}, u = {u}"
+                );
+                // dn relative to itself: its logarithmic derivative is at most
+                // 1 in size (m sn cn/dn ≤ 1), so an argument good to ε K
+                // leaves it good to that.
+                let tol_d = 4.0 * f64::EPSILON * (1.0 + k) * d + 1e-300;
+                assert!((d2 - d).abs() <= tol_d, "m1 {m1}, u = {u}: dn");
             }
         }
     }

@@ -235,3 +235,33 @@ fn large_times_keep_the_phase() {
         assert!((m[i] - m0[i]).abs() < 1e-8, "{m:?}");
     }
 }
+
+#[test]
+fn extreme_component_ratios_are_solved() {
+    // Components 1e-170 … 1e-300 beside O(1) ones: their squares underflow;
+    // Δ, the amplitudes and k' are formed without squaring them.
+    let w = [Dd2::new(-1.777), Dd2::new(-0.529), Dd2::new(0.875)];
+    let cases = [
+        [0.0, -1e-300, 1.0],
+        [0.0, -1e-170, 1.0],
+        [1e-170, 1.0, 0.0],
+        [1e-200, 0.0, 1.0],
+        [0.3, 1.0, 1e-160],
+    ];
+    for m0 in cases {
+        let top = EulerTop::new(w, m0).unwrap();
+        for t in [0.0, 1.0, 37.0, 1e4] {
+            let m = top.m(t);
+            assert!(m.iter().all(|v| v.is_finite()), "{m0:?} at {t}: {m:?}");
+            let g: f64 = m.iter().map(|v| v * v).sum();
+            let g0: f64 = m0.iter().map(|v| v * v).sum();
+            assert!((g - g0).abs() <= 1e-15 * g0, "{m0:?} at {t}");
+        }
+        // Near the middle axis (W_2) the motion is elliptic with k' ~ the
+        // small components (not a separatrix).
+        if m0[1] == 1.0 {
+            assert_eq!(top.regime(), EulerRegime::Elliptic, "{m0:?}");
+            assert!(top.frequency() > 0.0);
+        }
+    }
+}
