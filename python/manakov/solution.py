@@ -154,7 +154,7 @@ class Solution:
     raise ``AttributeError`` naming the kind on the others.
     """
 
-    __slots__ = ("_a", "_b", "_l0", "_motion", "_core", "_curve", "_torus")
+    __slots__ = ("_a", "_b", "_l0", "_motion", "_core", "_curve", "_torus", "_freq")
 
     def __init__(self, a: Any, b: Any, l0: Any) -> None:
         aa = _float_array(a, "a").astype(float)
@@ -168,6 +168,7 @@ class Solution:
         self._core = self._motion.genus2()
         self._curve: HyperellipticCurve | None = None
         self._torus: Torus | None = None
+        self._freq: np.ndarray | None = None
 
     @property
     def kind(self) -> str:
@@ -389,7 +390,10 @@ class Solution:
         """
         if self._core is not None:
             return self.torus.frequencies
-        return _frozen(np.array(self._motion.closed_form_frequencies()))
+        if self._freq is None:
+            # An Euler motion integrates its transverse monodromy once (0.1-10 ms).
+            self._freq = _frozen(np.array(self._motion.closed_form_frequencies()))
+        return self._freq
 
     @property
     def rotation_number(self) -> float:
