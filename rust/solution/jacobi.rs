@@ -48,6 +48,8 @@ pub struct Jacobi {
     b: [f64; AGM_MAX + 1],
     c: [f64; AGM_MAX + 1],
     n: usize,
+    /// `2^N a_N`: `φ_N = 2^N a_N u`.
+    scale: f64,
 }
 
 impl Jacobi {
@@ -123,6 +125,7 @@ impl Jacobi {
             b,
             c,
             n,
+            scale: a[n] * (n as f64).exp2(),
         })
     }
 
@@ -145,16 +148,26 @@ impl Jacobi {
     #[inline]
     fn sn_cn_agm(&self, u: f64) -> (f64, f64) {
         let n = self.n;
-        let mut phi = self.a[n] * u * (n as f64).exp2();
+        let mut phi = self.scale * u;
         for j in (1..=n).rev() {
-            // arcsin(x sin φ), x = c_j/a_j, as atan2(x sin φ, √(1 − x² sin²φ))
-            // with 1 − x² sin²φ = (b_j/a_j)² + x² cos²φ: near m = 1, x is
-            // within 2k' of 1 and arcsin of a rounded x sin φ ≈ 1 would lose
-            // ε/k' of the phase; the sum of squares keeps it.
             let x = self.c[j] / self.a[j];
-            let (s, c) = phi.sin_cos();
-            let w = self.b[j] / self.a[j];
-            let r = (x * s).atan2((w * w + x * x * c * c).sqrt());
+            let r = if x < 1e-4 {
+                // arcsin y = y + y³/6 + O(y⁵): below ε for |y| < 1e-4 (the
+                // last AGM levels, where c_j/a_j falls quadratically).
+                let y = x * phi.sin();
+                y + y * y * y / 6.0
+            } else if x < 0.9 {
+                // |y| ≤ 0.9: arcsin amplifies the rounding of y by ≤ 2.3.
+                (x * phi.sin()).asin()
+            } else {
+                // arcsin(x sin φ) as atan2(x sin φ, √(1 − x² sin²φ)) with
+                // 1 − x² sin²φ = (b_j/a_j)² + x² cos²φ: near m = 1, x is
+                // within 2k' of 1 and arcsin of a rounded x sin φ ≈ 1 would
+                // lose ε/k' of the phase; the sum of squares keeps it.
+                let (s, c) = phi.sin_cos();
+                let w = self.b[j] / self.a[j];
+                (x * s).atan2((w * w + x * x * c * c).sqrt())
+            };
             phi = 0.5 * (phi + r);
         }
         phi.sin_cos()
