@@ -7,9 +7,8 @@ dispatcher's kinds and errors, and the frequencies of Euler motions against the
 genus-2 frequencies of their neighbours.
 
 References: gauss16 (the package's integrator) and, where heyoka is installed,
-heyoka's Taylor integrator in long double (``ld_reference.py``): the bound of
-the issue is ``max(1e-10, 10 × gauss16's error)`` against the long-double
-reference.
+heyoka's Taylor integrator in long double (``ld_reference.py``); the accuracy
+bound is ``max(1e-10, 10 × gauss16's error)`` against the long-double reference.
 """
 
 from __future__ import annotations
@@ -28,7 +27,7 @@ POS = {p: q for q, p in enumerate(PAIRS)}
 BLOCKS = [(0, 1, 2), (0, 1, 3), (0, 2, 3), (1, 2, 3)]
 NAMES = ("generic", "physical", "wide", "near_degenerate")
 
-#: The issue's floor: a closed form within this of the reference passes
+#: The bound's floor: a closed form within this of the reference passes
 #: whatever gauss16 reaches (gauss16 itself reaches ~1e-14 here).
 FLOOR = 1e-10
 #: ... and otherwise within this factor of gauss16's own error.
@@ -233,7 +232,7 @@ def _near_separatrix(
 
 
 @pytest.mark.parametrize("name", NAMES)
-def test_exactly_degenerate_states_meet_the_issue_bound(name: str) -> None:
+def test_exactly_degenerate_states_against_long_double(name: str) -> None:
     pytest.importorskip("heyoka")
     p = manakov.problem(name)
     top = manakov.ManakovTop(p.a, p.b)

@@ -27,8 +27,9 @@ use crate::error::{Error, Result};
 use crate::so4;
 
 /// Scales are left at 1 when the quantity lies in `[2^-WINDOW, 2^WINDOW]`:
-/// the genus-2 path is exercised and accurate there (the refusals
-/// start at `|l0| ~ 1e-80` and `1e76`), and the identity keeps its bits.
+/// the genus-2 path is exercised and accurate there (without normalization
+/// it refused from `|l0| ~ 1e-80` and `1e76` on), and the identity keeps its
+/// bits.
 pub const WINDOW: i32 = 16;
 
 /// Values count as clustered, and are shifted, when their spread is at most

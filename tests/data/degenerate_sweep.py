@@ -7,7 +7,7 @@ and the three coordinate planes, the equilibrium subspaces V± where the doubles
 have them, block states 1e-6 off their separatrix) solved by ``top.solve``;
 ``max |l − l_ref| / |l0|`` on [0, 100] against heyoka's Taylor integrator in
 long double (``tests/ld_reference.py``), beside gauss16 (dt = 1e-3) against the
-same reference; the issue's bound is ``max(1e-10, 10 × gauss16's error)``.
+same reference; the accuracy bound is ``max(1e-10, 10 × gauss16's error)``.
 Then: block states on their separatrix to rounding (1 − m ~ 1e-17) against a
 40-digit mpmath integration of the Euler top (long double loses ~1e-4 there);
 the scaling law ``l(t; s l0) = s l(s t; l0)`` at s = 1e-150, 1e150; ``a``
