@@ -36,82 +36,17 @@
 
 use super::jacobi::Jacobi;
 use crate::error::{Error, Result};
+use crate::numeric::dd::Dd;
 
-/// A double-double `hi + lo` (unevaluated sum, `|lo| ≤ ulp(hi)/2`).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Dd2 {
-    pub hi: f64,
-    pub lo: f64,
-}
-
-impl Dd2 {
-    /// `x` exactly.
-    pub fn new(x: f64) -> Self {
-        Dd2 { hi: x, lo: 0.0 }
-    }
-
-    /// `a + b` exactly (Knuth's two-sum).
-    pub fn sum(a: f64, b: f64) -> Self {
-        let s = a + b;
-        let bb = s - a;
-        let e = (a - (s - bb)) + (b - bb);
-        Dd2 { hi: s, lo: e }
-    }
-
-    /// `a · b` exactly (fma).
-    fn prod(a: f64, b: f64) -> Self {
-        let p = a * b;
-        Dd2 {
-            hi: p,
-            lo: a.mul_add(b, -p),
-        }
-    }
-
-    fn add(self, o: Dd2) -> Dd2 {
-        let s = Dd2::sum(self.hi, o.hi);
-        let lo = s.lo + self.lo + o.lo;
-        let hi = s.hi + lo;
-        Dd2 {
-            hi,
-            lo: lo - (hi - s.hi),
-        }
-    }
-
-    fn neg(self) -> Dd2 {
-        Dd2 {
-            hi: -self.hi,
-            lo: -self.lo,
-        }
-    }
-
-    fn sub(self, o: Dd2) -> Dd2 {
-        self.add(o.neg())
-    }
-
-    fn mul(self, o: Dd2) -> Dd2 {
-        let p = Dd2::prod(self.hi, o.hi);
-        let lo = p.lo + (self.hi * o.lo + self.lo * o.hi);
-        let hi = p.hi + lo;
-        Dd2 {
-            hi,
-            lo: lo - (hi - p.hi),
-        }
-    }
-
-    fn value(self) -> f64 {
-        self.hi + self.lo
-    }
-
-    /// Sign of `hi + lo` (`0` for an exact zero).
-    fn signum0(self) -> f64 {
-        let v = if self.hi != 0.0 { self.hi } else { self.lo };
-        if v > 0.0 {
-            1.0
-        } else if v < 0.0 {
-            -1.0
-        } else {
-            0.0
-        }
+/// Sign of the double-double `hi + lo` (`0` for an exact zero).
+fn signum0(x: Dd) -> f64 {
+    let v = if x.hi != 0.0 { x.hi } else { x.lo };
+    if v > 0.0 {
+        1.0
+    } else if v < 0.0 {
+        -1.0
+    } else {
+        0.0
     }
 }
 
@@ -166,7 +101,7 @@ enum Motion {
 #[derive(Debug, Clone)]
 pub struct EulerTop {
     m0: [f64; 3],
-    w: [Dd2; 3],
+    w: [Dd; 3],
     motion: Motion,
     regime: EulerRegime,
     /// `m`, `1 − m`, `ω` of the elliptic form (NaN where undefined).
@@ -191,9 +126,9 @@ impl EulerTop {
     ///
     /// Errors: non-finite input, or an elliptic parameter outside `[0, 1]`
     /// (not reachable for finite input; a guard).
-    pub fn new(w: [Dd2; 3], m0: [f64; 3]) -> Result<Self> {
+    pub(crate) fn new(w: [Dd; 3], m0: [f64; 3]) -> Result<Self> {
         crate::error::check_finite("M0", &m0)?;
-        let wv = w.map(|x| x.value());
+        let wv = w.map(|x| x.to_f64());
         crate::error::check_finite("W", &wv)?;
         let rest = |regime| EulerTop {
             m0,
@@ -207,7 +142,7 @@ impl EulerTop {
             return Ok(rest(EulerRegime::Rest));
         }
         let diff = |i: usize, j: usize| w[i].sub(w[j]);
-        let eq = |i: usize, j: usize| diff(i, j).signum0() == 0.0;
+        let eq = |i: usize, j: usize| signum0(diff(i, j)) == 0.0;
         let n_equal = [(0, 1), (1, 2), (0, 2)]
             .iter()
             .filter(|&&(i, j)| eq(i, j))
@@ -219,7 +154,7 @@ impl EulerTop {
             // Axisymmetric: z the distinct axis.
             let z = (0..3).find(|&z| eq((z + 1) % 3, (z + 2) % 3)).unwrap_or(0);
             let (p, q) = ((z + 1) % 3, (z + 2) % 3);
-            let omega = diff(z, p).value() * m0[z];
+            let omega = diff(z, p).to_f64() * m0[z];
             let nu = omega / (2.0 * std::f64::consts::PI);
             if nu == 0.0 || (m0[p] == 0.0 && m0[q] == 0.0) {
                 return Ok(rest(EulerRegime::Rest));
@@ -241,7 +176,7 @@ impl EulerTop {
         // Triaxial: b the middle axis.
         let mut order = [0usize, 1, 2];
         // The exact order of the double-double W (their sums may round alike).
-        order.sort_by(|&i, &j| diff(i, j).signum0().total_cmp(&0.0));
+        order.sort_by(|&i, &j| signum0(diff(i, j)).total_cmp(&0.0));
         let (lo, b, hi) = (order[0], order[1], order[2]);
         // Δ with the two outer components scaled by a power of two μ (exact),
         // so that their squares do not underflow when they are tiny beside
@@ -250,23 +185,23 @@ impl EulerTop {
         let mu = big.log2().floor().max(-1074.0).exp2();
         let sq = |i: usize| {
             let v = m0[i] / mu;
-            Dd2::prod(v, v)
+            Dd::prod(v, v)
         };
         let t_hi = diff(hi, b).mul(sq(hi));
         let t_lo = diff(lo, b).mul(sq(lo));
         let delta = t_hi.add(t_lo);
-        let scale = t_hi.value().abs() + t_lo.value().abs();
-        let mut on_separatrix = delta.value().abs() <= SEPARATRIX_RTOL * scale;
-        let (s, r) = if on_separatrix || delta.signum0() > 0.0 {
+        let scale = t_hi.to_f64().abs() + t_lo.to_f64().abs();
+        let mut on_separatrix = delta.to_f64().abs() <= SEPARATRIX_RTOL * scale;
+        let (s, r) = if on_separatrix || signum0(delta) > 0.0 {
             (hi, lo)
         } else {
             (lo, hi)
         };
         let chi = if s == (b + 1) % 3 { 1.0 } else { -1.0 };
-        let dsb = diff(s, b).value();
+        let dsb = diff(s, b).to_f64();
         let a_ = dsb.abs();
-        let b_ = diff(b, r).value().abs();
-        let c_ = diff(s, r).value().abs();
+        let b_ = diff(b, r).to_f64().abs();
+        let c_ = diff(s, r).to_f64().abs();
         let (mb, mr, ms) = (m0[b], m0[r], m0[s]);
         // Amplitudes as hypotenuses: no square underflows or overflows.
         let x = mb.hypot((c_ / a_).sqrt() * mr);
@@ -288,7 +223,7 @@ impl EulerTop {
             });
         }
         // k' = √(1 − m) = (μ/ω) √(|Δ'| C): no underflow down to μ ~ 1e-308.
-        let kc = (mu / omega) * (delta.value().abs() * c_).sqrt();
+        let kc = (mu / omega) * (delta.to_f64().abs() * c_).sqrt();
         // A k' below the double range (μ subnormal): the separatrix to the
         // last bit; its period would exceed ~1400/ω.
         on_separatrix |= kc == 0.0;
@@ -353,7 +288,7 @@ impl EulerTop {
 
     /// The coefficients `W` (rounded to doubles).
     pub fn w(&self) -> [f64; 3] {
-        self.w.map(|x| x.value())
+        self.w.map(|x| x.to_f64())
     }
 
     /// `(m, 1 − m, ω)` of the elliptic form (`m = 0`, `ω = |Ω|` when
@@ -499,17 +434,17 @@ impl Embedding {
     /// The Euler coefficients `W` of the top with Manakov's `c` (state
     /// order): `−(c_jk, c_ik, c_ij)` for a block, `−(c_kl + c_j4)` (exact, as
     /// double-doubles) for a self-dual state.
-    pub fn w_of(&self, c4: &[f64; 6]) -> [Dd2; 3] {
+    pub(crate) fn w_of(&self, c4: &[f64; 6]) -> [Dd; 3] {
         match *self {
             Embedding::Block([i, j, k]) => [
-                Dd2::new(-c4[pos(j, k)]),
-                Dd2::new(-c4[pos(i, k)]),
-                Dd2::new(-c4[pos(i, j)]),
+                Dd::new(-c4[pos(j, k)]),
+                Dd::new(-c4[pos(i, k)]),
+                Dd::new(-c4[pos(i, j)]),
             ],
             Embedding::SelfDual(_) => [
-                Dd2::sum(-c4[3], -c4[2]),
-                Dd2::sum(-c4[1], -c4[4]),
-                Dd2::sum(-c4[0], -c4[5]),
+                Dd::sum(-c4[3], -c4[2]),
+                Dd::sum(-c4[1], -c4[4]),
+                Dd::sum(-c4[0], -c4[5]),
             ],
         }
     }

@@ -88,7 +88,7 @@ fn blocks_and_self_dual_states_follow_the_integrator_on_the_shared_tops() {
 
 #[test]
 fn the_integrals_are_constant_along_the_closed_form() {
-    let w = [Dd2::new(-0.3), Dd2::new(1.2), Dd2::new(2.9)];
+    let w = [Dd::new(-0.3), Dd::new(1.2), Dd::new(2.9)];
     let m0 = [0.4, -1.1, 0.7];
     let top = EulerTop::new(w, m0).unwrap();
     let e0: f64 = (0..3).map(|i| w[i].hi * m0[i] * m0[i]).sum();
@@ -107,7 +107,7 @@ fn the_integrals_are_constant_along_the_closed_form() {
 
 #[test]
 fn the_period_is_4k_over_omega() {
-    let w = [Dd2::new(1.0), Dd2::new(2.5), Dd2::new(4.0)];
+    let w = [Dd::new(1.0), Dd::new(2.5), Dd::new(4.0)];
     for m0 in [[0.3, 1.0, 0.2], [1.0, 0.1, 0.4], [0.7, 0.7, 0.1]] {
         let top = EulerTop::new(w, m0).unwrap();
         let nu = top.frequency();
@@ -124,7 +124,7 @@ fn the_period_is_4k_over_omega() {
 #[test]
 fn axisymmetric_and_spherical_tops() {
     // W_1 = W_2: M_3 constant, (M_1, M_2) rotating at Ω = (W_3 − W_1) M_3.
-    let w = [Dd2::new(1.0), Dd2::new(1.0), Dd2::new(3.0)];
+    let w = [Dd::new(1.0), Dd::new(1.0), Dd::new(3.0)];
     let m0 = [0.6, -0.2, 0.5];
     let top = EulerTop::new(w, m0).unwrap();
     assert_eq!(top.regime(), EulerRegime::Axisymmetric);
@@ -139,14 +139,14 @@ fn axisymmetric_and_spherical_tops() {
         assert_eq!(m[2], 0.5);
     }
     assert!((top.frequency() - om / (2.0 * std::f64::consts::PI)).abs() < 1e-16);
-    let top = EulerTop::new([Dd2::new(2.0); 3], m0).unwrap();
+    let top = EulerTop::new([Dd::new(2.0); 3], m0).unwrap();
     assert_eq!(top.regime(), EulerRegime::Rest);
     assert_eq!(top.m(17.0), m0);
 }
 
 #[test]
 fn states_on_an_axis_are_at_rest() {
-    let w = [Dd2::new(1.0), Dd2::new(2.0), Dd2::new(4.0)];
+    let w = [Dd::new(1.0), Dd::new(2.0), Dd::new(4.0)];
     for m0 in [
         [0.0, 0.0, 0.0],
         [1.5, 0.0, 0.0],
@@ -163,7 +163,7 @@ fn states_on_an_axis_are_at_rest() {
 fn an_exact_separatrix_state_moves_on_the_separatrix() {
     // W = (1, 2, 3): middle axis 2; Δ = (1 − 2) M_1² + (3 − 2) M_3² = 0 for
     // |M_1| = |M_3| (exact in doubles).
-    let w = [Dd2::new(1.0), Dd2::new(2.0), Dd2::new(3.0)];
+    let w = [Dd::new(1.0), Dd::new(2.0), Dd::new(3.0)];
     // The four heteroclinic orbits through the signs of (M_1, M_3), and both
     // directions of travel (M_2 of either sign).
     let c4 = [-3.0, -2.0, 0.0, -1.0, 0.0, 0.0];
@@ -207,7 +207,7 @@ fn an_exact_separatrix_state_moves_on_the_separatrix() {
 #[test]
 fn near_the_separatrix_the_elliptic_form_stays_accurate() {
     // Δ = 2^-40 and 2^-80 relative: m1 = 1 − m tiny, K ≈ ln(4/k') large.
-    let w = [Dd2::new(1.0), Dd2::new(2.0), Dd2::new(3.0)];
+    let w = [Dd::new(1.0), Dd::new(2.0), Dd::new(3.0)];
     let times: Vec<f64> = (1..=30).map(|k| 0.5 * k as f64).collect();
     let c4 = [-3.0, -2.0, 0.0, -1.0, 0.0, 0.0];
     let emb = Embedding::Block([0, 1, 2]);
@@ -226,7 +226,7 @@ fn near_the_separatrix_the_elliptic_form_stays_accurate() {
 fn large_times_keep_the_phase() {
     // M(t + n T) = M(t) for the period T = 1/ν; at n ~ 1e6 the error is
     // that of ν times t (relative 1e-16 · 1e6).
-    let w = [Dd2::new(-0.5), Dd2::new(0.25), Dd2::new(1.5)];
+    let w = [Dd::new(-0.5), Dd::new(0.25), Dd::new(1.5)];
     let m0 = [0.3, 0.9, -0.4];
     let top = EulerTop::new(w, m0).unwrap();
     let t = 1.0e6 / top.frequency();
@@ -240,7 +240,7 @@ fn large_times_keep_the_phase() {
 fn extreme_component_ratios_are_solved() {
     // Components 1e-170 … 1e-300 beside O(1) ones: their squares underflow;
     // Δ, the amplitudes and k' are formed without squaring them.
-    let w = [Dd2::new(-1.777), Dd2::new(-0.529), Dd2::new(0.875)];
+    let w = [Dd::new(-1.777), Dd::new(-0.529), Dd::new(0.875)];
     let cases = [
         [0.0, -1e-300, 1.0],
         [0.0, -1e-170, 1.0],
