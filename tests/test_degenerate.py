@@ -174,10 +174,20 @@ def test_kinds_and_attributes() -> None:
         assert repr(sol).startswith("Solution(")
         if kind == "genus2":
             assert sol.U.shape == (2,)
+            assert 0.0 <= sol.self_check <= 1e-10
             with pytest.raises(AttributeError, match="kind 'genus2'"):
                 _ = sol.euler
         else:
-            for attr in ("U", "tau", "u0", "curve", "torus", "constants", "calibration"):
+            for attr in (
+                "U",
+                "tau",
+                "u0",
+                "curve",
+                "torus",
+                "constants",
+                "calibration",
+                "self_check",
+            ):
                 with pytest.raises(AttributeError, match=f"kind '{kind}'"):
                     getattr(sol, attr)
             with pytest.raises(AttributeError, match=f"kind '{kind}'"):

@@ -122,9 +122,12 @@ class Solution:
     ValueError
         Invalid ``a``, ``b``, ``l0`` (shapes, non-finite values, repeated
         ``a_i``); and, for a genus-2 state, a singular level set of the
-        Theorem (the message names it: ``h0 = 0`` or ``h1² = 4h0²`` off the
-        exact sets above, coinciding branch points, the divisor of ``l0`` at
-        infinity).
+        Theorem (the message names it: ``h1² = 4h0²`` off the exact sets
+        above, coinciding branch points, the divisor of ``l0`` at infinity).
+    manakov.ClosedFormError
+        A genus-2 solution that fails its self-check (:attr:`self_check`
+        above 1e-10): the state is valid, the closed form could not be
+        verified; integrate it instead.
 
     Notes
     -----

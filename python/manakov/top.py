@@ -819,6 +819,9 @@ class ManakovTop(FrahmTop):
         ValueError
             Not an so(4) top, or a singular genus-2 state (the message names the
             reason).
+        manakov.ClosedFormError
+            A genus-2 solution that fails its self-check (``Solution.self_check``
+            above 1e-10; docs/degenerate.md).
         """
         self._require_so4("solve")
         return Solution(self.a, self.b, l0)

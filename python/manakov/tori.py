@@ -59,8 +59,9 @@ STATUS_NAMES: tuple[str, ...] = (*_CORE_STATUS_NAMES, "not computed")
 OK = 0
 #: ``h1² = 4 h0²``: ``F(s)`` of (19) is undefined; the level set is singular.
 SINGULAR_CASIMIRS = 1
-#: Two branch points of (8) coincide (``h0 = 0`` and a repeated root of ``F``
-#: (19) included): genus drops; a separatrix or a degenerate torus.
+#: Two branch points of (8) coincide (a repeated root of ``F`` (19) and a root
+#: of ``F`` at an ``a_j`` included): genus drops; a separatrix or a degenerate
+#: torus. (``h0 = 0`` alone is a regular level set: docs/degenerate.md §8.)
 COINCIDING_BRANCH_POINTS = 2
 #: The divisor of the initial state has a point at infinity (the solution's
 #: route, ``sol.torus``; the map works on the level set and needs no divisor).

@@ -537,8 +537,9 @@ status_table! {
     Ok = 0, "ok";
     /// `h1² = 4 h0²`: `F(s)` of (19) is undefined (the level set is singular).
     SingularCasimirs = 1, "h1^2 = 4 h0^2";
-    /// Two branch points `d_j` of (8) coincide (`h0 = 0` and a repeated root of
-    /// `F` (19) included): the genus drops, a separatrix or a degenerate torus.
+    /// Two branch points `d_j` of (8) coincide (a repeated root of `F` (19) and
+    /// a root of `F` at an `a_j` included): the genus drops, a separatrix or a
+    /// degenerate torus. (`h0 = 0` alone is a regular level set.)
     CoincidingBranchPoints = 2, "coinciding branch points";
     /// The divisor of the initial state has a point at infinity.
     DivisorAtInfinity = 3, "divisor at infinity";
