@@ -136,8 +136,9 @@ class Solution:
     :attr:`frame`), with ``l(t) = s l'(T t)``, ``T = s λ``
     (:attr:`time_scale`). Scales are powers of two and shifts exact, so the
     normalized data are the given ones moved exactly; for moderate data
-    (``max |l0_q|``, the half-spreads of ``a`` and of ``c`` in
-    ``[2^-16, 2^16]``, no clustered ``a`` or ``c``) the frame is the identity.
+    (``max |l0_q|``, the geometric mean of the largest and smallest nonzero
+    ``|a_i|`` and the half-spread of ``c`` in ``[2^-16, 2^16]``, no clustered
+    ``a`` or ``c``) the frame is the identity.
     The genus-2 attributes (:attr:`tau`, :attr:`U`, :attr:`u0`,
     :attr:`riemann_constant`, :attr:`curve`, :attr:`constants`, …) are those
     of the normalized problem: ``u(t) = u0 + U T t``. :meth:`l`,

@@ -19,7 +19,8 @@
 //! scale is exact. Where the data are already moderate the normalization is
 //! the identity (so the generic genus-2 path sees the user's numbers, bit for
 //! bit): `l0` is scaled only if `max |l0_q|` lies outside `[2^-16, 2^16]`, `a`
-//! only if its half-spread does, `c` only if its half-spread does; `a` is
+//! only if the geometric mean of its largest and smallest nonzero modulus
+//! (after the shift) does, `c` only if its half-spread does; `a` is
 //! shifted only when its values cluster (`spread ≤ max |a_i| / 16`, e.g. `a`
 //! shifted by 1e6), `c` only when the `c_ij` cluster (e.g. `b ≈ α a + β`).
 
@@ -83,6 +84,26 @@ fn pow2_scale(h: f64) -> f64 {
     }
 }
 
+/// The scale of the shifted `a` that [`TopFrame`] brings to 1: the geometric
+/// mean `√(max |a_i| · min |a_i|)` of the largest and the smallest nonzero
+/// `|a_i|`. The roots of `F` (19) lie near the `a_i`, and the reduction keeps
+/// its digits while they are moderate at both ends: centring their logarithmic
+/// range on 1 leaves a uniformly scaled `a` (`a × 1e±12`) at `O(1)`, and leaves a
+/// top with one far `a_i` as it is. Bringing the largest to 1 instead squeezed
+/// the others (the Manakov top `a = (−0.42, −0.06, 0.48, 1e8)` of the Clebsch
+/// contraction was refused: after `a / 2^26` two roots of `F` near the small
+/// `a_i` met at 7e-10).
+fn a_scale(a: &[f64; 4]) -> f64 {
+    let hi = a.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    let lo = a
+        .iter()
+        .filter(|v| **v != 0.0)
+        .fold(f64::INFINITY, |m, v| m.min(v.abs()));
+    // Both factors are within the double range, and so is their geometric mean
+    // taken as a product of square roots (no overflow of hi · lo).
+    hi.sqrt() * lo.sqrt()
+}
+
 /// A shift `κ` for which every `x_i − κ` is exact, when the values cluster
 /// ([`CLUSTER_FRACTION`]), else 0.
 fn exact_shift(x: &[f64]) -> f64 {
@@ -115,7 +136,7 @@ impl TopFrame {
         let c4u = [c[1], c[2], c[3], c[6], c[7], c[11]];
         let kappa = exact_shift(a);
         let a_shift = a.map(|v| v - kappa);
-        let sigma = pow2_scale(a_shift.iter().fold(0.0f64, |m, v| m.max(v.abs())));
+        let sigma = pow2_scale(a_scale(&a_shift));
         let a_n = a_shift.map(|v| v / sigma);
 
         // Spherical: all c_ij equal to their rounding.
@@ -247,6 +268,26 @@ mod tests {
             // Its normalized c has a half-spread in [1/2, 2) (power-of-two λ) or is moderate.
             let h = f2.c4.iter().fold(0.0f64, |m, v| m.max(v.abs()));
             assert!(h > 0.0 && h.is_finite());
+        }
+    }
+
+    #[test]
+    fn a_is_scaled_by_the_geometric_mean_of_its_ends() {
+        // One far a_i (the Manakov top of the Clebsch contraction, a4 = 1e8): the
+        // geometric mean 7.7e2 lies in the window, the top is left as it is.
+        let b = [-3.216, -2.424, -2.046, 0.0];
+        let f = TopFrame::new(&[-0.42, -0.06, 0.48, 1e8], &b).unwrap();
+        assert_eq!(f.sigma, 1.0);
+        // A uniformly scaled a: its normalized geometric mean is within a factor
+        // √2 of 1, and the differences are the given ones scaled exactly.
+        for (a, b, _) in crate::solution::tests::TOPS {
+            for scale in [1e-12, 1e12] {
+                let (a_s, b_s) = (a.map(|v| v * scale), b.map(|v| v * scale));
+                let f = TopFrame::new(&a_s, &b_s).unwrap();
+                let g = a_scale(&f.a);
+                assert!((0.7..=1.42).contains(&g), "{a_s:?}: {g}");
+                assert_eq!(f.a.map(|v| v * f.sigma), a_s.map(|v| v - f.kappa));
+            }
         }
     }
 
