@@ -366,6 +366,28 @@ def test_states_with_M_dot_p_zero_are_solved(name):
         assert err <= RANDOM_RTOL, err
 
 
+@pytest.mark.parametrize("name", CLEBSCH)
+def test_states_on_the_conjugate_tops_exact_sets_take_its_closed_form(name):
+    """``M``, ``p`` on two axes (the conjugate state in an so(3) block) and ``p0 = 0``
+    (Euler's top): the conjugate top's solution is its closed form (an Euler top in
+    Jacobi's elliptic functions, or an equilibrium; docs/degenerate.md), which
+    follows Kirchhoff's equations; the genus-2 attributes name the kind."""
+    body = manakov.fluid_problem(name).body
+    t = np.linspace(0.0, 20.0, 101)
+    for M0, p0 in (([1.0, 0.0, 0.0], [0.0, 1.0, 0.0]), ([1.0, 0.5, 0.0], [0.0, 0.0, 0.0])):
+        M0, p0 = np.array(M0), np.array(p0)
+        sol = body.solve(M0, p0)
+        kind = sol.solution.kind
+        assert kind in ("euler", "equilibrium"), kind
+        tr = body.integrate(M0, p0, 20.0, t_eval=t, dt=body.default_dt(M0, p0) / 10)
+        M, p = sol.state(t)
+        scale = max(np.max(np.abs(M0)), np.max(np.abs(p0)))
+        err = max(np.max(np.abs(M - tr.M)), np.max(np.abs(p - tr.p))) / scale
+        assert err <= CLOSED_FORM_RTOL, (M0, p0, err)
+        with pytest.raises(AttributeError, match=f"kind '{kind}'"):
+            _ = sol.U
+
+
 def test_a_failed_self_check_is_not_turned_into_a_value_error(monkeypatch):
     """A conjugate top's solution refused by its own check (ClosedFormError) reaches
     the caller as it is: it is no statement about the state."""
@@ -389,12 +411,11 @@ def test_solve_refuses_other_bodies_and_singular_states():
     with pytest.raises(ValueError, match="Clebsch case only"):
         _ = gen.body.conjugate_top
     body = manakov.fluid_problem("clebsch_generic").body
-    # M·p = 0 on two axes: the conjugate top's h0 = 0 with the double roots of F
-    # at an a_j (an so(3) block); the message translates h0 and gives the top's.
-    with pytest.raises(ValueError, match=r"M0·p0 = 0 is the conjugate top's h0 = 0.*a_j"):
-        body.solve([1.0, 0.0, 0.0], [0.0, 1.0, 0.0])
-    with pytest.raises(ValueError, match="p0 = 0"):
-        body.solve([1.0, 0.5, 0.0], [0.0, 0.0, 0.0])
+    # 1e-13 off M·p = 0 beside two axes: a genus-2 state of the conjugate top that
+    # its reduction refuses (a repeated root of F); the message translates h0 and
+    # gives the top's.
+    with pytest.raises(ValueError, match=r"M0·p0 = 0 is the conjugate top's h0 = 0.*repeated root"):
+        body.solve([1.0, 1e-13, 0.0], [0.0, 1.0, 0.0])
     with pytest.raises(ValueError, match="finite"):
         body.solve([np.nan, 0, 0], [0, 1, 0])
     with pytest.raises(ValueError, match=r"shape \(3,\)"):

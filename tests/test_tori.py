@@ -117,9 +117,12 @@ def test_status_names_match_the_constants():
     assert tori.STATUS_NAMES[tori.SINGULAR] == "singular"
     assert tori.STATUS_NAMES[tori.DEGENERATE_GRADIENTS] == "degenerate gradients"
     assert tori.STATUS_NAMES[tori.INCONSISTENT_QUOTIENTS] == "inconsistent quotients"
+    assert tori.STATUS_NAMES[tori.EQUILIBRIUM] == "equilibrium"
+    assert tori.STATUS_NAMES[tori.SEPARATRIX] == "separatrix"
     # The states an interrupted map did not reach: one past the core's codes.
     assert tori.STATUS_NAMES[tori.NOT_COMPUTED] == "not computed"
-    assert len(tori.STATUS_NAMES) == 13
+    assert tori.NOT_COMPUTED == 14
+    assert len(tori.STATUS_NAMES) == 15
 
 
 def test_casimir_slice_keeps_h0_and_h1():

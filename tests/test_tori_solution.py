@@ -183,8 +183,8 @@ def test_frequency_map_shapes_and_status_codes():
             l0,
             np.zeros(6),  # l0 = 0
             [np.nan, 0, 0, 0, 0, 0],
-            [m[2], -m[1], m[0], m[0], m[1], m[2]],  # m = n: h1 = 2 h0, h1² = 4 h0²
-            [1.0, 0.0, 0.0, 0.0, 0.0, 0.0],  # h0 = 0
+            [m[2], -m[1], m[0], m[0], m[1], m[2]],  # m = n: an Euler top
+            [1.0, 0.0, 0.0, 0.0, 0.0, 0.0],  # one component: at rest
         ]
     )
     orig = states.copy()
@@ -195,8 +195,8 @@ def test_frequency_map_shapes_and_status_codes():
     assert fm.status[0] == tori.OK
     assert fm.status[1] == tori.ZERO_STATE
     assert fm.status[2] == tori.NON_FINITE
-    assert fm.status[3] == tori.SINGULAR_CASIMIRS
-    assert fm.status[4] == tori.COINCIDING_BRANCH_POINTS
+    assert fm.status[3] == tori.OK
+    assert fm.status[4] == tori.EQUILIBRIUM
     # NaN exactly where the status is not ok.
     assert np.array_equal(np.isnan(fm.nu).any(axis=1), fm.status != tori.OK)
     grid = tori.frequency_map(top, np.broadcast_to(l0, (2, 3, 6)))
@@ -207,15 +207,45 @@ def test_frequency_map_shapes_and_status_codes():
         tori.frequency_map(top, states, chunk_size=0)
 
 
-# Singular states of the generic top, their ValueError text (as `solve` raised it
-# before the errors got kinds, copied from that build: the text is API too) and
-# the map's code. The codes
-# come from the kind of the Rust error, no longer from these words.
+# States the Theorem does not cover, solved in closed form (docs/degenerate.md):
+# (l0, kind of the solution, status in a frequency map).
+CLOSED_FORM_STATES = [
+    ([0.0] * 6, "rest", tori.ZERO_STATE),
+    ([1.0, 0, 0, 0, 0.5, 0], "euler", tori.OK),  # the so(3) block {1, 2, 4}
+    ([0.7, -0.5, 0.3, 0.3, 0.5, 0.7], "euler", tori.OK),  # m = n
+    ([1.0, 0, 0, 0, 0, 1e-12], "equilibrium", tori.EQUILIBRIUM),  # l12, l34
+    ([1.0, 0, 0, 0, 0, 0.5], "equilibrium", tori.EQUILIBRIUM),
+]
+
+
+@pytest.mark.parametrize("l0, kind, code", CLOSED_FORM_STATES)
+def test_closed_form_states_get_their_kind_and_code(l0, kind, code):
+    top, _ = _top("generic")
+    assert top.solve(np.array(l0)).kind == kind
+    fm = tori.frequency_map(top, np.array(l0))
+    assert fm.status == code
+    assert np.isnan(fm.nu).all() == (code != tori.OK)
+
+
+# Singular states of the generic top that `solve` refuses, their ValueError text
+# (the text is API too) and the map's code. The codes come from the kind of the
+# Rust error, not from these words.
 SINGULAR_STATES = [
+    (
+        # n = (1 + 2^-30) m: within 1e-13 of h1^2 = 4 h0^2, not exactly self-dual.
+        [0.7, -0.5, 0.3 * (1 + 2**-30), 0.3, 0.5 * (1 + 2**-30), 0.7 * (1 + 2**-30)],
+        ("invalid state l0: h1^2 - 4 h0^2 = ", "", "the genus-2 solution exists only as a limit"),
+        tori.SINGULAR_CASIMIRS,
+    ),
+]
+
+# The genus-2 solver itself (the core's SolutionCore, below the dispatcher)
+# still refuses the states of the exact degenerate sets, with these texts (the
+# text is API too); `solve` routes them to their closed forms instead.
+GENUS2_REFUSALS = [
     (
         [0.0] * 6,
         "invalid state l0: l0 = 0: the rest state; the solution is l(t) = 0, there is no curve (8)",
-        tori.ZERO_STATE,
     ),
     (
         # in the so(3) block {1, 2, 4}
@@ -223,17 +253,15 @@ SINGULAR_STATES = [
         "invalid state l: h0 = 0 and the double roots of F(s) (19), the roots of "
         "h1 s^2 - h2 s + h3, coincide or lie at an a_j: the reduction degenerates there "
         "(an equilibrium, an so(3) block or a separatrix)",
-        tori.COINCIDING_BRANCH_POINTS,
     ),
     (
         [0.7, -0.5, 0.3, 0.3, 0.5, 0.7],
         "invalid state l0: h1^2 - 4 h0^2 = 0e0 vanishes (m = ±n, a self-dual state): "
         "F (19) is not defined; the motion reduces to an so(3) top (elliptic functions), "
         "the genus-2 solution exists only as a limit",
-        tori.SINGULAR_CASIMIRS,
     ),
     (
-        # 1e-12 from the equilibrium l12 E12: the roots of h1 s^2 - h2 s + h3 lie at
+        # the equilibrium l12 E12 + 1e-12 E34: the roots of h1 s^2 - h2 s + h3 lie at
         # a_3, a_4, where the two roots of F of each pair meet
         [1.0, 0, 0, 0, 0, 1e-12],
         (
@@ -241,7 +269,6 @@ SINGULAR_STATES = [
             "(|s_",
             "): l^(p) (20) divides by sqrt(F'(s_p)) = 0",
         ),
-        tori.COINCIDING_BRANCH_POINTS,
     ),
     (
         [1.0, 0, 0, 0, 0, 0.5],
@@ -252,9 +279,36 @@ SINGULAR_STATES = [
             "(|s_1 - s_4| = ",
             "e-7): l^(p) (20) divides by sqrt(F'(s_p)) = 0",
         ),
-        tori.COINCIDING_BRANCH_POINTS,
     ),
 ]
+
+
+@pytest.mark.parametrize("l0, text", GENUS2_REFUSALS)
+def test_the_genus2_solver_refuses_the_exact_sets_with_its_text(l0, text):
+    top, _ = _top("generic")
+    with pytest.raises(ValueError) as e:
+        manakov._core.SolutionCore(top.a, top.b, np.array(l0, dtype=float))
+    msg = str(e.value)
+    if isinstance(text, tuple):
+        start, mid, end = text
+        assert msg.startswith(start) and mid in msg and msg.endswith(end), msg
+    else:
+        assert msg == text
+
+
+def test_rank2_state_off_the_exact_sets_is_a_genus2_state():
+    # h0 = 0 exactly (dyadic components), in no so(3) block and no equilibrium:
+    # the reduction takes its limit h0 -> 0, so solve returns the Theorem's
+    # solution (checked by itself) and the map gives the torus's frequencies.
+    top, _ = _top("generic")
+    l0 = np.array([0.5, 0.25, 0.125, 0.5, 0.75, 0.25])
+    assert l0[0] * l0[5] - l0[1] * l0[4] + l0[2] * l0[3] == 0.0
+    sol = top.solve(l0)
+    assert sol.kind == "genus2"
+    assert sol.self_check <= 1e-10
+    fm = tori.frequency_map(top, l0)
+    assert fm.status == tori.OK
+    assert np.isfinite(fm.nu).all()
 
 
 @pytest.mark.parametrize("l0, text, code", SINGULAR_STATES)

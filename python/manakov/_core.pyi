@@ -27,6 +27,8 @@ __all__ = [
     "hamiltonian",
     "integrate",
     "integrate_many",
+    "jacobi_ellipf",
+    "jacobi_ellipj",
     "KirchhoffCore",
     "kirchhoff_casimirs",
     "kotter_batch",
@@ -37,6 +39,7 @@ __all__ = [
     "manakov_c",
     "manakov_integral_labels",
     "manakov_integrals",
+    "MotionCore",
     "poisson_tensor",
     "real_torus",
     "so4_integrals",
@@ -344,3 +347,53 @@ class ClebschCore:
     def mobius(self) -> tuple[float, float]: ...
     def to_so4(self, y: npt.NDArray[np.float64]) -> npt.NDArray[np.float64]: ...
     def to_body(self, l: npt.NDArray[np.float64]) -> npt.NDArray[np.float64]: ...  # noqa: E741
+
+# --- motion (rust/python/motion.rs) ---
+
+@final
+class MotionCore:
+    def __new__(
+        cls,
+        a: npt.NDArray[np.float64],
+        b: npt.NDArray[np.float64],
+        l0: npt.NDArray[np.float64],
+    ) -> MotionCore: ...
+    @property
+    def kind(self) -> str: ...
+    def l(self, t: npt.NDArray[np.float64]) -> npt.NDArray[np.float64]: ...  # noqa: E743
+    @property
+    def state_scale(self) -> float: ...
+    @property
+    def time_scale(self) -> float: ...
+    def frame(
+        self,
+    ) -> tuple[
+        npt.NDArray[np.float64],
+        npt.NDArray[np.float64],
+        list[float],
+    ]: ...
+    def genus2(self) -> SolutionCore | None: ...
+    def euler(
+        self,
+    ) -> tuple[str, list[float], list[float], str, list[float]] | None: ...
+    def closed_form_frequencies(self) -> list[float]: ...
+    def torus(
+        self,
+    ) -> tuple[
+        npt.NDArray[np.complex128],
+        npt.NDArray[np.int64],
+        npt.NDArray[np.float64],
+        npt.NDArray[np.complex128],
+    ]: ...
+
+def jacobi_ellipj(
+    u: npt.NDArray[np.float64], m: float, m1: float
+) -> tuple[
+    npt.NDArray[np.float64],
+    npt.NDArray[np.float64],
+    npt.NDArray[np.float64],
+    npt.NDArray[np.float64],
+]: ...
+def jacobi_ellipf(
+    phi: npt.NDArray[np.float64], m: float, m1: float
+) -> tuple[float, npt.NDArray[np.float64]]: ...

@@ -897,7 +897,9 @@ class KirchhoffBody:
         ValueError
             Not a Clebsch body, or a singular level set (the message names the
             reason, as :meth:`manakov.ManakovTop.solve`). ``M0·p0 = 0`` (the
-            conjugate top's ``h0 = 0``) is not singular by itself.
+            conjugate top's ``h0 = 0``) is not singular by itself, and the states
+            on the conjugate top's exact degenerate sets (``p0 = 0``; ``M0``,
+            ``p0`` on two axes) are solved in its closed form.
         ClosedFormError
             The conjugate top's solution did not pass its own check
             (:attr:`manakov.Solution.self_check`); no solution is returned.
@@ -947,7 +949,12 @@ class ClebschSolution:
 
     ``(M, p)(t) = L⁻¹ l(t)`` with ``l(t)`` the :class:`manakov.Solution` of the
     conjugate Manakov top: ``u0``, ``U``, ``tau``, ``curve``, ``frequencies`` are
-    those of the body (the conjugacy keeps time).
+    those of the body (the conjugacy keeps time). Where the conjugate state lies
+    on one of the top's exact degenerate sets (``p0 = 0``: Euler's top; ``M0``,
+    ``p0`` on two axes: an so(3) block) that solution is the top's closed form
+    (``solution.kind``, docs/degenerate.md): :meth:`state` and
+    :attr:`frequencies` work as for every kind, while ``u0``, ``U``, ``tau``,
+    ``curve`` and :meth:`quotient` raise ``AttributeError`` naming the kind.
 
     Parameters
     ----------
@@ -968,11 +975,11 @@ class ClebschSolution:
         try:
             self._solution = Solution(top.a, top.b, l0)
         except ValueError as err:
+            # p0 = 0 (Euler's top) never gets here: its conjugate state lies in an
+            # so(3) block, which Solution solves in closed form.
             M0a, p0a = self._M0, self._p0
             hint = ""
-            if not np.any(p0a):
-                hint = "p0 = 0: the body turns as Euler's top (elliptic functions), h0 = 0; "
-            elif abs(M0a @ p0a) <= 1e-13 * np.linalg.norm(M0a) * np.linalg.norm(p0a):
+            if abs(M0a @ p0a) <= 1e-13 * np.linalg.norm(M0a) * np.linalg.norm(p0a):
                 # h0 = 0 alone is a regular level set of the top (its reduction takes
                 # the limit there); this only translates the top's wording.
                 hint = "M0·p0 = 0 is the conjugate top's h0 = 0; "

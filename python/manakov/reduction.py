@@ -523,10 +523,12 @@ def kotter(a: Any, b: Any, l: Any, *, errors: str = "raise") -> Kotter:
     ------
     ValueError
         Non-finite input; ``max |l_ij|`` outside :data:`STATE_RANGE` (rescale
-        l); repeated ``a_i``; ``h0 = 0`` or ``h1^2 = 4 h0^2``
-        (``F`` (19) undefined or with double roots), which includes every
-        state with ``(h1^2 - 4 h0^2)/h1^2 <= 1e-12``; repeated roots of ``F``;
-        a root of ``F`` at some ``a_j``; coinciding branch points ``d_j`` of
+        l); repeated ``a_i``; ``h1^2 = 4 h0^2`` (``F`` (19) undefined), which
+        includes every state with ``(h1^2 - 4 h0^2)/h1^2 <= 1e-12``; ``h0 = 0``
+        with the double roots of ``F`` (the roots of ``h1 s^2 - h2 s + h3``)
+        coinciding or at an ``a_j`` (an equilibrium, an so(3) block, a
+        separatrix; other rank-2 states reduce, docs/degenerate.md); repeated
+        roots of ``F``; a root of ``F`` at some ``a_j``; coinciding branch points ``d_j`` of
         the curve (its genus drops); ``z1 = z2``; ``1 - eps P_0 = 0``. States
         with ``1e-12 < (h1^2 - 4 h0^2)/h1^2 < 1e-10`` usually reduce but may
         raise, naming that distance; every state farther from the singular

@@ -1,46 +1,68 @@
 # ruff: noqa: E741, E743  (l is the paper's name for the state)
-"""The Theorem (9)–(10): ``l(t)`` as genus-2 theta quotients with a linear argument.
+"""One solution for every state: the Theorem (9)–(10) in genus-2 theta functions,
+and the closed forms where it degenerates.
 
-``ManakovTop.solve(l0)`` returns a :class:`Solution`. The recipe, equation by
-equation with Perelomov's numbers and the errata rows, is docs/theorem.md; in
-short, with ``v = u + K`` (``u`` the Abel map of the divisor, base point ∞,
-``K`` the vector of Riemann constants)
+``ManakovTop.solve(l0)`` returns a :class:`Solution` of one of the kinds of
+:data:`KINDS`, chosen by exact tests on the state (docs/degenerate.md):
 
-.. math::
+* ``"genus2"``: the Theorem. With ``v = u + K`` (``u`` the Abel map of the
+  divisor, base point ∞, ``K`` the vector of Riemann constants)
 
-    P_L = C_L \\frac{\\theta[\\chi_L](v)}{\\theta(v)} \\;(34), \\quad
-    \\xi_j = \\sqrt{c_j}\\, g P_{kl}, \\; \\eta_j = \\sqrt{c_j}\\, g P_{j4} \\;(37), \\quad
-    g = \\frac{G}{1 - \\varepsilon P_0} \\;(42,\\ \\text{corrected}),
+  .. math::
 
-and ``l`` linear in ``ξ, η`` by (22)–(23), so that
+      P_L = C_L \\frac{\\theta[\\chi_L](v)}{\\theta(v)} \\;(34), \\quad
+      \\xi_j = \\sqrt{c_j}\\, g P_{kl}, \\; \\eta_j = \\sqrt{c_j}\\, g P_{j4} \\;(37), \\quad
+      g = \\frac{G}{1 - \\varepsilon P_0} \\;(42,\\ \\text{corrected}),
 
-.. math::
+  and ``l`` linear in ``ξ, η`` by (22)–(23), so that
 
-    l_q(t) = \\frac{\\sum_L w_{qL}\\, \\theta[\\chi_L](v(t))}
-                  {\\theta(v(t)) - \\varepsilon C_0\\, \\theta[\\chi_0](v(t))}, \\qquad
-    v(t) = v_0 + U t,
+  .. math::
 
-(9)–(10) as they truly read. ``U`` comes from the equations of motion (1) at
-``v0``, not from a fit to a trajectory.
+      l_q(t) = \\frac{\\sum_L w_{qL}\\, \\theta[\\chi_L](v(t))}
+                    {\\theta(v(t)) - \\varepsilon C_0\\, \\theta[\\chi_0](v(t))}, \\qquad
+      v(t) = v_0 + U t,
+
+  (9)–(10) as they truly read; ``U`` comes from the equations of motion (1).
+* ``"euler"``: a state in an so(3) block (three components exactly zero) or
+  self-dual (``n = ±m``) moves as a three-dimensional Euler top, solved in
+  Jacobi's elliptic functions ``sn, cn, dn`` (trigonometric when axisymmetric);
+  ``"separatrix"``: the same on the Euler top's separatrix (``tanh``, ``sech``).
+* ``"rest"`` (``l0 = 0``), ``"spherical"`` (all ``c_ij`` equal, ``b = α a + β``),
+  ``"equilibrium"`` (``l̇ = 0`` by (1)): ``l(t) = l0``.
+
+Every kind works from normalized data: ``l0/s``, ``a' = (a − κ)/σ``,
+``c' = (c − μ)/λ`` (powers of two and exact shifts, the identity for moderate
+data), and ``l(t) = s l'(T t)`` with the time scale ``T = s λ`` (the flow is
+homogeneous in ``l`` and blind to a common shift of the ``c_ij``).
 """
 
 from __future__ import annotations
 
-from typing import Any
+from typing import Any, NamedTuple
 
 import numpy as np
 
 from . import _core
 from ._checks import _float_array, _one_state, _show, _states
-from ._torus import Torus, torus_of_state
+from ._torus import Torus
 from .riemann import HyperellipticCurve
 
-__all__ = ["LABELS", "Solution"]
+__all__ = ["KINDS", "LABELS", "EulerMotion", "Solution"]
 
 #: Labels of the Wurzelfunktionen (27)–(28) entering (37) and (42), in the
 #: order of :attr:`Solution.constants` and :attr:`Solution.characteristics`.
 LABELS: tuple[str, ...] = ("P0", "P23", "P31", "P12", "P14", "P24", "P34")
 
+#: The kinds of :attr:`Solution.kind`.
+KINDS: tuple[str, ...] = ("genus2", "rest", "spherical", "equilibrium", "euler", "separatrix")
+
+_WHY = {
+    "rest": "l0 = 0, the state does not move",
+    "spherical": "all c_ij are equal (b = alpha a + beta): every state is at rest",
+    "equilibrium": "l0 is a stationary rotation (dl/dt = 0 by (1))",
+    "euler": "l0 lies in an invariant so(3) and moves as an Euler top (elliptic functions)",
+    "separatrix": "l0 lies in an invariant so(3), on the Euler top's separatrix",
+}
 
 #: What the one-state calls of the solution point to for many states.
 _MANY_STATES = "manakov.frequency_map (frequencies) or top.integrate (trajectories)"
@@ -52,40 +74,91 @@ def _frozen(a: np.ndarray) -> np.ndarray:
     return a
 
 
-class Solution:
-    """The explicit solution through ``l0`` of the Manakov top with parameters ``a, b``.
+class EulerMotion(NamedTuple):
+    """The Euler top of a solution of kind ``"euler"`` or ``"separatrix"``
+    (normalized frame: ``l0/s``, ``c'``).
 
-    Usually made by :meth:`manakov.ManakovTop.solve`.
+    ``Ṁ = M × (W∘M)``, i.e. ``Ṁ_1 = (W_3 − W_2) M_2 M_3`` and cyclically.
+
+    Attributes
+    ----------
+    subalgebra : str
+        ``"block 123"`` … ``"block 234"`` (``M = (l_jk, −l_ik, l_ij)``,
+        ``W = −(c_jk, c_ik, c_ij)``), ``"self-dual"`` or ``"anti-self-dual"``
+        (``n = ±m``, ``M = m``, ``W_j = −(c_kl + c_j4)``).
+    W, M0 : ndarray, shape (3,)
+    regime : str
+        ``"elliptic"``, ``"axisymmetric"`` (trigonometric) or ``"separatrix"``.
+    m, m1, omega : float
+        The parameter ``m = k²``, ``1 − m`` and ``ω`` of
+        ``M_b = X sn(ωt + u0 | m)`` (normalized time).
+    """
+
+    subalgebra: str
+    W: np.ndarray
+    M0: np.ndarray
+    regime: str
+    m: float
+    m1: float
+    omega: float
+
+
+class Solution:
+    """The solution through ``l0`` of the Manakov top with parameters ``a, b``.
+
+    Usually made by :meth:`manakov.ManakovTop.solve`. :attr:`kind` says which
+    representation holds (:data:`KINDS`); :meth:`l`, :attr:`frequencies`,
+    :attr:`rotation_number` and :meth:`angles` work for every kind.
 
     Parameters
     ----------
     a, b : array_like, shape (4,)
         The parameters of (2).
     l0 : array_like, shape (6,)
-        The initial state ``(l12, l13, l14, l23, l24, l34)``.
+        The initial state ``(l12, l13, l14, l23, l24, l34)``, any finite scale.
 
     Raises
     ------
     ValueError
-        The reduction is singular at ``l0``; the message names why: ``l0 = 0``,
-        ``h0 = 0`` (branch points ``d_0 = 0`` and ``d_j`` coincide),
-        ``h1² = 4h0²`` (self-dual state, ``F`` (19) undefined), coinciding
-        branch points ``d_j``, or the divisor of ``l0`` at infinity
-        (``θ(v0) = 0``; the solution exists, start at another time); and the
-        errors of the reduction (:func:`manakov.kotter`).
+        Invalid ``a``, ``b``, ``l0`` (shapes, non-finite values, repeated
+        ``a_i``); and, for a genus-2 state, a singular level set of the
+        Theorem (the message names it: ``h1² = 4h0²`` off the exact sets
+        above, coinciding branch points, the divisor of ``l0`` at infinity).
+    manakov.ClosedFormError
+        A genus-2 solution that fails its self-check (:attr:`self_check`
+        above 1e-10): the state is valid, the closed form could not be
+        verified; integrate it instead.
 
     Notes
     -----
-    Branches (``√c_j``, the roots of ``F``, the sheets, the sign of ``g``) are
-    fixed once from ``l0``. ``l(v)`` is periodic only under a sublattice of the
-    period lattice, so ``v(t)`` is never reduced modulo the lattice itself:
-    in lattice coordinates ``v = x + τ y`` the real ``x(t), y(t)`` are reduced
-    modulo 2 (an even lattice vector multiplies every ``θ[χ]`` by one common
-    factor), with the products of the rates and ``t`` split error-free, so that
-    ``l(10**6)`` costs and keeps what ``l(1)`` does.
+    **Frames.** The solution is built on normalized data: ``l0' = l0/s``,
+    ``a' = (a − κ)/σ``, ``c' = (c − μ)/λ`` (:attr:`state_scale`,
+    :attr:`frame`), with ``l(t) = s l'(T t)``, ``T = s λ``
+    (:attr:`time_scale`). Scales are powers of two and shifts exact, so the
+    normalized data are the given ones moved exactly; for moderate data
+    (``max |l0_q|``, the geometric mean of the largest and smallest nonzero
+    ``|a_i|`` and the half-spread of ``c`` in ``[2^-16, 2^16]``, no clustered
+    ``a`` or ``c``) the frame is the identity.
+    The genus-2 attributes (:attr:`tau`, :attr:`U`, :attr:`u0`,
+    :attr:`riemann_constant`, :attr:`curve`, :attr:`constants`, …) are those
+    of the normalized problem: ``u(t) = u0 + U T t``. :meth:`l`,
+    :attr:`frequencies`, :attr:`torus` (its frequencies) and :meth:`abel`
+    (its argument) are in the user's frame.
+
+    **Genus 2.** Branches (``√c_j``, the roots of ``F``, the sheets, the sign
+    of ``g``) are fixed once from ``l0``. ``l(v)`` is periodic only under a
+    sublattice of the period lattice, so ``v(t)`` is never reduced modulo the
+    lattice itself: in lattice coordinates ``v = x + τ y`` the real
+    ``x(t), y(t)`` are reduced modulo 2 (an even lattice vector multiplies
+    every ``θ[χ]`` by one common factor), with the products of the rates and
+    ``t`` split error-free, so that ``l(10**6)`` costs and keeps what ``l(1)``
+    does.
+
+    Attributes that exist for one kind only (the genus-2 ones, :attr:`euler`)
+    raise ``AttributeError`` naming the kind on the others.
     """
 
-    __slots__ = ("_a", "_b", "_l0", "_core", "_curve", "_torus")
+    __slots__ = ("_a", "_b", "_l0", "_motion", "_core", "_curve", "_torus", "_freq")
 
     def __init__(self, a: Any, b: Any, l0: Any) -> None:
         aa = _float_array(a, "a").astype(float)
@@ -95,9 +168,22 @@ class Solution:
                 raise ValueError(f"{name} must have shape (4,), got {arr.shape}")
         ll = _one_state(l0, 6, "l0", "solve", _MANY_STATES)
         self._a, self._b, self._l0 = _frozen(aa.copy()), _frozen(bb.copy()), _frozen(ll.copy())
-        self._core = _core.SolutionCore(self._a, self._b, self._l0)
+        self._motion = _core.MotionCore(self._a, self._b, self._l0)
+        self._core = self._motion.genus2()
         self._curve: HyperellipticCurve | None = None
         self._torus: Torus | None = None
+        self._freq: np.ndarray | None = None
+
+    @property
+    def kind(self) -> str:
+        """The representation of the motion, one of :data:`KINDS`.
+
+        ``"genus2"``: the Theorem (9)–(10); ``"euler"``: an Euler top in an
+        so(3) block or a self-dual state (elliptic functions);
+        ``"separatrix"``: the same on its separatrix; ``"rest"``,
+        ``"spherical"``, ``"equilibrium"``: ``l(t) = l0``.
+        """
+        return str(self._motion.kind)
 
     @property
     def a(self) -> np.ndarray:
@@ -114,8 +200,44 @@ class Solution:
         """The initial state (read-only)."""
         return self._l0
 
+    @property
+    def state_scale(self) -> float:
+        """``s``: the normalized state is ``l0/s`` (a power of two)."""
+        return float(self._motion.state_scale)
+
+    @property
+    def time_scale(self) -> float:
+        """``T = s λ``: ``l(t) = s l'(T t)`` (a power of two)."""
+        return float(self._motion.time_scale)
+
+    @property
+    def frame(self) -> dict[str, Any]:
+        """The normalized top: ``a' = (a − κ)/σ`` and ``c' = (c − μ)/λ``
+        (state order), with ``kappa, sigma, mu, lambda``."""
+        a, c, (kappa, sigma, mu, lam) = self._motion.frame()
+        return {
+            "a": _frozen(a),
+            "c": _frozen(c),
+            "kappa": kappa,
+            "sigma": sigma,
+            "mu": mu,
+            "lambda": lam,
+        }
+
+    def _genus2(self, what: str) -> Any:
+        if self._core is None:
+            kind = self.kind
+            raise AttributeError(
+                f"{what} exists for a genus-2 solution only; this one is of kind "
+                f"'{kind}' ({_WHY.get(kind, kind)})"
+            )
+        return self._core
+
     def l(self, t: Any) -> np.ndarray:
-        """The state at time(s) ``t`` from the theta quotients (9)–(10).
+        """The state at time(s) ``t``.
+
+        By the Theorem (9)–(10) for a genus-2 state, Jacobi's elliptic
+        functions for an Euler top, ``l0`` for the constant kinds.
 
         Parameters
         ----------
@@ -133,14 +255,16 @@ class Solution:
             Non-finite ``t``.
         """
         tt = _float_array(t, "t")
-        out = self._core.l(np.ascontiguousarray(tt.reshape(-1)))
+        out = self._motion.l(np.ascontiguousarray(tt.reshape(-1)))
         return out.reshape(tt.shape + (6,))
 
     def abel(self, l: Any) -> np.ndarray:
         """The Abel image ``u(P1) + u(P2)`` (modulo the lattice) of states ``l``
-        on the same level set, with the branches of ``l0``'s reduction.
+        on the same level set, with the branches of ``l0``'s reduction (genus 2).
 
-        Along a trajectory ``abel(l(t)) ≡ u0 + U t`` modulo the lattice.
+        ``l`` is in the user's frame; the image is on the normalized curve:
+        along a trajectory ``abel(l(t)) ≡ u0 + U T t`` modulo the lattice
+        (``T`` = :attr:`time_scale`).
 
         Parameters
         ----------
@@ -156,44 +280,47 @@ class Solution:
             Wrong last axis, complex or non-finite ``l``, or a state the reduction
             of ``l0``'s level set refuses (the message names why).
         """
+        core = self._genus2("abel")
         flat, lead = _states(l, 6, "l")
+        s = self.state_scale
         out = np.empty((flat.shape[0], 2), dtype=complex)
         for i, x in enumerate(flat):
-            out[i] = self._core.abel(np.ascontiguousarray(x))
+            out[i] = core.abel(np.ascontiguousarray(x / s))
         return out.reshape(lead + (2,))
 
     @property
     def u0(self) -> np.ndarray:
         """``u0 = u(P1) + u(P2)`` at ``t = 0`` (Abel map, base point ∞; ``v0 = u0 + K``)."""
-        return _frozen(self._core.u0)
+        return _frozen(self._genus2("u0").u0)
 
     @property
     def U(self) -> np.ndarray:  # noqa: N802 (the paper's name)
-        """``U``: ``u(t) = u0 + U t``, from the equations of motion (1)."""
-        return _frozen(self._core.rate)
+        """``U``: ``u = u0 + U t'`` in the normalized time ``t' = T t``, from (1)."""
+        return _frozen(self._genus2("U").rate)
 
     @property
     def tau(self) -> np.ndarray:
         """The period matrix ``τ`` of the curve (8) in :attr:`curve`'s basis."""
-        return _frozen(self._core.tau)
+        return _frozen(self._genus2("tau").tau)
 
     @property
     def riemann_constant(self) -> np.ndarray:
         """The vector of Riemann constants ``K`` (``v = u + K``)."""
-        return _frozen(self._core.riemann_constant)
+        return _frozen(self._genus2("riemann_constant").riemann_constant)
 
     @property
     def curve(self) -> HyperellipticCurve:
         """The curve (8), ``y² = Π_{j=0}^{4} (x − d_j)``, with its homology basis."""
+        core = self._genus2("curve")
         if self._curve is None:
-            self._curve = HyperellipticCurve(self._core.branch_points)
+            self._curve = HyperellipticCurve(core.branch_points)
         return self._curve
 
     @property
     def characteristics(self) -> dict[str, tuple[tuple[int, int], tuple[int, int]]]:
         """``χ_L = ([a1, a2], [b1, b2])`` for :data:`LABELS`: ``χ_j = η(d_j)``,
         ``χ_jk = χ_j + χ_k`` (mod 2)."""
-        ch = self._core.characteristics
+        ch = self._genus2("characteristics").characteristics
         return {
             lab: ((int(r[0]), int(r[1])), (int(r[2]), int(r[3])))
             for lab, r in zip(LABELS, ch, strict=True)
@@ -202,55 +329,101 @@ class Solution:
     @property
     def constants(self) -> dict[str, complex]:
         """``C_L`` of (34), ``P_L = C_L θ[χ_L](v)/θ(v)``, for :data:`LABELS`."""
-        return {lab: complex(c) for lab, c in zip(LABELS, self._core.constants, strict=True)}
+        core = self._genus2("constants")
+        return {lab: complex(c) for lab, c in zip(LABELS, core.constants, strict=True)}
 
     @property
     def calibration(self) -> np.ndarray:
         """``|C_L − P_L(l0) θ(v0)/θ[χ_L](v0)| / |C_L|`` (``C_L`` from an auxiliary divisor)."""
-        return _frozen(self._core.calibration)
+        return _frozen(self._genus2("calibration").calibration)
 
     @property
     def self_check(self) -> float:
-        """The largest relative defect found by the solution's own check when it was built.
+        """The largest relative defect found by the genus-2 solution's own check when
+        it was built.
 
         At ``t = 0`` and at three points of the torus the quotients (9)–(10) must give
         a real state with the integrals (6)–(7) of ``l0``, whose velocity along ``U``
         is Frahm's (1), and ``l(0) = l0``; defects are relative to ``|l0|``, to the
         largest speed ``|dl/dt|`` met at those points and to the scales of the
         integrals. A solution is only returned when this is at most 1e-10
-        (correct set-ups leave ~1e-15 … 1e-11).
+        (correct set-ups leave ~1e-15 … 1e-11). Checked on the normalized data.
         """
-        return float(self._core.self_check)
+        return float(self._genus2("self_check").self_check)
 
     @property
     def torus(self) -> Torus:
-        """The real torus of the motion (docs/tori.md): a reduced basis ``λ1, λ2``
-        of the periods of ``l`` in the real plane of ``U`` and a second
-        commuting flow, and ``(ν1, ν2)`` with ``U = ν1 λ1 + ν2 λ2``."""
+        """The real torus of a genus-2 motion (docs/tori.md): a reduced basis
+        ``λ1, λ2`` of the periods of ``l`` in the real plane of ``U`` and a
+        second commuting flow (normalized frame), and ``(ν1, ν2)`` with
+        ``U T = ν1 λ1 + ν2 λ2`` (cycles per unit of the user's time)."""
+        self._genus2("torus")
         if self._torus is None:
-            self._torus = torus_of_state(self._a, self._b, self._l0)[0]
+            lam, coords, nu, _ = self._motion.torus()
+            self._torus = Torus(_frozen(lam), _frozen(coords), _frozen(nu))
         return self._torus
 
     @property
+    def euler(self) -> EulerMotion:
+        """The Euler top of a solution of kind ``"euler"`` or ``"separatrix"``."""
+        e = self._motion.euler()
+        if e is None:
+            kind = self.kind
+            raise AttributeError(
+                f"euler exists for the kinds 'euler' and 'separatrix' only; this solution is "
+                f"of kind '{kind}'"
+            )
+        sub, w, m0, regime, (m, m1, omega) = e
+        return EulerMotion(sub, _frozen(np.array(w)), _frozen(np.array(m0)), regime, m, m1, omega)
+
+    @property
     def frequencies(self) -> np.ndarray:
-        """``(ν1, ν2) ≥ 0`` in cycles per unit time, ``U = ν1 λ1 + ν2 λ2``."""
-        return self.torus.frequencies
+        """``(ν1, ν2) ≥ 0`` in cycles per unit time.
+
+        * ``"genus2"``: ``U T = ν1 λ1 + ν2 λ2`` on the reduced basis of :attr:`torus`.
+        * ``"euler"``: the orbit is closed (a 1-torus); ``ν2 = ν_E = ω/(4K)``, its
+          frequency, and ``ν1 = ν_⊥ ∈ [0, ν_E/2]``, the rotation number of the
+          linearized motion off the invariant so(3) along the orbit (the angle
+          ``θ ∈ [0, π]`` of its monodromy over one period, ``ν_⊥ = θ ν_E/(2π)``).
+          The genus-2 tori near the orbit have frequencies tending to
+          ``(|ν_⊥ + k ν_E|, ν_E)`` for an integer ``k`` of their reduced basis
+          (docs/degenerate.md §5). If the orbit is transversally hyperbolic
+          (possible for so(3) blocks), ``ν1 = 0``: no tori shrink onto it.
+        * ``"separatrix"``: ``(0, 0)``: no period (the limit of both).
+        * ``"rest"``, ``"spherical"``, ``"equilibrium"``: ``(0, 0)``.
+        """
+        if self._core is not None:
+            return self.torus.frequencies
+        if self._freq is None:
+            # An Euler motion integrates its transverse monodromy once (0.1-10 ms).
+            self._freq = _frozen(np.array(self._motion.closed_form_frequencies()))
+        return self._freq
 
     @property
     def rotation_number(self) -> float:
-        """``ν1/ν2``."""
-        return self.torus.rotation_number
+        """``ν1/ν2`` (``inf`` when ``ν2 = 0 < ν1``, NaN when both vanish)."""
+        n1, n2 = (float(v) for v in self.frequencies)
+        if n2 != 0.0:
+            return n1 / n2
+        return float("inf") if n1 != 0.0 else float("nan")
 
     def angles(self, t: Any) -> np.ndarray:
         """Torus angles ``(ν1 t, ν2 t) mod 1`` from the initial point, shape ``(..., 2)``."""
-        return self.torus.angles(t)
+        tt = np.asarray(t, dtype=float)[..., None]
+        return np.mod(tt * self.frequencies, 1.0)
 
     def quotient(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """``(idx, num, den)``: ``l_q = Re(Σ_m num[q, m] θ[idx[m]](v) / Σ_m den[m] θ[idx[m]](v))``
-        (theta indices in the package's characteristic order)."""
-        return self._core.quotient()
+        (theta indices in the package's characteristic order; normalized frame)."""
+        return self._genus2("quotient").quotient()
 
     def __repr__(self) -> str:
-        d = ", ".join(_show(x, 6) for x in self._core.branch_points)
-        u = ", ".join(_show(x, 12) for x in self._core.rate)
-        return f"Solution(curve: y^2 = prod (x - d_j), d = [{d}]; U = [{u}])"
+        if self._core is not None:
+            d = ", ".join(_show(x, 6) for x in self._core.branch_points)
+            u = ", ".join(_show(x, 12) for x in self._core.rate)
+            return f"Solution(curve: y^2 = prod (x - d_j), d = [{d}]; U = [{u}])"
+        e = self._motion.euler()
+        if e is not None:
+            sub, w, _, regime, (m, _, _) = e
+            return f"Solution(kind={self.kind!r}, {sub}, {regime}, m = {m:.12g})"
+        return f"Solution(kind={self.kind!r}, l = {self._l0.tolist()})"

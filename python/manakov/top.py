@@ -798,22 +798,30 @@ class ManakovTop(FrahmTop):
         )
 
     def solve(self, l0: Any) -> Solution:
-        """The explicit solution (9)–(10) through ``l0``: ``l(t)`` as theta quotients.
+        """The explicit solution through ``l0``: the Theorem (9)–(10), ``l(t)`` as
+        theta quotients, or the closed form where it degenerates.
 
         Parameters
         ----------
         l0 : array_like, shape (6,)
+            Any finite scale (the input is normalized, docs/degenerate.md).
 
         Returns
         -------
         manakov.solution.Solution
-            ``.l(t)``, ``.u0``, ``.U``, ``.tau``, ``.curve``, ``.characteristics``,
-            ``.constants``, ``.abel(l)``.
+            ``.kind`` (``"genus2"``, ``"euler"``, ``"separatrix"``,
+            ``"equilibrium"``, ``"spherical"``, ``"rest"``), ``.l(t)``,
+            ``.frequencies``; for ``"genus2"`` also ``.u0``, ``.U``, ``.tau``,
+            ``.curve``, ``.characteristics``, ``.constants``, ``.abel(l)``.
 
         Raises
         ------
         ValueError
-            Not an so(4) top, or a singular state (the message names the reason).
+            Not an so(4) top, or a singular genus-2 state (the message names the
+            reason).
+        manakov.ClosedFormError
+            A genus-2 solution that fails its self-check (``Solution.self_check``
+            above 1e-10; docs/degenerate.md).
         """
         self._require_so4("solve")
         return Solution(self.a, self.b, l0)

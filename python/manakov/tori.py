@@ -59,8 +59,9 @@ STATUS_NAMES: tuple[str, ...] = (*_CORE_STATUS_NAMES, "not computed")
 OK = 0
 #: ``h1² = 4 h0²``: ``F(s)`` of (19) is undefined; the level set is singular.
 SINGULAR_CASIMIRS = 1
-#: Two branch points of (8) coincide (``h0 = 0`` and a repeated root of ``F``
-#: (19) included): genus drops; a separatrix or a degenerate torus.
+#: Two branch points of (8) coincide (a repeated root of ``F`` (19) and a root
+#: of ``F`` at an ``a_j`` included): genus drops; a separatrix or a degenerate
+#: torus. (``h0 = 0`` alone is a regular level set: docs/degenerate.md §8.)
 COINCIDING_BRANCH_POINTS = 2
 #: The divisor of the initial state has a point at infinity (the solution's
 #: route, ``sol.torus``; the map works on the level set and needs no divisor).
@@ -84,6 +85,13 @@ DEGENERATE_GRADIENTS = 10
 #: velocity: its set-up is wrong there (one of the Theorem's outliers), so
 #: would its frequencies be (the solution's route).
 INCONSISTENT_QUOTIENTS = 11
+#: The state is at rest: an equilibrium of (1) (a stationary rotation), or any
+#: state of a spherical top (all ``c_ij`` equal). NaN frequencies: the
+#: neighbouring tori tend to the linearized motion's frequencies instead.
+EQUILIBRIUM = 12
+#: The state lies on the separatrix of an Euler top (an so(3) block or a
+#: self-dual state): its motion is asymptotic, with no period.
+SEPARATRIX = 13
 
 #: States per chunk without a client: the unit between progress updates and
 #: Ctrl-C checks of the Python loop (the Rust core also polls within a chunk).
@@ -258,6 +266,15 @@ def frequency_map(
     ``sol.torus`` give the same torus through the Theorem's solution; the
     frequencies agree to 2.4e-15 (median) and 4e-12 (max) relative on the
     100 random states of ``tests/data/tori_naff_random100.py``).
+
+    Each state is first normalized and classified, as :meth:`ManakovTop.solve`
+    does (docs/degenerate.md): an exactly self-dual or so(3)-block state (an
+    Euler top, a closed orbit) gets status ``ok`` with ``(ν1, ν2) = (ν_⊥, ν_E)``,
+    the transverse rotation number and the Euler frequency (the limit of the
+    neighbouring tori's frequencies up to ``ν1 → |ν_⊥ + k ν_E|``); an equilibrium
+    of (1) or any state of a spherical top gets :data:`EQUILIBRIUM`, an Euler
+    top's separatrix :data:`SEPARATRIX`; genus-2 states are computed on the
+    normalized data, their frequencies in the user's time.
 
     Parameters
     ----------

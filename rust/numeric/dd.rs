@@ -12,7 +12,9 @@
 //! Why: the reduction's round trip needs the roots `s_p`, `σ_p` and `F'(s_p)`
 //! consistent with each other to better than double precision when a branch
 //! point `d_j` is large (`docs/kotter.md`, "Accuracy"); they are computed in DD
-//! once per level set and rounded to double at the end.
+//! once per level set and rounded to double at the end. The Euler tops of the
+//! degenerate states (`crate::solution::euler`) evaluate `Δ = Σ (W_i − W_b) M_i²`
+//! in DD: its sign and size decide the separatrix and `1 − m`.
 
 use num_complex::Complex64;
 

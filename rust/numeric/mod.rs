@@ -4,7 +4,8 @@
 //! * [`compensated`]: error-free transformations — Knuth's `two_sum`,
 //!   Dekker's `fast_two_sum`, Veltkamp's `split` and Dekker's `two_prod`.
 //! * [`dd`]: double-double real and complex numbers built on them (the
-//!   reduction's level-set constants, `crate::kotter`).
+//!   reduction's level-set constants, `crate::kotter`; the separatrix test and
+//!   `1 − m` of the Euler tops, `crate::solution::euler`).
 //! * [`complex`]: the principal square root with the crate's one branch cut
 //!   and Smith's complex division.
 //! * [`cancel`]: cooperative cancellation ([`cancel::Cancel`]), the poll of a

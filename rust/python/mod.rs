@@ -13,6 +13,7 @@ mod errors;
 mod fluid;
 mod integrate;
 mod kotter;
+mod motion;
 mod riemann;
 mod so4;
 mod solution;
@@ -40,6 +41,7 @@ mod _core {
         tori::register(m)?;
         riemann::register(m)?;
         solution::register(m)?;
+        motion::register(m)?;
         fluid::register(m)?;
         Ok(())
     }

@@ -5,6 +5,8 @@ use numpy::ndarray::{Array1, Array2};
 use numpy::{Complex64, IntoPyArray, PyArray1, PyArray2, PyReadonlyArray1};
 use pyo3::prelude::*;
 
+use std::sync::Arc;
+
 use super::arrays::{array1, out_shape_err};
 use super::errors::py_cancel;
 use crate::solution::Solution;
@@ -21,7 +23,14 @@ type Quotient<'py> = (
 /// The explicit theta-function solution through one state.
 #[pyclass(name = "SolutionCore", module = "manakov._core", frozen)]
 pub struct SolutionCore {
-    sol: Solution,
+    sol: Arc<Solution>,
+}
+
+impl SolutionCore {
+    /// A handle on a solution set up elsewhere (the dispatcher's genus-2 kind).
+    pub(super) fn from_shared(sol: Arc<Solution>) -> Self {
+        SolutionCore { sol }
+    }
 }
 
 #[pymethods]
@@ -37,7 +46,7 @@ impl SolutionCore {
         let b: [f64; 4] = array1(&b, "b")?;
         let l0: [f64; 6] = array1(&l0, "l0")?;
         let sol = py.detach(|| Solution::new(&a, &b, &l0))?;
-        Ok(SolutionCore { sol })
+        Ok(SolutionCore { sol: Arc::new(sol) })
     }
 
     /// `l(t_k)`, `(N, 6)`, for a flat array of times.

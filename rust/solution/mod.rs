@@ -45,8 +45,14 @@ use crate::so4;
 use crate::theta::{char_index, LatticeLanes, SelectedBlock, ThetaJet, ThetaPlan, BLOCK};
 
 mod check;
+pub mod constant;
+pub mod euler;
+pub mod jacobi;
 mod level_set;
+pub mod motion;
+pub mod normalize;
 mod setup;
+pub mod transverse;
 pub mod velocity;
 
 pub use check::SELF_CHECK_RTOL;
@@ -133,14 +139,26 @@ fn phase_mod2(x0: f64, rate: f64, t: f64) -> f64 {
 impl Solution {
     /// Sets up the solution through `l0` for the top with parameters `a, b`.
     ///
-    /// Errors ([`Error::InvalidArgument`] naming the reason): `l0 = 0`;
-    /// `h0 = 0`; `h1² = 4h0²`; coinciding branch points `d_j`; the divisor of
-    /// `l0` at infinity (`θ(v0) = 0`); and those of the reduction.
+    /// Errors ([`Error::Singular`] naming the reason): `l0 = 0`;
+    /// `h1² = 4h0²`; coinciding branch points `d_j`; the divisor of `l0` at
+    /// infinity (`θ(v0) = 0`); and those of the reduction; a solution that
+    /// fails its self-check ([`Error::Unverified`]).
     pub fn new(a: &[f64; 4], b: &[f64; 4], l0: &[f64; 6]) -> Result<Self> {
         crate::error::check_finite("l0", l0)?;
         let c = so4::manakov_c(a, b)?;
         // State order (12, 13, 14, 23, 24, 34) from the row-major 4 × 4 matrix.
         let c4 = [c[1], c[2], c[3], c[6], c[7], c[11]];
+        Self::with_c4(a, &c4, l0)
+    }
+
+    /// [`Solution::new`] for the top with parameters `a` and Manakov
+    /// coefficients `c4` (state order) given directly, e.g. the normalized
+    /// `c' = (c − μ)/λ` of [`normalize::TopFrame`], which no `b` represents
+    /// exactly in doubles.
+    pub fn with_c4(a: &[f64; 4], c4: &[f64; 6], l0: &[f64; 6]) -> Result<Self> {
+        crate::error::check_finite("l0", l0)?;
+        crate::error::check_finite("c", c4)?;
+        let c4 = *c4;
         let LevelSetCurve {
             kotter,
             kcurve: _,

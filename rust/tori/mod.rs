@@ -30,6 +30,7 @@
 //! in waves between which the caller's [`Cancel`] is checked; the results do
 //! not depend on the number of threads or on how the batch is split.
 
+pub mod motion;
 pub mod solve;
 #[cfg(test)]
 mod tests;
@@ -536,8 +537,9 @@ status_table! {
     Ok = 0, "ok";
     /// `h1² = 4 h0²`: `F(s)` of (19) is undefined (the level set is singular).
     SingularCasimirs = 1, "h1^2 = 4 h0^2";
-    /// Two branch points `d_j` of (8) coincide (`h0 = 0` and a repeated root of
-    /// `F` (19) included): the genus drops, a separatrix or a degenerate torus.
+    /// Two branch points `d_j` of (8) coincide (a repeated root of `F` (19) and
+    /// a root of `F` at an `a_j` included): the genus drops, a separatrix or a
+    /// degenerate torus. (`h0 = 0` alone is a regular level set.)
     CoincidingBranchPoints = 2, "coinciding branch points";
     /// The divisor of the initial state has a point at infinity.
     DivisorAtInfinity = 3, "divisor at infinity";
@@ -559,6 +561,12 @@ status_table! {
     /// equations (1) at `v0` for no velocity: its set-up is wrong at this
     /// state (one of the Theorem's outliers), so are its frequencies.
     InconsistentQuotients = 11, "inconsistent quotients";
+    /// The state is at rest: an equilibrium of (1) (a stationary rotation),
+    /// or any state of a spherical top (all `c_ij` equal).
+    Equilibrium = 12, "equilibrium";
+    /// The state lies on the separatrix of an Euler top (an so(3) block or a
+    /// self-dual state): its motion is asymptotic, with no period.
+    Separatrix = 13, "separatrix";
 }
 
 // The codes are the indices of the table (so that `STATUS_NAMES[code]` is the name).

@@ -17,9 +17,7 @@
 
 use num_complex::Complex64 as C;
 
-use super::{
-    frequencies_of_state, real_torus, second_flow_b, Char, FlowData, MapEntry, RealTorus, Status,
-};
+use super::{frequencies_of_state, second_flow_b, Char, FlowData, MapEntry, RealTorus, Status};
 use crate::error::{Error, Result, SingularKind};
 use crate::numeric::cancel::Cancel;
 use crate::so4;
@@ -104,6 +102,18 @@ pub fn level_set_flow_data(
 ) -> Result<FlowData> {
     let c4 = c_pairs(a, b)?;
     let c2 = c_pairs(a, b2)?;
+    level_set_flow_data_c4(a, &c4, &c2, l0)
+}
+
+/// [`level_set_flow_data`] with the `c_ij` of the top (`c4`) and of the
+/// second flow (`c2`) given directly (state order), e.g. normalized ones.
+pub fn level_set_flow_data_c4(
+    a: &[f64; 4],
+    c4: &[f64; 6],
+    c2: &[f64; 6],
+    l0: &[f64; 6],
+) -> Result<FlowData> {
+    let (c4, c2) = (*c4, *c2);
     let ls = level_set_curve(a, l0)?;
     let alg = algebraic_rates(&ls.kotter, &ls.kcurve, &a_periods_of(&ls.curve), &[c4, c2])?;
     let t = ls.curve.tau_row_major();
@@ -123,15 +133,44 @@ pub fn level_set_flow_data(
 /// level set ([`level_set_flow_data`]); where the auxiliary divisors do not
 /// reach a consensus on the velocities (none is known), through the
 /// Theorem's solution ([`state_frequencies_theta`]).
+///
+/// The state is first normalized and classified
+/// ([`super::motion::state_frequencies_in`]): equilibria, separatrices and
+/// `l0 = 0` get their status, Euler motions their closed-form frequencies,
+/// and genus-2 states this level-set route on the normalized data.
 pub fn state_frequencies(a: &[f64; 4], b: &[f64; 4], l0: &[f64; 6]) -> MapEntry {
-    let b2 = second_flow_b(a, b);
+    match crate::solution::normalize::TopFrame::new(a, b) {
+        Ok(frame) => super::motion::state_frequencies_in(&frame, l0),
+        Err(e) => super::MapEntry::failed(classify(&e)),
+    }
+}
+
+/// The level-set route of [`state_frequencies`] on the data as given (no
+/// normalization, no classification).
+pub fn state_frequencies_level_set(a: &[f64; 4], b: &[f64; 4], l0: &[f64; 6]) -> MapEntry {
+    match c_pairs(a, b) {
+        Ok(c4) => level_set_entry(a, &c4, &second_flow_b(a, b), l0),
+        Err(e) => MapEntry::failed(classify(&e)),
+    }
+}
+
+/// Status and `(ν1, ν2)` of the state `l0` of the top with parameters `a`
+/// and coefficients `c4` (state order), the second flow `b2`: from the level
+/// set ([`level_set_flow_data_c4`]); where the auxiliary divisors do not reach
+/// a consensus on the velocities, through the Theorem's solution
+/// ([`flow_data`]).
+pub fn level_set_entry(a: &[f64; 4], c4: &[f64; 6], b2: &[f64; 4], l0: &[f64; 6]) -> MapEntry {
+    let c2 = match c_pairs(a, b2) {
+        Ok(c2) => c2,
+        Err(e) => return MapEntry::failed(classify(&e)),
+    };
     frequencies_of_state(
         l0,
-        |l| match level_set_flow_data(a, b, &b2, l) {
+        |l| match level_set_flow_data_c4(a, c4, &c2, l) {
             Err(Error::Singular {
                 kind: SingularKind::NoVelocityConsensus,
                 ..
-            }) => Solution::new(a, b, l).and_then(|s| flow_data(&s, &b2)),
+            }) => Solution::with_c4(a, c4, l).and_then(|s| flow_data(&s, b2)),
             other => other,
         },
         classify,
@@ -140,7 +179,7 @@ pub fn state_frequencies(a: &[f64; 4], b: &[f64; 4], l0: &[f64; 6]) -> MapEntry 
 
 /// The frequency map of the top `(a, b)` over `states`: [`state_frequencies`]
 /// of each, in parallel ([`super::map_states`], `cancel` checked between
-/// waves).
+/// waves). The top's normalized frame is built once for all states.
 ///
 /// Errors: an invalid top (non-finite `a`, `b`, repeated `a_i`: an argument
 /// error, not a status); `Interrupted`.
@@ -152,8 +191,13 @@ pub fn frequency_map(
 ) -> Result<Vec<MapEntry>> {
     crate::error::check_finite("a", a)?;
     crate::error::check_finite("b", b)?;
-    so4::manakov_c(a, b)?;
-    super::map_states(states, |l0| state_frequencies(a, b, l0), cancel)
+    // The top itself must be valid (distinct a_i): an argument error, not a status.
+    let frame = crate::solution::normalize::TopFrame::new(a, b)?;
+    super::map_states(
+        states,
+        |l0| super::motion::state_frequencies_in_with(&frame, l0, cancel),
+        cancel,
+    )
 }
 
 /// [`state_frequencies`] through the Theorem's solution ([`flow_data`]):
@@ -180,9 +224,11 @@ pub use crate::solution::{INCONSISTENT, QUOTIENT_RESIDUAL_RTOL};
 /// The real torus of the state `l0` of the top `(a, b)` and the second
 /// velocity `U'`, or the error that stopped it (the solution's, or the
 /// lattice's as [`Error::InvalidArgument`]).
+///
+/// Through the dispatcher ([`crate::solution::motion::Motion`]): the torus of
+/// a genus-2 state of the normalized top, frequencies in the user's time; a
+/// state of another kind has no genus-2 torus and is refused, naming its kind.
 pub fn torus_of_state(a: &[f64; 4], b: &[f64; 4], l0: &[f64; 6]) -> Result<(RealTorus, [C; 2])> {
-    let sol = Solution::new(a, b, l0)?;
-    let d = flow_data(&sol, &second_flow_b(a, b))?;
-    let t = real_torus(&d.tau, &d.u, &d.u2, &d.chars)?;
-    Ok((t, d.u2))
+    let m = crate::solution::motion::Motion::new(a, b, l0)?;
+    super::motion::torus_of_motion(&m)
 }

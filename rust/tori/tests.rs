@@ -512,15 +512,35 @@ mod on_the_solution {
     #[test]
     fn singular_states_get_their_codes() {
         let (a, b, _) = GENERIC;
-        // h0 = 0: d_0 = 0 coincides with a branch point.
-        let e = state_frequencies(&a, &b, &[1.0, 0.0, 0.0, 0.0, 0.5, 0.0]);
-        assert_eq!(e.status, Status::CoincidingBranchPoints);
-        assert!(e.nu.iter().all(|v| v.is_nan()));
-        let e = state_frequencies(&a, &b, &[0.3, -0.2, 0.5, 0.5, 0.2, 0.3]);
-        assert_eq!(e.status, Status::SingularCasimirs);
-        // A double root of F (19) (l12, l34 only): a separatrix.
+        // h0 = 0 exactly (dyadic components), in no so(3) block and not an
+        // equilibrium: a genus-2 state (the reduction's limit h0 → 0), with the
+        // level-set route's frequencies, bit for bit.
+        let l = [0.5, 0.25, 0.125, 0.5, 0.75, 0.25];
+        let e = state_frequencies(&a, &b, &l);
+        assert_eq!(e.status, Status::Ok, "{e:?}");
+        assert!(e.nu.iter().all(|v| v.is_finite()), "{e:?}");
+        let o = super::super::solve::state_frequencies_level_set(&a, &b, &l);
+        assert_eq!(e.nu.map(f64::to_bits), o.nu.map(f64::to_bits));
+        // An so(3) block ({1, 2, 4}) and a self-dual state: Euler tops, with
+        // (ν_⊥, ν_E) (crate::solution::transverse).
+        for l in [
+            [1.0, 0.0, 0.0, 0.0, 0.5, 0.0],
+            [0.3, -0.2, 0.5, 0.5, 0.2, 0.3],
+        ] {
+            let e = state_frequencies(&a, &b, &l);
+            assert_eq!(e.status, Status::Ok, "{l:?}");
+            assert!(
+                e.nu[0] >= 0.0 && e.nu[0] <= 0.5 * e.nu[1] && e.nu[1] > 0.0,
+                "{e:?}"
+            );
+        }
+        // l12, l34 only: a stationary rotation.
         let e = state_frequencies(&a, &b, &[1.0, 0.0, 0.0, 0.0, 0.0, 0.5]);
-        assert_eq!(e.status, Status::CoincidingBranchPoints);
+        assert_eq!(e.status, Status::Equilibrium);
+        assert!(e.nu.iter().all(|v| v.is_nan()));
+        // b = a: every state at rest.
+        let e = state_frequencies(&a, &a, &[0.3, -0.2, 0.5, 0.5, 0.2, 0.7]);
+        assert_eq!(e.status, Status::Equilibrium);
     }
 
     fn kind_of(e: Error) -> (&'static str, SingularKind) {
@@ -656,5 +676,27 @@ mod on_the_solution {
         let e = state_frequencies(&a, &b, &l0);
         assert_eq!(e.status, Status::Ok);
         assert!(e.nu.iter().all(|v| v.is_finite()));
+    }
+}
+
+/// The dispatcher keeps the frequency map's bits on genus-2 states of
+/// moderate data (the identity frame): the level-set route as before.
+#[test]
+fn moderate_genus2_states_keep_the_map_bits() {
+    use crate::tori::solve::{state_frequencies, state_frequencies_level_set};
+    let shared = crate::solution::tests::TOPS;
+    for (a, b, l0) in shared {
+        for k in 0..8 {
+            let l: [f64; 6] =
+                std::array::from_fn(|q| l0[q] * (1.0 + 0.05 * ((k * 7 + q) % 5) as f64));
+            let e = state_frequencies(&a, &b, &l);
+            let o = state_frequencies_level_set(&a, &b, &l);
+            assert_eq!(e.status, o.status);
+            assert_eq!(
+                e.nu.map(f64::to_bits),
+                o.nu.map(f64::to_bits),
+                "{a:?} {l:?}"
+            );
+        }
     }
 }

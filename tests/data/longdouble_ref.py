@@ -7,8 +7,9 @@ more precise than double, used as the reference for the package's solutions and
 integrators. The c_ij enter as runtime parameters, so one compiled integrator
 serves every top.
 
-Used by the committed data scripts (e.g. ``every_state_harsh.py``); needs the
-``bench`` extra (heyoka).
+Used by the committed data scripts (``every_state_harsh.py``,
+``every_state_sweeps.py``, ``degenerate_sweep.py``) and by
+``tests/test_degenerate.py``; needs heyoka (the ``test`` and ``bench`` extras).
 """
 
 from __future__ import annotations
@@ -66,12 +67,18 @@ def c_pairs(a, b) -> np.ndarray:
     return np.array([(b[i] - b[j]) / (a[i] - a[j]) for i, j in PAIRS], dtype=np.longdouble)
 
 
-def reference(a, b, l0, t) -> np.ndarray:
-    """l(t) at the sorted times ``t`` (t[0] >= 0) from l(0) = l0, as long double (len(t), 6)."""
+def reference(a, b, l0, t, c=None) -> np.ndarray:
+    """l(t) at the sorted times ``t`` (t[0] >= 0) from l(0) = l0, as long double (len(t), 6).
+
+    ``c``: the c_ij (state order) to integrate instead of those of (2) from ``a, b``
+    in long double, e.g. the doubles a solver works with (converted exactly): the
+    difference of the two references is what the rounding of the c_ij alone does to
+    l(t), large where the motion is ill-conditioned (near a separatrix).
+    """
     ta = _integrator()
     ta.time = np.longdouble(0)
     ta.state[:] = np.asarray(l0, dtype=np.longdouble)
-    ta.pars[:] = c_pairs(a, b)
+    ta.pars[:] = c_pairs(a, b) if c is None else np.asarray(c, dtype=np.longdouble)
     t = np.asarray(t, dtype=np.longdouble)
     res = ta.propagate_grid(t, max_delta_t=np.longdouble(np.inf))
     outcome = res[0]

@@ -1,0 +1,326 @@
+//! The one entry point: a state of a Manakov top, normalized
+//! ([`super::normalize`]), classified, and solved by the representation that
+//! holds on its set (docs/degenerate.md §4):
+//!
+//! | kind | set (exact) | solution |
+//! |---|---|---|
+//! | [`Kind::Rest`] | `l0 = 0` | `l(t) = 0` |
+//! | [`Kind::Spherical`] | all `c_ij` equal (to their rounding) | `l(t) = l0` |
+//! | [`Kind::Equilibrium`] | `l̇ = 0` by (1) ([`super::constant`]) | `l(t) = l0` |
+//! | [`Kind::Euler`] | an so(3) block or `n = ±m`, exactly | Jacobi elliptic functions ([`super::euler`]) |
+//! | [`Kind::Separatrix`] | the same, with `Δ = 0` | `tanh`, `sech` |
+//! | [`Kind::Genus2`] | every other state | the Theorem (9)–(10) ([`Solution`]) |
+//!
+//! The sets are tested exactly (components compared as doubles; the
+//! equilibrium and spherical tests at the rounding of their defining
+//! equations): a state *near* a set is a genus-2 state.
+//!
+//! Frames: the classification and the solution work on the normalized data
+//! `a' = (a − κ)/σ`, `c' = (c − μ)/λ`, `l0' = l0/s`; then
+//! `l(t) = s l'(T t)` with `T = s λ` (powers of two: exact). A [`Solution`]
+//! inside keeps its attributes (`τ`, `U`, `u0`, …) in the normalized frame.
+
+use std::sync::Arc;
+
+use rayon::prelude::*;
+
+use super::constant::is_equilibrium;
+use super::euler::{Embedding, EulerRegime, EulerTop};
+use super::normalize::{state_scale, TopFrame};
+use super::Solution;
+use crate::error::{Error, Result};
+use crate::numeric::cancel::Cancel;
+
+/// What kind of motion a state has (see the module table).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum Kind {
+    /// The genus-2 theta-function solution of the Theorem (9)–(10).
+    Genus2,
+    /// `l0 = 0`.
+    Rest,
+    /// All `c_ij` equal (`b = α a + β`): every state is at rest.
+    Spherical,
+    /// A stationary rotation: `l̇ = 0` by (1).
+    Equilibrium,
+    /// An Euler top in an so(3) block or a (anti-)self-dual state.
+    Euler,
+    /// The same on the separatrix of the Euler top (`m = 1`).
+    Separatrix,
+}
+
+impl Kind {
+    /// All kinds, in the order of their codes.
+    pub const ALL: [Kind; 6] = [
+        Kind::Genus2,
+        Kind::Rest,
+        Kind::Spherical,
+        Kind::Equilibrium,
+        Kind::Euler,
+        Kind::Separatrix,
+    ];
+
+    /// The name the Python API uses.
+    pub fn name(self) -> &'static str {
+        match self {
+            Kind::Genus2 => "genus2",
+            Kind::Rest => "rest",
+            Kind::Spherical => "spherical",
+            Kind::Equilibrium => "equilibrium",
+            Kind::Euler => "euler",
+            Kind::Separatrix => "separatrix",
+        }
+    }
+
+    /// Whether `l(t) = l0` for all `t`.
+    pub fn is_constant(self) -> bool {
+        matches!(self, Kind::Rest | Kind::Spherical | Kind::Equilibrium)
+    }
+}
+
+#[derive(Debug)]
+enum Body {
+    Constant,
+    Euler { emb: Embedding, top: Box<EulerTop> },
+    Genus2(Arc<Solution>),
+}
+
+/// A solved state of a Manakov top, of any [`Kind`].
+#[derive(Debug)]
+pub struct Motion {
+    kind: Kind,
+    frame: TopFrame,
+    /// `s`: `l0' = l0/s`.
+    scale: f64,
+    /// `T = s λ`: `t' = T t`.
+    time_scale: f64,
+    l0: [f64; 6],
+    body: Body,
+}
+
+/// Times per cancellation check in the closed forms (~1 ms).
+const CHUNK: usize = 16384;
+
+/// Smallest piece handed to one thread by the closed forms.
+const PAR_PIECE: usize = 4096;
+
+impl Motion {
+    /// Normalizes, classifies and solves the state `l0` of the top `(a, b)`.
+    ///
+    /// Errors: invalid `a`, `b` or `l0` (non-finite, repeated `a_i`); for the
+    /// genus-2 kind, those of [`Solution::with_c4`].
+    pub fn new(a: &[f64; 4], b: &[f64; 4], l0: &[f64; 6]) -> Result<Self> {
+        crate::error::check_finite("l0", l0)?;
+        let frame = TopFrame::new(a, b)?;
+        Self::in_frame(frame, l0)
+    }
+
+    /// [`Motion::new`] for a top whose frame is already built (frequency maps
+    /// build it once per top).
+    pub fn in_frame(frame: TopFrame, l0: &[f64; 6]) -> Result<Self> {
+        crate::error::check_finite("l0", l0)?;
+        let (kind, scale, ln) = classify(&frame, l0);
+        let time_scale = scale * frame.lambda;
+        if !time_scale.is_finite() || time_scale == 0.0 {
+            return Err(Error::InvalidArgument {
+                what: "l0",
+                reason: format!(
+                    "the time scale |l0| x spread(c) = {scale:e} x {:e} is not representable",
+                    frame.lambda
+                ),
+            });
+        }
+        let body = match kind {
+            Kind::Rest | Kind::Spherical | Kind::Equilibrium => Body::Constant,
+            Kind::Euler | Kind::Separatrix => {
+                let emb = Embedding::of_state(&ln).ok_or(Error::InvalidArgument {
+                    what: "l0",
+                    reason: "classified as an Euler top but in no invariant subspace".into(),
+                })?;
+                let top = Box::new(EulerTop::new(emb.w_of(&frame.c4), emb.m_of(&ln))?);
+                Body::Euler { emb, top }
+            }
+            Kind::Genus2 => Body::Genus2(Arc::new(Solution::with_c4(&frame.a, &frame.c4, &ln)?)),
+        };
+        Ok(Motion {
+            kind,
+            frame,
+            scale,
+            time_scale,
+            l0: *l0,
+            body,
+        })
+    }
+
+    /// The kind of motion.
+    pub fn kind(&self) -> Kind {
+        self.kind
+    }
+
+    /// The user's `l0`.
+    pub fn l0(&self) -> &[f64; 6] {
+        &self.l0
+    }
+
+    /// The normalized top.
+    pub fn frame(&self) -> &TopFrame {
+        &self.frame
+    }
+
+    /// `s` of `l0' = l0/s` (a power of two).
+    pub fn state_scale(&self) -> f64 {
+        self.scale
+    }
+
+    /// `T` of `t' = T t` (a power of two).
+    pub fn time_scale(&self) -> f64 {
+        self.time_scale
+    }
+
+    /// The genus-2 solution in the normalized frame (kind [`Kind::Genus2`]).
+    pub fn genus2(&self) -> Option<&Solution> {
+        match &self.body {
+            Body::Genus2(s) => Some(s),
+            _ => None,
+        }
+    }
+
+    /// The genus-2 solution, shared (for bindings that hand it out).
+    pub fn genus2_shared(&self) -> Option<Arc<Solution>> {
+        match &self.body {
+            Body::Genus2(s) => Some(Arc::clone(s)),
+            _ => None,
+        }
+    }
+
+    /// The Euler top in the normalized frame and its embedding (kinds
+    /// [`Kind::Euler`], [`Kind::Separatrix`]).
+    pub fn euler(&self) -> Option<(&Embedding, &EulerTop)> {
+        match &self.body {
+            Body::Euler { emb, top } => Some((emb, top)),
+            _ => None,
+        }
+    }
+
+    /// The frequency of the closed forms in the user's time: the Euler
+    /// frequency `ν_E = ω/(4K)` (0 on the separatrix), 0 for the constant
+    /// kinds; `None` for the genus-2 kind (its two frequencies are the real
+    /// torus's, in [`crate::tori`]).
+    pub fn closed_form_frequency(&self) -> Option<f64> {
+        match &self.body {
+            Body::Constant => Some(0.0),
+            Body::Euler { top, .. } => Some(top.frequency() * self.time_scale),
+            Body::Genus2(_) => None,
+        }
+    }
+
+    fn eval_serial(&self, t: &[f64], out: &mut [f64]) -> Result<()> {
+        match &self.body {
+            Body::Constant => {
+                for o in out.chunks_exact_mut(6) {
+                    o.copy_from_slice(&self.l0);
+                }
+                Ok(())
+            }
+            Body::Euler { emb, top } => {
+                for (o, &tk) in out.chunks_exact_mut(6).zip(t) {
+                    let l = emb.state(&top.m(self.time_scale * tk));
+                    for q in 0..6 {
+                        o[q] = self.scale * l[q];
+                    }
+                }
+                Ok(())
+            }
+            Body::Genus2(sol) => {
+                if self.time_scale == 1.0 && self.scale == 1.0 {
+                    return sol.l_batch_serial(t, out, &Cancel::never());
+                }
+                let ts: Vec<f64> = t.iter().map(|&x| self.time_scale * x).collect();
+                crate::error::check_finite("t x time scale", &ts)?;
+                sol.l_batch_serial(&ts, out, &Cancel::never())?;
+                if self.scale != 1.0 {
+                    out.iter_mut().for_each(|v| *v *= self.scale);
+                }
+                Ok(())
+            }
+        }
+    }
+
+    /// `l(t_k)` into `out` (row-major `(N, 6)`), in the user's frame; rayon
+    /// for large batches, `cancel` checked between chunks.
+    ///
+    /// Errors: non-finite `t` (or `T t`), wrong `out` size, [`Error::Interrupted`].
+    pub fn l_batch(&self, t: &[f64], out: &mut [f64], cancel: &Cancel) -> Result<()> {
+        if out.len() != 6 * t.len() {
+            return Err(Error::Shape {
+                what: "out",
+                expected: format!("({}, 6)", t.len()),
+                got: format!("{} entries", out.len()),
+            });
+        }
+        crate::error::check_finite("t", t)?;
+        if let Body::Genus2(sol) = &self.body {
+            if self.time_scale == 1.0 && self.scale == 1.0 {
+                // The generic path, unchanged.
+                return sol.l_batch(t, out, cancel);
+            }
+        }
+        let threads = rayon::current_num_threads();
+        let unit = CHUNK * threads.max(1);
+        for (tc, oc) in t.chunks(unit).zip(out.chunks_mut(6 * unit)) {
+            cancel.check()?;
+            if threads > 1 && tc.len() >= 2 * PAR_PIECE {
+                let piece = tc.len().div_ceil(4 * threads).max(PAR_PIECE);
+                tc.par_chunks(piece)
+                    .zip(oc.par_chunks_mut(6 * piece))
+                    .try_for_each(|(tp, op)| self.eval_serial(tp, op))?;
+            } else {
+                self.eval_serial(tc, oc)?;
+            }
+        }
+        Ok(())
+    }
+
+    /// `l(t)` at one time.
+    pub fn l(&self, t: f64) -> Result<[f64; 6]> {
+        let mut out = [0.0; 6];
+        self.l_batch(&[t], &mut out, &Cancel::never())?;
+        Ok(out)
+    }
+}
+
+/// The kind of the state `l0` on the normalized top `frame`, with the scale
+/// `s` and the normalized state `l0/s`. Cheap (tens of nanoseconds): exact
+/// comparisons and one evaluation of (1).
+pub fn classify(frame: &TopFrame, l0: &[f64; 6]) -> (Kind, f64, [f64; 6]) {
+    if l0.iter().all(|v| *v == 0.0) {
+        return (Kind::Rest, 1.0, *l0);
+    }
+    let s = state_scale(l0);
+    let ln = if s == 1.0 { *l0 } else { l0.map(|v| v / s) };
+    if frame.spherical {
+        return (Kind::Spherical, s, ln);
+    }
+    if is_equilibrium(&frame.c4, &ln) {
+        return (Kind::Equilibrium, s, ln);
+    }
+    let kind = match Embedding::of_state(&ln) {
+        None => Kind::Genus2,
+        Some(emb) => {
+            if euler_regime(frame, emb, &ln) == Some(EulerRegime::Separatrix) {
+                Kind::Separatrix
+            } else {
+                Kind::Euler
+            }
+        }
+    };
+    (kind, s, ln)
+}
+
+fn euler_regime(frame: &TopFrame, emb: Embedding, l: &[f64; 6]) -> Option<EulerRegime> {
+    EulerTop::new(emb.w_of(&frame.c4), emb.m_of(l))
+        .ok()
+        .map(|t| t.regime())
+}
+
+#[cfg(test)]
+mod tests;

@@ -1,0 +1,151 @@
+use super::*;
+use crate::solution::normalize::TopFrame;
+use crate::solution::tests::TOPS;
+
+/// Two solutions of the same motion, one through normalized data: their
+/// states agree to the genus-2 route's accuracy (~1e-13 relative on [0, 10]).
+const SAME_MOTION: f64 = 1e-11;
+
+fn max_rel(x: &[f64], y: &[f64], scale: f64) -> f64 {
+    x.iter()
+        .zip(y)
+        .fold(0.0f64, |m, (p, q)| m.max((p - q).abs()))
+        / scale
+}
+
+fn norm(l: &[f64; 6]) -> f64 {
+    l.iter().map(|v| v * v).sum::<f64>().sqrt()
+}
+
+#[test]
+fn kinds_of_the_shared_states() {
+    for (a, b, l0) in TOPS {
+        let m = Motion::new(&a, &b, &l0).unwrap();
+        assert_eq!(m.kind(), Kind::Genus2);
+        assert_eq!(Motion::new(&a, &b, &[0.0; 6]).unwrap().kind(), Kind::Rest);
+        for q in 0..6 {
+            let mut l = [0.0; 6];
+            l[q] = -0.8;
+            assert_eq!(Motion::new(&a, &b, &l).unwrap().kind(), Kind::Equilibrium);
+        }
+        let planes = [
+            [0.4, 0.0, 0.0, 0.0, 0.0, 1.3],
+            [0.0, 0.4, 0.0, 0.0, 1.3, 0.0],
+        ];
+        for l in planes {
+            assert_eq!(Motion::new(&a, &b, &l).unwrap().kind(), Kind::Equilibrium);
+        }
+        let block = [0.4, -0.9, 0.0, 0.3, 0.0, 0.0];
+        assert_eq!(Motion::new(&a, &b, &block).unwrap().kind(), Kind::Euler);
+        let sd = [0.4, -0.9, 0.3, 0.3, 0.9, 0.4];
+        assert_eq!(Motion::new(&a, &b, &sd).unwrap().kind(), Kind::Euler);
+        let asd = [0.4, -0.9, -0.3, 0.3, -0.9, -0.4];
+        assert_eq!(Motion::new(&a, &b, &asd).unwrap().kind(), Kind::Euler);
+        // b = α a + β: spherical.
+        let bs = a.map(|x| 0.7 * x + 0.2);
+        assert_eq!(Motion::new(&a, &bs, &l0).unwrap().kind(), Kind::Spherical);
+    }
+}
+
+#[test]
+fn the_generic_path_is_unchanged_for_moderate_data() {
+    let (a, b, l0) = TOPS[0];
+    let m = Motion::new(&a, &b, &l0).unwrap();
+    let s = Solution::new(&a, &b, &l0).unwrap();
+    let t: Vec<f64> = (0..50).map(|k| 0.7 * k as f64).collect();
+    let mut o1 = vec![0.0; 300];
+    let mut o2 = vec![0.0; 300];
+    m.l_batch(&t, &mut o1, &Cancel::never()).unwrap();
+    s.l_batch(&t, &mut o2, &Cancel::never()).unwrap();
+    assert_eq!(o1, o2);
+}
+
+#[test]
+fn scaled_states_follow_l_of_s_l0_equals_s_l_of_s_t() {
+    let t: Vec<f64> = (0..21).map(|k| 0.5 * k as f64).collect();
+    for (a, b, l0) in TOPS {
+        for l in [
+            l0,
+            [0.4, -0.9, 0.0, 0.3, 0.0, 0.0],
+            [0.4, -0.9, 0.3, 0.3, 0.9, 0.4],
+        ] {
+            let base = Motion::new(&a, &b, &l).unwrap();
+            for s in [1e-150, 1e150, 3.0e-7, 2f64.powi(40)] {
+                let ls = l.map(|v| v * s);
+                let m = Motion::new(&a, &b, &ls).unwrap();
+                assert_eq!(m.kind(), base.kind());
+                let ts: Vec<f64> = t.iter().map(|x| x / s).collect();
+                let mut o1 = vec![0.0; 6 * t.len()];
+                let mut o2 = vec![0.0; 6 * t.len()];
+                m.l_batch(&ts, &mut o1, &Cancel::never()).unwrap();
+                base.l_batch(&t, &mut o2, &Cancel::never()).unwrap();
+                let o2s: Vec<f64> = o2.iter().map(|v| v * s).collect();
+                let err = max_rel(&o1, &o2s, norm(&l) * s);
+                assert!(
+                    err < SAME_MOTION,
+                    "a = {a:?}, l = {l:?}, s = {s:e}: {err:e}"
+                );
+            }
+        }
+    }
+}
+
+#[test]
+fn shifted_a_gives_the_same_motion() {
+    let t: Vec<f64> = (0..21).map(|k| 0.5 * k as f64).collect();
+    for (a, b, l0) in TOPS {
+        let base = Motion::new(&a, &b, &l0).unwrap();
+        let mut o2 = vec![0.0; 6 * t.len()];
+        base.l_batch(&t, &mut o2, &Cancel::never()).unwrap();
+        for shift in [1e6, -1e6, 1e9] {
+            let a6 = a.map(|v| v + shift);
+            // b shifted with the same a keeps c: b' = b + (a' − a) · 0 and
+            // the c_ij of the doubles (b_i − b_j)/(a6_i − a6_j).
+            let m = Motion::new(&a6, &b, &l0).unwrap();
+            assert_eq!(m.kind(), Kind::Genus2);
+            let mut o1 = vec![0.0; 6 * t.len()];
+            m.l_batch(&t, &mut o1, &Cancel::never()).unwrap();
+            // The reference is the flow of the shifted doubles' c, which
+            // differs from the unshifted c by the rounding of a + shift.
+            let mut c = [[0.0; 16]; 1];
+            let cc = crate::so4::manakov_c(&a6, &b).unwrap();
+            c[0].copy_from_slice(&cc);
+            let top = crate::so4::FrahmTop::new(4, &c[0]).unwrap();
+            let opts = crate::integrate::Options {
+                method: crate::integrate::Method::Gauss16,
+                dt: 1e-2,
+                rtol: 0.0,
+                atol: 0.0,
+                max_steps: 10_000_000,
+            };
+            let traj = crate::integrate::integrate(&top, &l0, 0.0, &t, &opts).unwrap();
+            let err = max_rel(&o1, &traj.y, norm(&l0));
+            assert!(err < SAME_MOTION, "shift {shift:e}, a = {a:?}: {err:e}");
+        }
+    }
+}
+
+/// The set-up cost the dispatcher adds to a genus-2 state: the top's frame
+/// (once per top) and the classification (once per state). A timing, not an
+/// assertion: `cargo test --release -- --ignored --nocapture classification_cost`.
+#[test]
+#[ignore]
+fn classification_cost() {
+    use std::hint::black_box;
+    use std::time::Instant;
+    let n = 2_000_000u32;
+    for (a, b, l0) in TOPS {
+        let t = Instant::now();
+        for _ in 0..n {
+            black_box(TopFrame::new(black_box(&a), black_box(&b)).unwrap());
+        }
+        let frame_ns = t.elapsed().as_nanos() as f64 / f64::from(n);
+        let frame = TopFrame::new(&a, &b).unwrap();
+        let t = Instant::now();
+        for _ in 0..n {
+            black_box(classify(black_box(&frame), black_box(&l0)));
+        }
+        let class_ns = t.elapsed().as_nanos() as f64 / f64::from(n);
+        eprintln!("a = {a:?}: frame {frame_ns:.1} ns, classify {class_ns:.1} ns");
+    }
+}

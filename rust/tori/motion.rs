@@ -1,0 +1,90 @@
+//! Frequencies of every kind of state ([`crate::solution::motion`];
+//! docs/degenerate.md §5): the frequency map and `sol.torus` classify the
+//! state first, on the normalized top.
+//!
+//! | kind | status | `(ν1, ν2)` |
+//! |---|---|---|
+//! | genus-2 | as before ([`super::solve`]), on the normalized data | the real torus's, times `T` |
+//! | Euler (block or self-dual) | [`Status::Ok`] | `(ν_E, ν_⊥)` of [`crate::solution::transverse`] |
+//! | separatrix | [`Status::Separatrix`] | NaN |
+//! | equilibrium, spherical top | [`Status::Equilibrium`] | NaN |
+//! | `l0 = 0` | [`Status::ZeroState`] | NaN |
+//!
+//! Frequencies are in cycles per unit of the user's time: the normalized
+//! problem's times `T` (`t' = T t`, [`Motion::time_scale`]).
+
+use num_complex::Complex64 as C;
+
+use super::solve::{classify as classify_error, flow_data, level_set_entry};
+use super::{real_torus, MapEntry, RealTorus, Status};
+use crate::error::{Error, Result};
+use crate::numeric::cancel::Cancel;
+use crate::solution::motion::{classify, Kind, Motion};
+use crate::solution::normalize::TopFrame;
+use crate::solution::transverse::euler_frequencies_with;
+
+/// Status and `(ν1, ν2)` of the state `l0` of the top with frame `frame`
+/// (see the module table). Nothing here panics or raises.
+pub fn state_frequencies_in(frame: &TopFrame, l0: &[f64; 6]) -> MapEntry {
+    state_frequencies_in_with(frame, l0, &Cancel::never())
+}
+
+/// [`state_frequencies_in`] with a cancellation token, checked inside the
+/// (up to ~0.1 s) monodromy of an Euler state; when it fires the entry is a
+/// failure and the caller's next check stops the map.
+pub fn state_frequencies_in_with(frame: &TopFrame, l0: &[f64; 6], cancel: &Cancel) -> MapEntry {
+    if l0.iter().any(|v| !v.is_finite()) {
+        return MapEntry::failed(Status::NonFinite);
+    }
+    let (kind, scale, ln) = classify(frame, l0);
+    let t_scale = scale * frame.lambda;
+    match kind {
+        Kind::Rest => MapEntry::failed(Status::ZeroState),
+        Kind::Spherical | Kind::Equilibrium => MapEntry::failed(Status::Equilibrium),
+        Kind::Separatrix => MapEntry::failed(Status::Separatrix),
+        Kind::Euler => {
+            match Motion::in_frame(frame.clone(), l0)
+                .and_then(|m| euler_frequencies_with(&m, cancel))
+            {
+                Ok(nu) if nu.iter().all(|v| v.is_finite()) => MapEntry {
+                    status: Status::Ok,
+                    nu,
+                },
+                Ok(_) => MapEntry::failed(Status::Singular),
+                Err(e) => MapEntry::failed(classify_error(&e)),
+            }
+        }
+        Kind::Genus2 => {
+            let entry = level_set_entry(&frame.a, &frame.c4, &frame.second_flow_b(), &ln);
+            if entry.status == Status::Ok && t_scale != 1.0 {
+                MapEntry {
+                    status: Status::Ok,
+                    nu: entry.nu.map(|v| v * t_scale),
+                }
+            } else {
+                entry
+            }
+        }
+    }
+}
+
+/// The real torus of a genus-2 motion and the second velocity `U'`, both in
+/// the normalized frame except the frequencies, which are per unit of the
+/// user's time.
+///
+/// Errors: a motion of another kind (the message names it; those have no
+/// 2-torus), and those of [`flow_data`] and [`real_torus`].
+pub fn torus_of_motion(m: &Motion) -> Result<(RealTorus, [C; 2])> {
+    let sol = m.genus2().ok_or_else(|| Error::InvalidArgument {
+        what: "state l0",
+        reason: format!(
+            "the motion is of kind '{}': it has no genus-2 torus (its frequencies are those of \
+             the closed form)",
+            m.kind().name()
+        ),
+    })?;
+    let d = flow_data(sol, &m.frame().second_flow_b())?;
+    let mut t = real_torus(&d.tau, &d.u, &d.u2, &d.chars)?;
+    t.nu = t.nu.map(|v| v * m.time_scale());
+    Ok((t, d.u2))
+}
