@@ -189,7 +189,7 @@ def _stagger(xs: np.ndarray, span: float) -> list[int]:
 
 
 def plot_kotter(path: str | os.PathLike[str], k: Kotter, name: str, *, dpi: int = 110) -> None:
-    """The branch points ``d_0 .. d_4`` of the curve (8) and the divisor ``z1, z2``.
+    """The branch points ``d_0``–``d_4`` of the curve (8) and the divisor ``z1, z2``.
 
     When every point lies on the real (or the imaginary) axis, as for states of
     the shared problems, the figure is that axis on a symmetric-log scale (the

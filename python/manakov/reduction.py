@@ -34,6 +34,7 @@ from ._checks import _states as _top_states
 from .curve import KotterCurve
 
 __all__ = [
+    "STATE_RANGE",
     "Kotter",
     "LevelSet",
     "from_kotter",

@@ -18,13 +18,13 @@ one state and say so).
 
 Equations (numbers are those of Perelomov's paper)
 ---------------------------------------------------
-(1) ``l̇_ij = Σ_k (l_ik ω_kj - ω_ik l_kj)``, ``ω_ij = c_ij l_ij``;
-(2) ``c_ij = (b_i - b_j)/(a_i - a_j)``;
-(3) ``{l_ij, l_km} = l_im δ_jk - l_ik δ_jm + l_jk δ_im - l_jm δ_ik``;
-(4) ``H = ½ Σ_{j<k} c_jk l_jk²``; (5) ``l̇_jk = {H, l_jk}`` (sign as printed holds);
-(6) ``H0 = l12 l34 + l23 l14 + l31 l24``; (7), corrected (see ``docs/errata.md``):
-``H1 = Σ l_jk²``, ``H2 = Σ (a_l + a_m) l_jk²``, ``H3 = Σ a_l a_m l_jk²`` with
-``{l, m} = {1,2,3,4} \\ {j, k}``.
+* (1) ``l̇_ij = Σ_k (l_ik ω_kj - ω_ik l_kj)``, ``ω_ij = c_ij l_ij``;
+* (2) ``c_ij = (b_i - b_j)/(a_i - a_j)``;
+* (3) ``{l_ij, l_km} = l_im δ_jk - l_ik δ_jm + l_jk δ_im - l_jm δ_ik``;
+* (4) ``H = ½ Σ_{j<k} c_jk l_jk²``; (5) ``l̇_jk = {H, l_jk}`` (sign as printed holds);
+* (6) ``H0 = l12 l34 + l23 l14 + l31 l24``; (7), corrected (see ``docs/errata.md``):
+  ``H1 = Σ l_jk²``, ``H2 = Σ (a_l + a_m) l_jk²``, ``H3 = Σ a_l a_m l_jk²`` with
+  ``{l, m} = {1,2,3,4} \\ {j, k}``.
 """
 
 from __future__ import annotations
