@@ -24,6 +24,12 @@ def state_dim(n: int) -> int:
     Returns
     -------
     int
+
+    Examples
+    --------
+    >>> from manakov.top import state_dim
+    >>> state_dim(4), state_dim(5)
+    (6, 10)
     """
     return n * (n - 1) // 2
 

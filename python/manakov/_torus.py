@@ -82,6 +82,18 @@ def real_torus(tau: Any, U: Any, U2: Any, characteristics: Any) -> Torus:
         If the inputs have the wrong shape, are not finite, ``Im τ`` is not
         positive definite, ``U`` and ``U2`` do not span a real plane, or the
         plane meets ``Λ'`` in no rank-2 lattice.
+
+    Examples
+    --------
+    >>> import manakov
+    >>> from manakov.tori import real_torus, torus_of_state
+    >>> p = manakov.problem("generic")
+    >>> sol = manakov.ManakovTop(p.a, p.b).solve(p.l0)
+    >>> _, U2 = torus_of_state(p.a, p.b, p.l0)
+    >>> chars = [sum(c, ()) for c in sol.characteristics.values()]
+    >>> torus = real_torus(sol.tau, sol.U, U2, chars)
+    >>> print(torus.frequencies.round(6))
+    [0.264922 0.278362]
     """
     t = np.ascontiguousarray(np.asarray(tau, dtype=complex))
     u = np.ascontiguousarray(np.asarray(U, dtype=complex))
@@ -115,6 +127,12 @@ def second_flow_b(a: Any, b: Any) -> np.ndarray:
     Returns
     -------
     ndarray, shape (4,)
+
+    Examples
+    --------
+    >>> from manakov.tori import second_flow_b
+    >>> print(second_flow_b([0.3, 1.1, 2.0, 3.7], [0.5, -0.2, 1.4, 0.9]))
+    [2.7000e-02 1.3310e+00 8.0000e+00 5.0653e+01]
     """
     aa = np.asarray(a, dtype=float)
     bb = np.asarray(b, dtype=float)
@@ -146,6 +164,15 @@ def torus_of_state(a: Any, b: Any, l0: Any) -> tuple[Torus, np.ndarray]:
     ValueError
         On a singular level set (the solution's message names the case) or
         when the lattice of periods has no rank-2 part in the real plane.
+
+    Examples
+    --------
+    >>> import manakov
+    >>> from manakov.tori import torus_of_state
+    >>> p = manakov.problem("generic")
+    >>> torus, U2 = torus_of_state(p.a, p.b, p.l0)
+    >>> print(torus.frequencies.round(6))
+    [0.264922 0.278362]
     """
     arr = [np.ascontiguousarray(np.asarray(x, dtype=float)) for x in (a, b, l0)]
     lam, coords, nu, u2 = _core.torus_of_state(*arr)

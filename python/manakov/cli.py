@@ -652,7 +652,16 @@ def _quiet_broken_pipe() -> int:
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    """Entry point of the ``manakov`` console script; returns the exit status."""
+    """Entry point of the ``manakov`` console script; returns the exit status.
+
+    Examples
+    --------
+    >>> from manakov.cli import main
+    >>> main(["kotter", "generic"])  # doctest: +ELLIPSIS
+    generic: a = [0.3, 1.1, 2.0, 3.7], b = [0.5, -0.2, 1.4, 0.9]
+    l = [0.8, -0.3, 0.5, 1.1, -0.7, 0.2]
+    ...
+    """
     try:
         ap = _parser()
         args = ap.parse_args(argv)

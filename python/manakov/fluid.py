@@ -1183,6 +1183,19 @@ def fluid_problem_names() -> list[str]:
         Four Clebsch bodies (``clebsch_generic``, ``clebsch_wide``,
         ``clebsch_isotropic``, ``clebsch_near_degenerate``), then ``kirchhoff``,
         ``lyapunov_steklov`` and ``general``.
+
+    Examples
+    --------
+    >>> import manakov
+    >>> for name in manakov.fluid_problem_names():
+    ...     print(name)
+    clebsch_generic
+    clebsch_wide
+    clebsch_isotropic
+    clebsch_near_degenerate
+    kirchhoff
+    lyapunov_steklov
+    general
     """
     return list(_bodies())
 
@@ -1203,6 +1216,13 @@ def fluid_problem(name: str) -> FluidProblem:
     ------
     ValueError
         If there is no body of that name.
+
+    Examples
+    --------
+    >>> import manakov
+    >>> fp = manakov.fluid_problem(manakov.fluid_problem_names()[0])
+    >>> print(fp.M0, fp.p0)
+    [ 0.4 -0.7  0.9] [ 0.8  0.3 -0.5]
     """
     bodies = _bodies()
     if name not in bodies:
@@ -1263,6 +1283,16 @@ def plot_motion(
     -------
     SpaceTrajectory
         The motion that was plotted.
+
+    Examples
+    --------
+    >>> import os, tempfile, manakov
+    >>> from manakov.fluid import plot_motion
+    >>> fp = manakov.fluid_problem(manakov.fluid_problem_names()[0])
+    >>> path = os.path.join(tempfile.mkdtemp(), "motion.png")
+    >>> tr = plot_motion(fp.body, fp.M0, fp.p0, path, t_end=5.0, samples=51)
+    >>> os.path.exists(path)
+    True
     """
     t_end_f = _scalar(t_end, "t_end")
     if not t_end_f > 0:
@@ -1289,6 +1319,17 @@ def plot_space_trajectory(
         The PNG file to write.
     frames : int
         How many instants show the body's axes.
+
+    Examples
+    --------
+    >>> import os, tempfile, manakov
+    >>> from manakov.fluid import plot_space_trajectory
+    >>> fp = manakov.fluid_problem(manakov.fluid_problem_names()[0])
+    >>> tr = fp.body.motion_in_space(fp.M0, fp.p0, 5.0, sample_every=0.1)
+    >>> path = os.path.join(tempfile.mkdtemp(), "space.png")
+    >>> plot_space_trajectory(fp.body, tr, path)
+    >>> os.path.exists(path)
+    True
     """
     import matplotlib
 
@@ -1369,6 +1410,16 @@ def plot_clebsch_theorem(
     -------
     float
         ``max_t |y_theta − y_int| / max |y0|``.
+
+    Examples
+    --------
+    >>> import os, tempfile, manakov
+    >>> from manakov.fluid import plot_clebsch_theorem
+    >>> name = manakov.fluid_problem_names()[0]
+    >>> path = os.path.join(tempfile.mkdtemp(), "clebsch.png")
+    >>> err = plot_clebsch_theorem(name, path, t_end=10.0, samples=21)
+    >>> bool(err < 1e-8), os.path.exists(path)
+    (True, True)
     """
     import matplotlib
 

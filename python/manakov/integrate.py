@@ -221,6 +221,12 @@ def sample_times(t_end: Any, t_eval: Any = None, sample_every: Any = None) -> np
         ``t_end`` negative or not finite, both ``t_eval`` and ``sample_every``,
         unsorted ``t_eval`` or outside ``[0, t_end]``, ``sample_every <= 0`` or
         more than :data:`MAX_SAMPLES` samples.
+
+    Examples
+    --------
+    >>> from manakov.integrate import sample_times
+    >>> print(sample_times(1.0, sample_every=0.25))
+    [0.   0.25 0.5  0.75 1.  ]
     """
     t_end_f = _scalar(t_end, "t_end")
     if t_end_f < 0:
@@ -280,6 +286,12 @@ def gauss_steps(times: Any, dt: float, t0: float = 0.0) -> int:
     ------
     ValueError
         Unsorted or non-finite times, ``dt`` not finite and positive.
+
+    Examples
+    --------
+    >>> from manakov.integrate import gauss_steps
+    >>> gauss_steps([0.0, 1.0, 2.5], 0.1)
+    25
     """
     te = np.ascontiguousarray(_float_array(times, "times").reshape(-1))
     return int(_core.gauss_steps(float(t0), te, float(dt)))
@@ -331,6 +343,18 @@ def run(
     ``top`` provides ``c`` (its coefficients), ``dim``, ``integrals(l)``,
     ``_batch_default_dt(states, method)`` and ``_refuse_default_step``. Everything is
     checked before the first step (and before the first progress report).
+
+    Examples
+    --------
+    >>> import manakov
+    >>> from manakov.integrate import run
+    >>> p = manakov.problem("generic")
+    >>> top = manakov.ManakovTop(p.a, p.b)
+    >>> tr = run(top, p.l0, 10.0, dt=None, t_eval=None, sample_every=1.0, method="gauss16",
+    ...          rtol=None, atol=1e-12, progress=False, chunks=1, max_steps=10**8,
+    ...          parallel=True, chunk_size=None)
+    >>> tr.l.shape
+    (11, 6)
     """
     flat, lead = _states(l0, top.dim, "l0")
     times = sample_times(t_end, t_eval, sample_every)

@@ -119,6 +119,18 @@ def plot_trajectory(
     title : str
     window : float
     dpi : int
+
+    Examples
+    --------
+    >>> import os, tempfile, manakov
+    >>> from manakov.plots import plot_trajectory
+    >>> p = manakov.problem("generic")
+    >>> top = manakov.ManakovTop(p.a, p.b)
+    >>> tr = top.integrate(p.l0, 20.0, sample_every=1.0)
+    >>> path = os.path.join(tempfile.mkdtemp(), "generic.png")
+    >>> plot_trajectory(path, top, tr, title="generic", window=10.0)
+    >>> os.path.exists(path)
+    True
     """
     plt = _pyplot()
     t, l = tr.t, tr.l
@@ -206,6 +218,16 @@ def plot_kotter(path: str | os.PathLike[str], k: Kotter, name: str, *, dpi: int 
     name : str
         Shown in the title.
     dpi : int
+
+    Examples
+    --------
+    >>> import os, tempfile, manakov
+    >>> from manakov.plots import plot_kotter
+    >>> p = manakov.problem("generic")
+    >>> path = os.path.join(tempfile.mkdtemp(), "kotter.png")
+    >>> plot_kotter(path, manakov.kotter(p.a, p.b, p.l0), "generic")
+    >>> os.path.exists(path)
+    True
     """
     plt = _pyplot()
     d = [_clean(x) for x in np.concatenate([[0.0], np.asarray(k.d), [np.prod(k.d)]])]
@@ -349,6 +371,15 @@ def plot_theorem(
         Ctrl-C during the integration: the figure of the samples reached is
         written first; ``err.partial`` is the integration's partial
         :class:`~manakov.Trajectory`, ``err.partial_path`` the figure.
+
+    Examples
+    --------
+    >>> import os, tempfile
+    >>> from manakov.plots import plot_theorem
+    >>> path = os.path.join(tempfile.mkdtemp(), "theorem.png")
+    >>> err = plot_theorem("generic", path, t_end=10.0, samples=41)
+    >>> bool(err < 1e-10), os.path.exists(path)
+    (True, True)
     """
     pr = as_problem(problem)
     if not (t_end > 0 and np.isfinite(t_end)):
@@ -483,6 +514,15 @@ def plot_frequency_map(
         Ctrl-C: the figure of the states done is written first; ``err.partial``
         is the partial :class:`~manakov.FrequencyMap`, ``err.partial_path`` the
         figure.
+
+    Examples
+    --------
+    >>> import os, tempfile
+    >>> from manakov.plots import plot_frequency_map
+    >>> path = os.path.join(tempfile.mkdtemp(), "map.png")
+    >>> fm = plot_frequency_map("generic", 8, path, progress=False)
+    >>> fm.nu.shape, os.path.exists(path)
+    ((8, 8, 2), True)
     """
     pr = as_problem(problem)
     top = ManakovTop(pr.a, pr.b)

@@ -43,6 +43,12 @@ def problem_names() -> list[str]:
     -------
     list of str
         ``["generic", "physical", "wide", "near_degenerate"]`` in file order.
+
+    Examples
+    --------
+    >>> import manakov
+    >>> manakov.problem_names()
+    ['generic', 'physical', 'wide', 'near_degenerate']
     """
     return list(_data()["tops"])
 
@@ -64,6 +70,15 @@ def problem(name: str) -> Problem:
     ------
     ValueError
         If there is no problem of that name.
+
+    Examples
+    --------
+    >>> import manakov
+    >>> p = manakov.problem("generic")
+    >>> print(p.a, p.b)
+    [0.3 1.1 2.  3.7] [ 0.5 -0.2  1.4  0.9]
+    >>> print(p.l0)
+    [ 0.8 -0.3  0.5  1.1 -0.7  0.2]
     """
     tops = _data()["tops"]
     if name not in tops:
@@ -94,6 +109,12 @@ def benchmark_setup(name: str) -> dict[str, Any]:
     ------
     ValueError
         If there is no set-up of that name.
+
+    Examples
+    --------
+    >>> from manakov.problems import benchmark_setup
+    >>> sorted(benchmark_setup("integration"))
+    ['sample_every', 't_end', 'top']
     """
     bench = _data()["benchmark"]
     if name not in bench:
@@ -108,6 +129,12 @@ def as_problem(p: str | Problem) -> Problem:
     ------
     ValueError
         An unknown name, or neither a name nor a Problem.
+
+    Examples
+    --------
+    >>> from manakov.problems import as_problem
+    >>> as_problem("physical").name
+    'physical'
     """
     if isinstance(p, Problem):
         return p
@@ -152,6 +179,19 @@ def read_problem(path: str | os.PathLike[str], name: str | None = None) -> Probl
         missing key, or an unknown or missing ``name``.
     OSError
         The file cannot be read.
+
+    Examples
+    --------
+    >>> import json, os, tempfile
+    >>> from manakov.problems import read_problem
+    >>> path = os.path.join(tempfile.mkdtemp(), "mytop.json")
+    >>> top = {"a": [0.1, 0.9, 2.3, 3.1], "b": [0.4, -0.6, 1.1, 2.5],
+    ...        "l0": [0.7, -0.2, 0.6, 1, -0.5, 0.3]}
+    >>> with open(path, "w") as f:
+    ...     json.dump(top, f)
+    ...
+    >>> print(read_problem(path).l0)
+    [ 0.7 -0.2  0.6  1.  -0.5  0.3]
     """
     path = Path(path)
     text = path.read_text(encoding="utf-8")

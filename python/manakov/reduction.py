@@ -92,6 +92,13 @@ def integrals(a: Any, l: Any) -> np.ndarray:
     ------
     ValueError
         Wrong shapes, complex or non-finite input, or a result that overflows.
+
+    Examples
+    --------
+    >>> from manakov.reduction import integrals
+    >>> p_a = [0.3, 1.1, 2.0, 3.7]
+    >>> print(integrals(p_a, [0.8, -0.3, 0.5, 1.1, -0.7, 0.2]).round(6))
+    [ 0.5     2.72   10.878   7.3026]
     """
     a = _check_a(a)
     flat, shape = _states(l)
@@ -125,6 +132,15 @@ def schottky(a: Any, l: Any, s: Any, *, sqrt_g: Any = None) -> tuple[np.ndarray,
     ValueError
         Wrong shapes, complex or non-finite ``a``, ``l``, non-finite ``s``
         or ``sqrt_g``, ``G(s)`` overflowing, or ``s = a_j``.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from manakov.reduction import schottky
+    >>> a = [0.3, 1.1, 2.0, 3.7]
+    >>> ls, ms = schottky(a, [0.8, -0.3, 0.5, 1.1, -0.7, 0.2], 5.0)
+    >>> ls.shape, ms.shape
+    ((3,), (3,))
     """
     a = _check_a(a)
     flat, lshape = _states(l)
@@ -198,6 +214,15 @@ def lax_pair(
     ValueError
         Bad shapes or non-finite input, repeated ``a``, ``s = a_j``,
         ``sqrt_g**2 != G(s)``, or ``s = e1`` when ``p3 != 0`` (a pole of ``M_b``).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from manakov.reduction import lax_pair
+    >>> a, b = [0.3, 1.1, 2.0, 3.7], [0.5, -0.2, 1.4, 0.9]
+    >>> L, M = lax_pair(a, b, [0.8, -0.3, 0.5, 1.1, -0.7, 0.2], 5.0)
+    >>> L.shape, bool(np.allclose(L, -L.T))
+    ((3, 3), True)
     """
     a = _check_a(a)
     b = _check_b(b)
@@ -236,6 +261,14 @@ def quartic(a: Any, h: Any) -> np.ndarray:
     ValueError
         If ``h1^2 = 4 h0^2`` (a self-dual or anti-self-dual state): (19) is not
         defined; wrong shapes, complex or non-finite input, or an overflow.
+
+    Examples
+    --------
+    >>> from manakov.reduction import integrals, quartic
+    >>> a = [0.3, 1.1, 2.0, 3.7]
+    >>> h = integrals(a, [0.8, -0.3, 0.5, 1.1, -0.7, 0.2])
+    >>> print(quartic(a, h).round(6))
+    [  1.        -8.13896   22.247285 -22.917349   7.952921]
     """
     a = _check_a(a)
     flat, shape = _top_states(h, 4, "h")
@@ -534,6 +567,14 @@ def kotter(a: Any, b: Any, l: Any, *, errors: str = "raise") -> Kotter:
         with ``1e-12 < (h1^2 - 4 h0^2)/h1^2 < 1e-10`` usually reduce but may
         raise, naming that distance; every state farther from the singular
         set reduces (docs/kotter.md, "Near the singular set").
+
+    Examples
+    --------
+    >>> import manakov
+    >>> p = manakov.problem("generic")
+    >>> k = manakov.kotter(p.a, p.b, p.l0)
+    >>> print(k.d.real.round(6))  # d_1, d_2, d_3 of (26): real for this state
+    [  3.196708  -1.854681 -14.10493 ]
     """
     a = _check_a(a)
     b = _check_b(b)
@@ -685,6 +726,14 @@ def from_kotter(a: Any, b: Any, k: Kotter) -> np.ndarray:
         ``z1 = z2``, ``g = 0``, a bad branch, or data that give a complex state.
     TypeError
         ``k`` is not a :class:`Kotter`.
+
+    Examples
+    --------
+    >>> import numpy as np, manakov
+    >>> p = manakov.problem("generic")
+    >>> back = manakov.from_kotter(p.a, p.b, manakov.kotter(p.a, p.b, p.l0))
+    >>> bool(np.abs(back - p.l0).max() < 1e-12)
+    True
     """
     a = _check_a(a)
     b = _check_b(b)

@@ -108,6 +108,13 @@ def characteristics(g: int = 2) -> list[Characteristic]:
         ``g`` is not an integer.
     ValueError
         ``g`` is outside 1..6.
+
+    Examples
+    --------
+    >>> import manakov
+    >>> chars = manakov.characteristics(2)
+    >>> len(chars), chars[0], chars[9]
+    (16, ((0, 0), (0, 0)), ((1, 0), (0, 1)))
     """
     g = operator.index(g)
     if not 1 <= g <= 6:
@@ -170,6 +177,12 @@ def char_index(a: Sequence[int], b: Sequence[int]) -> int:
         are refused).
     TypeError
         ``a`` or ``b`` is not a sequence.
+
+    Examples
+    --------
+    >>> import manakov
+    >>> manakov.char_index((1, 0), (0, 1))
+    9
     """
     a_t, b_t = tuple(a), tuple(b)
     if len(a_t) != len(b_t) or not 1 <= len(a_t) <= 6:
@@ -209,6 +222,12 @@ def parity(char: CharLike, g: int = 2) -> int:
         ``g`` outside 1..6.
     TypeError
         ``g`` is not an integer.
+
+    Examples
+    --------
+    >>> import manakov
+    >>> manakov.parity(((1, 0), (1, 0))), manakov.parity(((1, 1), (1, 1)))
+    (-1, 1)
     """
     idx = _resolve_char(char, g)
     a, b = characteristics(g)[idx]
@@ -518,6 +537,18 @@ def theta(
         Ctrl-C: a batch checks for signals about every millisecond of work and
         stops within a few milliseconds (a single point costs at most
         :data:`MAX_SECONDS_PER_POINT` by the cost estimate).
+
+    Examples
+    --------
+    >>> import numpy as np, manakov
+    >>> tau = np.array([[0.3 + 1.1j, 0.1 + 0.4j], [0.1 + 0.4j, -0.2 + 1.3j]])
+    >>> z = np.array([0.2 + 0.1j, 0.7 - 0.3j])
+    >>> print(np.round(manakov.theta(z, tau), 8))
+    (0.87999796-0.04222314j)
+    >>> print(np.round(manakov.theta(z, tau, ((1, 0), (1, 0))), 8))
+    (-0.430963-0.11159507j)
+    >>> print(abs(manakov.theta(np.zeros(2), tau, ((1, 0), (1, 0)))) < 1e-15)  # odd: zero at 0
+    True
     """
     z2, tau_a, lead, g = _prepare(z, tau)
     idx = _resolve_char(char, g)
@@ -615,6 +646,16 @@ def theta_jet(
         Ctrl-C: a batch checks for signals about every millisecond of work and
         stops within a few milliseconds (a single point costs at most
         :data:`MAX_SECONDS_PER_POINT` by the cost estimate).
+
+    Examples
+    --------
+    >>> import numpy as np, manakov
+    >>> tau = np.array([[0.3 + 1.1j, 0.1 + 0.4j], [0.1 + 0.4j, -0.2 + 1.3j]])
+    >>> value, grad, hess = manakov.theta_jet([0.2 + 0.1j, 0.7 - 0.3j], tau)
+    >>> grad.shape, hess.shape
+    ((2,), (2, 2))
+    >>> print(np.round(grad, 8))
+    [-0.04503725+0.06662608j  0.26901073-1.04891769j]
     """
     z2, tau_a, lead, g = _prepare(z, tau)
     vals, grad, hess, log = _jet(z2, tau_a, lead, g, tol, 2, not log_scale, parallel)

@@ -87,6 +87,15 @@ def to_matrix(l: Any) -> np.ndarray:
     ------
     ValueError
         A last axis that is not ``n(n-1)/2``, complex or non-finite values.
+
+    Examples
+    --------
+    >>> import manakov
+    >>> print(manakov.to_matrix([1, 2, 3, 4, 5, 6]))
+    [[ 0.  1.  2.  3.]
+     [-1.  0.  4.  5.]
+     [-2. -4.  0.  6.]
+     [-3. -5. -6.  0.]]
     """
     arr = _float_array(l, "l")
     if arr.ndim == 0:
@@ -116,6 +125,13 @@ def from_matrix(m: Any, *, check: bool = True) -> np.ndarray:
     ------
     ValueError
         Not square, complex or non-finite values, or (with ``check``) not skew.
+
+    Examples
+    --------
+    >>> import manakov
+    >>> m = manakov.to_matrix([1, 2, 3, 4, 5, 6])
+    >>> print(manakov.from_matrix(m))
+    [1. 2. 3. 4. 5. 6.]
     """
     arr = _float_array(m, "m")
     if arr.ndim < 2 or arr.shape[-1] != arr.shape[-2]:
@@ -151,6 +167,13 @@ def poisson_tensor(l: Any) -> np.ndarray:
     ------
     ValueError
         A last axis that is not ``n(n-1)/2`` (n >= 2), complex or non-finite values.
+
+    Examples
+    --------
+    >>> import numpy as np, manakov
+    >>> P = manakov.poisson_tensor([0.8, -0.3, 0.5, 1.1, -0.7, 0.2])
+    >>> P.shape, bool(np.allclose(P, -P.T))
+    ((6, 6), True)
     """
     arr = _float_array(l, "l")
     if arr.ndim == 0:

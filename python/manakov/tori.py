@@ -325,6 +325,16 @@ def frequency_map(
         :class:`FrequencyMap` of the full shape whose other states have status
         :data:`NOT_COMPUTED` and NaN frequencies; so does any other exception
         raised during the map (the ``progress`` callable's, a lost cluster).
+
+    Examples
+    --------
+    >>> import manakov
+    >>> from manakov.tori import casimir_slice
+    >>> p = manakov.problem("generic")
+    >>> top = manakov.ManakovTop(p.a, p.b)
+    >>> fm = manakov.frequency_map(top, casimir_slice(p.l0, 8)[2])
+    >>> fm.nu.shape, fm.counts()
+    ((8, 8, 2), {'ok': 64})
     """
     a = np.ascontiguousarray(np.asarray(top.a, dtype=float))
     b = np.ascontiguousarray(np.asarray(top.b, dtype=float))
@@ -392,6 +402,14 @@ def casimir_slice(l0: Any, grid: int) -> tuple[np.ndarray, np.ndarray, np.ndarra
     cos_theta : ndarray, shape (grid,)
     states : ndarray, shape (grid, grid, 6)
         ``states[i, j]`` at ``cos ϑ = cos_theta[i]``, ``φ = phi[j]``.
+
+    Examples
+    --------
+    >>> import manakov
+    >>> from manakov.tori import casimir_slice
+    >>> phi, cos_theta, states = casimir_slice(manakov.problem("generic").l0, 8)
+    >>> states.shape
+    (8, 8, 6)
     """
     x = _one_state(l0, 6, "l0", "casimir_slice")
     if isinstance(grid, bool) or not isinstance(grid, (int, np.integer)) or grid < 2:
