@@ -27,6 +27,14 @@ class Torus(NamedTuple):
         Their lattice coordinates ``(m1, m2, n1, n2)``, ``λ = m + τ n``.
     frequencies : ndarray, shape (2,)
         ``(ν1, ν2) ≥ 0`` with ``U = ν1 λ1 + ν2 λ2`` (cycles per unit time).
+
+    Examples
+    --------
+    >>> import manakov
+    >>> p = manakov.problem("generic")
+    >>> torus = manakov.ManakovTop(p.a, p.b).solve(p.l0).torus
+    >>> print(torus.frequencies.round(6), round(torus.rotation_number, 6))
+    [0.264922 0.278362] 0.951716
     """
 
     lambdas: np.ndarray

@@ -140,6 +140,15 @@ class Wurzel:
     Pjk : ndarray, complex, shape (..., 5, 5)
         ``P_jk = P_j P_k/(z1 - z2) (y1/((z1 - d_j)(z1 - d_k)) - y2/((z2 - d_j)(z2 - d_k)))``
         (28); symmetric, zero diagonal.
+
+    Examples
+    --------
+    >>> import manakov
+    >>> curve = manakov.KotterCurve(1.0 + 0.5j, 2.0 - 0.3j, -1.5 + 0.2j)
+    >>> z1, z2 = 0.3 + 0.2j, -1.0 + 0.7j
+    >>> w = curve.wurzel(z1, curve.y(z1), z2, curve.y(z2, sheet=-1))
+    >>> w.P.shape, w.Pjk.shape
+    ((5,), (5, 5))
     """
 
     P: np.ndarray
@@ -170,6 +179,17 @@ class CurvePoints:
         ``curve.xi_eta(..., zd=pts.zd)`` or ``curve.wurzel(..., zd=pts.zd)`` to keep
         that accuracy for points close to a branch point, where the bare ``z_i``
         fix ``z_i - d_j`` only to ``u |z_i|``.
+
+    Examples
+    --------
+    >>> import manakov
+    >>> curve = manakov.KotterCurve(1.0 + 0.5j, 2.0 - 0.3j, -1.5 + 0.2j)
+    >>> z1, z2 = 0.3 + 0.2j, -1.0 + 0.7j
+    >>> y1, y2 = curve.y(z1), curve.y(z2, sheet=-1)
+    >>> xi, eta = curve.xi_eta(z1, y1, z2, y2, 1.2)
+    >>> pts = curve.points_from_wurzel(xi, eta, g_ref=1.2)
+    >>> print(sorted([round(complex(pts.z1).real, 9), round(complex(pts.z2).real, 9)]))
+    [-1.0, 0.3]
     """
 
     z1: Any
@@ -204,6 +224,16 @@ class KotterCurve:
     ``(j, k, l)`` cyclic in ``(1, 2, 3)``, hold for :meth:`wurzel` in every
     branch ``eps``, except that the right-hand side of (29) carries the factor
     :attr:`kappa` ``= prod_{m=1}^3 (d_m - d_4)`` (see ``docs/errata.md``).
+
+    Examples
+    --------
+    >>> import numpy as np, manakov
+    >>> curve = manakov.KotterCurve(1.0 + 0.5j, 2.0 - 0.3j, -1.5 + 0.2j)
+    >>> print(np.round(curve.branch_points, 6))
+    [ 0.   +0.j    1.   +0.5j   2.   -0.3j  -1.5  +0.2j  -3.365-0.62j]
+    >>> z = 0.3 + 0.2j
+    >>> bool(abs(curve.y(z) ** 2 - curve.R(z)) < 1e-14)
+    True
     """
 
     __slots__ = ("_d", "_c", "_ct", "_kappa", "_surface")

@@ -166,6 +166,14 @@ class FluidTrajectory:
         The largest step (Gauss methods) or the initial step (explicit; 0 = automatic).
     steps, evals : int
         Steps taken and vector-field evaluations.
+
+    Examples
+    --------
+    >>> import manakov
+    >>> pr = manakov.fluid_problem("clebsch_generic")
+    >>> tr = pr.body.integrate(pr.M0, pr.p0, 10.0, sample_every=1.0)
+    >>> tr.M.shape, tr.p.shape, max(tr.max_drift().values()) < 1e-13
+    ((11, 3), (11, 3), True)
     """
 
     t: np.ndarray
@@ -219,6 +227,15 @@ class SpaceTrajectory:
     method : str
     dt : float
     steps, evals : int
+
+    Examples
+    --------
+    >>> import numpy as np, manakov
+    >>> pr = manakov.fluid_problem("clebsch_generic")
+    >>> sp = pr.body.motion_in_space(pr.M0, pr.p0, 5.0, sample_every=0.5)
+    >>> P = sp.impulse()
+    >>> sp.x.shape, bool(np.abs(P - P[0]).max() < 1e-12)
+    ((11, 3), True)
     """
 
     t: np.ndarray
@@ -267,6 +284,18 @@ class KirchhoffBody:
     constructors :meth:`clebsch`, :meth:`kirchhoff`, :meth:`lyapunov_steklov`
     build them from their parameters and add their extra integral to
     :meth:`integrals`.
+
+    Examples
+    --------
+    >>> import manakov
+    >>> import numpy as np
+    >>> A, C = np.diag([0.7, 1.3, 2.2]), np.diag([3.216, 2.424, 2.046])
+    >>> body = manakov.KirchhoffBody(A, np.zeros((3, 3)), C)
+    >>> body.case
+    'clebsch'
+    >>> ints = body.integrals([0.4, -0.7, 0.9], [0.8, 0.3, -0.5])
+    >>> print({k: round(float(v), 6) for k, v in ints.items()})
+    {'pp': 0.98, 'Mp': -0.34, 'H': 2.65945, 'F': 1.6142}
     """
 
     def __init__(self, A: Any, B: Any, C: Any) -> None:
@@ -961,6 +990,16 @@ class ClebschSolution:
     body : KirchhoffBody
         A Clebsch body.
     M0, p0 : array_like, shape (3,)
+
+    Examples
+    --------
+    >>> import numpy as np, manakov
+    >>> pr = manakov.fluid_problem("clebsch_generic")
+    >>> sol = pr.body.solve(pr.M0, pr.p0)
+    >>> print(np.round(sol.M(0.0), 12), np.round(sol.p(0.0), 12))
+    [ 0.4 -0.7  0.9] [ 0.8  0.3 -0.5]
+    >>> print(sol.frequencies.round(6))
+    [0.39201  0.199898]
     """
 
     __slots__ = ("_body", "_M0", "_p0", "_solution")
@@ -1159,7 +1198,15 @@ def _sample_times(t_end: Any, t_eval: Any, sample_every: Any) -> np.ndarray:
 
 
 class FluidProblem(NamedTuple):
-    """A reference body in an ideal fluid with an initial state."""
+    """A reference body in an ideal fluid with an initial state.
+
+    Examples
+    --------
+    >>> import manakov
+    >>> pr = manakov.fluid_problem("clebsch_generic")
+    >>> pr.name, pr.body.case
+    ('clebsch_generic', 'clebsch')
+    """
 
     name: str
     body: KirchhoffBody

@@ -21,7 +21,15 @@ __all__ = ["Problem", "as_problem", "problem", "problem_names", "read_problem", 
 
 
 class Problem(NamedTuple):
-    """A reference top: Manakov parameters ``a``, ``b`` (2) and initial state ``l0``."""
+    """A reference top: Manakov parameters ``a``, ``b`` (2) and initial state ``l0``.
+
+    Examples
+    --------
+    >>> import manakov
+    >>> p = manakov.problem("generic")
+    >>> p.name, p.a.shape, p.b.shape, p.l0.shape
+    ('generic', (4,), (4,), (6,))
+    """
 
     name: str
     a: np.ndarray

@@ -362,6 +362,16 @@ class Kotter:
         ``near_degenerate`` top a point comes within 4e-9 of ``d_1``);
         :func:`from_kotter` uses ``zd`` when it is not ``None``. Set it to
         ``None`` when replacing ``z1`` or ``z2``.
+
+    Examples
+    --------
+    >>> import manakov
+    >>> p = manakov.problem("generic")
+    >>> k = manakov.kotter(p.a, p.b, p.l0)
+    >>> print(k.h.round(6))
+    [ 0.5     2.72   10.878   7.3026]
+    >>> print(round(k.z1.real, 6), round(k.z2.real, 6))
+    -2.087489 0.002384
     """
 
     h: np.ndarray

@@ -85,6 +85,16 @@ class HyperellipticCurve:
     between branch points, chosen to keep the other branch points far from
     each segment; it does not depend on the branch points being real or
     sorted (``docs/riemann.md`` has a picture).
+
+    Examples
+    --------
+    >>> import numpy as np, manakov
+    >>> e = [-1.3 + 0.2j, -0.4 - 0.7j, 0.3 + 0.5j, 1.1 - 0.1j, 2.0 + 0.9j]
+    >>> C = manakov.HyperellipticCurve(e)
+    >>> C.genus, C.base_point
+    (2, 'infinity')
+    >>> bool(np.allclose(C.tau, C.tau.T)), bool(np.all(np.linalg.eigvalsh(C.tau.imag) > 0))
+    (True, True)
     """
 
     __slots__ = ("_core", "_e")

@@ -92,6 +92,14 @@ class EulerMotion(NamedTuple):
     m, m1, omega : float
         The parameter ``m = k²``, ``1 − m`` and ``ω`` of
         ``M_b = X sn(ωt + u0 | m)`` (normalized time).
+
+    Examples
+    --------
+    >>> import manakov
+    >>> p = manakov.problem("generic")
+    >>> sol = manakov.ManakovTop(p.a, p.b).solve([0.7, -0.2, 0.0, 0.6, 0.0, 0.0])
+    >>> sol.kind, sol.euler.subalgebra, sol.euler.regime
+    ('euler', 'block 123', 'elliptic')
     """
 
     subalgebra: str
@@ -156,6 +164,18 @@ class Solution:
 
     Attributes that exist for one kind only (the genus-2 ones, :attr:`euler`)
     raise ``AttributeError`` naming the kind on the others.
+
+    Examples
+    --------
+    >>> import numpy as np, manakov
+    >>> p = manakov.problem("generic")
+    >>> sol = manakov.ManakovTop(p.a, p.b).solve(p.l0)
+    >>> sol.kind
+    'genus2'
+    >>> bool(np.abs(sol.l(0.0) - p.l0).max() < 1e-12)
+    True
+    >>> print(sol.frequencies.round(6))
+    [0.264922 0.278362]
     """
 
     __slots__ = ("_a", "_b", "_l0", "_motion", "_core", "_curve", "_torus", "_freq")

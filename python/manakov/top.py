@@ -196,6 +196,15 @@ class FrahmTop:
     ------
     ValueError
         If ``c`` is not square, not finite, not symmetric, or ``n < 3``.
+
+    Examples
+    --------
+    >>> import numpy as np, manakov
+    >>> c = np.array([[0, 1, 2, 3], [1, 0, 4, 5], [2, 4, 0, 6], [3, 5, 6, 0]], dtype=float)
+    >>> top = manakov.FrahmTop(c)
+    >>> tr = top.integrate([0.8, -0.3, 0.5, 1.1, -0.7, 0.2], 10.0, sample_every=1.0)
+    >>> tr.l.shape, max(tr.max_drift().values()) < 1e-13
+    ((11, 6), True)
     """
 
     def __init__(self, c: Any) -> None:
@@ -642,6 +651,16 @@ class ManakovTop(FrahmTop):
     given doubles when ``a_i``, ``a_j`` are close (Sterbenz's lemma); the
     loss of digits in the near-degenerate case is the conditioning of (2),
     ``|a_i| / |a_i - a_j|``, applied to the rounding of the inputs.
+
+    Examples
+    --------
+    >>> import manakov
+    >>> top = manakov.ManakovTop([0.3, 1.1, 2.0, 3.7], [0.5, -0.2, 1.4, 0.9])
+    >>> print(round(top.c[0, 1], 6))  # c_12 = (b_1 - b_2)/(a_1 - a_2)  (2)
+    -0.875
+    >>> ints = top.integrals([0.8, -0.3, 0.5, 1.1, -0.7, 0.2])
+    >>> print({k: round(float(v), 6) for k, v in ints.items()})
+    {'H0': 0.5, 'H1': 2.72, 'H2': 10.878, 'H3': 7.3026, 'H': 0.931856}
     """
 
     def __init__(self, a: Any, b: Any) -> None:

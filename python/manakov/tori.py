@@ -125,6 +125,15 @@ class FrequencyMap(NamedTuple):
     status : ndarray, uint8, shape (...)
         A code of :data:`STATUS_NAMES` per state (:data:`NOT_COMPUTED` only in
         the ``err.partial`` of an interrupted map).
+
+    Examples
+    --------
+    >>> import manakov
+    >>> from manakov.tori import casimir_slice
+    >>> p = manakov.problem("generic")
+    >>> fm = manakov.frequency_map(manakov.ManakovTop(p.a, p.b), casimir_slice(p.l0, 4)[2])
+    >>> fm.nu.shape, fm.status.shape, fm.counts()
+    ((4, 4, 2), (4, 4), {'ok': 16})
     """
 
     nu: np.ndarray
