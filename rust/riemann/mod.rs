@@ -45,6 +45,7 @@ mod constant;
 mod invert;
 mod many;
 mod periods;
+mod periods_dd;
 
 pub use invert::INVERT_MAX_RESIDUAL;
 pub use many::AbelRoute;
