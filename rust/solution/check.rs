@@ -159,7 +159,7 @@ impl SelfCheck {
         }
         let tau = curve.tau_row_major();
         let at = |t: f64| -> [C; 2] {
-            let ph = |a: f64, r: f64| phase_mod2(a, r, t);
+            let ph = |a: f64, r: f64| phase_mod2(a, r, 0.0, t);
             let x = [ph(x0[0], xr[0]), ph(x0[1], xr[1])];
             let y = [ph(y0[0], yr[0]), ph(y0[1], yr[1])];
             [

@@ -46,6 +46,7 @@ use crate::theta::{char_index, LatticeLanes, SelectedBlock, ThetaJet, ThetaPlan,
 
 mod check;
 pub mod constant;
+pub mod dubrovin;
 pub mod euler;
 pub mod jacobi;
 mod level_set;
@@ -105,6 +106,12 @@ pub struct Solution {
     lat0: [f64; 4],
     /// `X, Y` of `U = X + τ Y`.
     lat_rate: [f64; 4],
+    /// Their rounding errors: `lat_rate + lat_rate_lo` is `X, Y` in DD, so
+    /// that the phase keeps its digits at large `t` ([`phase_mod2`]).
+    lat_rate_lo: [f64; 4],
+    /// The sign of the closed-form velocities ([`dubrovin`]) in this
+    /// solution's convention.
+    v_sign: f64,
     /// Theta indices (FLINT order): `θ`, then the seven labels.
     idx: [usize; 8],
     /// Characteristics `(a, b)` of the seven labels.
@@ -126,11 +133,13 @@ fn singular(kind: SingularKind, reason: String) -> Error {
     }
 }
 
-/// `x + X t` reduced to `[−1, 1]` modulo 2 with `X t` split error-free.
+/// `x + X t` reduced to `[−1, 1]` modulo 2 with `X t` split error-free,
+/// `X = rate + rate_lo` in double-double (the second product needs no
+/// precision: it is below an ulp of the first).
 #[inline(always)]
-fn phase_mod2(x0: f64, rate: f64, t: f64) -> f64 {
+fn phase_mod2(x0: f64, rate: f64, rate_lo: f64, t: f64) -> f64 {
     let p = rate * t;
-    let e = rate.mul_add(t, -p);
+    let e = rate.mul_add(t, -p) + rate_lo * t;
     // p − 2 round(p/2) is exact (|result| ≤ 1 and both are multiples of ulp(p)).
     let r = crate::theta::rem2(p);
     crate::theta::rem2(x0 + r + e)
@@ -190,16 +199,35 @@ impl Solution {
         let est0 = at_v0.votes().then(|| est.map(|r| r * r));
         let c2 = aux_constants_squared(&curve, &state0.curve, &plan, &idx, &rc, est0)?;
         let (cl0, calibration) = signed_constants(&c2, &est);
+        // U in closed form (Dubrovin's equations at the half periods,
+        // [`dubrovin`]), with its lattice coordinates in DD and the real
+        // structure imposed: one for every sign pattern of the C_L below. Where
+        // it refuses (none known), U is the theta quotients' fit at v0.
+        let closed = dubrovin::half_period_velocities(&kotter, l0, &[*b]).and_then(|hp| {
+            let e_lo = hp.branch_point_errors(&curve);
+            let lat = dubrovin::lattice_rates_dd(&curve, e_lo.as_ref().map(|e| &e[..]), &hp.v_dd)?;
+            Ok((hp.v[0], lat))
+        });
         // Every sign pattern of the constants that l0 leaves undecided is built
         // and checked (check.rs); the one that passes the self-check best is kept.
         let check = SelfCheck::new(a, l0, &c4);
         let build = |cl: [C; 7]| -> Result<(f64, Built)> {
             let big_g = at_v0.big_g(&state0, &sc, &cl, eps);
             let (num, den) = quotient_weights(&kotter, &sc, eps, big_g, &cl);
-            // U from (1) by least squares at v0 (see [`VelocitySystem`]); a set-up
-            // whose quotients fit (1) for no velocity is refused.
-            let (rate, residual) = VelocitySystem::at(&jet, &idx, &num, &den)?.rate(&c4, "U")?;
+            // The quotients' own velocity at v0 by least squares (see
+            // [`VelocitySystem`]): a set-up whose quotients fit (1) for no
+            // velocity, or for another one than the closed form, is refused;
+            // the fit gives the closed form its sign.
+            let (fit, residual) = VelocitySystem::at(&jet, &idx, &num, &den)?.rate(&c4, "U")?;
             check_velocity_fit(residual)?;
+            let rate = match &closed {
+                Ok((v, lat)) => {
+                    let (s, dev) = dubrovin::sign_against(&curve, v, &fit);
+                    dubrovin::check_against_fit(dev)?;
+                    lat.u[0].map(|z| s * z)
+                }
+                Err(_) => fit,
+            };
             let built = Built { cl, num, den, rate };
             Ok((check.defect(&plan, &curve, &idx, &built, &v0)?, built))
         };
@@ -233,7 +261,21 @@ impl Solution {
             });
         }
         let (x0, y0) = curve.lattice_coordinates(&v0);
-        let (xr, yr) = curve.lattice_coordinates(&rate);
+        let (lat_rate, lat_rate_lo, v_sign) = match &closed {
+            Ok((_, lat)) => {
+                let u = lat.u[0];
+                let s = if (u[0].conj() * rate[0] + u[1].conj() * rate[1]).re >= 0.0 {
+                    1.0
+                } else {
+                    -1.0
+                };
+                (lat.w[0].map(|x| s * x), lat.w_lo[0].map(|x| s * x), s)
+            }
+            Err(_) => {
+                let (xr, yr) = curve.lattice_coordinates(&rate);
+                ([xr[0], xr[1], yr[0], yr[1]], [0.0; 4], 1.0)
+            }
+        };
         Ok(Solution {
             a: *a,
             c4,
@@ -247,7 +289,9 @@ impl Solution {
             u0,
             rate,
             lat0: [x0[0], x0[1], y0[0], y0[1]],
-            lat_rate: [xr[0], xr[1], yr[0], yr[1]],
+            lat_rate,
+            lat_rate_lo,
+            v_sign,
             idx,
             chars,
             cl,
@@ -304,6 +348,21 @@ impl Solution {
         let jet = self.plan.jet(&v0, 1)?;
         let sys = VelocitySystem::at(&jet, &self.idx, &self.num, &self.den)?;
         c4s.iter().map(|c4| sys.rate(c4, "U'")).collect()
+    }
+
+    /// The velocities `U` of the Manakov flows `ManakovTop(a, b)` for each
+    /// `b` in `bs` on this level set, in closed form ([`dubrovin`]) and in
+    /// this solution's sign convention, with their lattice coordinates (the
+    /// real structure imposed). For the solution's own `b` this is `U`.
+    pub fn closed_rates(&self, bs: &[[f64; 4]]) -> Result<dubrovin::LatticeRates> {
+        let hp = dubrovin::half_period_velocities(&self.kotter, &self.l0, bs)?;
+        let v: Vec<_> = hp
+            .v_dd
+            .iter()
+            .map(|z| z.map(|x| x.mul_f64(self.v_sign)))
+            .collect();
+        let e_lo = hp.branch_point_errors(&self.curve);
+        dubrovin::lattice_rates_dd(&self.curve, e_lo.as_ref().map(|e| &e[..]), &v)
     }
 
     /// `τ`, row-major.
@@ -406,12 +465,12 @@ impl Solution {
     pub fn lattice_reduced(&self, t: f64) -> ([f64; 2], [f64; 2]) {
         (
             [
-                phase_mod2(self.lat0[0], self.lat_rate[0], t),
-                phase_mod2(self.lat0[1], self.lat_rate[1], t),
+                phase_mod2(self.lat0[0], self.lat_rate[0], self.lat_rate_lo[0], t),
+                phase_mod2(self.lat0[1], self.lat_rate[1], self.lat_rate_lo[1], t),
             ],
             [
-                phase_mod2(self.lat0[2], self.lat_rate[2], t),
-                phase_mod2(self.lat0[3], self.lat_rate[3], t),
+                phase_mod2(self.lat0[2], self.lat_rate[2], self.lat_rate_lo[2], t),
+                phase_mod2(self.lat0[3], self.lat_rate[3], self.lat_rate_lo[3], t),
             ],
         )
     }
@@ -511,8 +570,13 @@ impl Solution {
         tt[..t.len()].copy_from_slice(t);
         for k in 0..2 {
             for (p, &t) in tt.iter().enumerate() {
-                lanes.x[k][p] = phase_mod2(self.lat0[k], self.lat_rate[k], t);
-                lanes.y[k][p] = phase_mod2(self.lat0[2 + k], self.lat_rate[2 + k], t);
+                lanes.x[k][p] = phase_mod2(self.lat0[k], self.lat_rate[k], self.lat_rate_lo[k], t);
+                lanes.y[k][p] = phase_mod2(
+                    self.lat0[2 + k],
+                    self.lat_rate[2 + k],
+                    self.lat_rate_lo[2 + k],
+                    t,
+                );
             }
         }
     }
