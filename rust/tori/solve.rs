@@ -4,16 +4,18 @@
 //! characteristics):
 //!
 //! * [`level_set_flow_data`] (the frequency map): the reduction's constants,
-//!   the curve (8) and its periods, and the velocities of both flows by the
-//!   chain rule at auxiliary divisors ([`crate::solution::velocity`]). No
-//!   theta function, no divisor of `l0`, no Abel map: the frequencies are a
-//!   property of the level set. Where the divisors do not agree on the
-//!   velocities (none known), the state takes the second route.
-//! * [`flow_data`] on a [`Solution`] (`sol.torus`): `U` from the solution's
-//!   theta-side fit at `v0`, `U'` from the same equations.
+//!   the curve (8) and its periods, and the velocities of both flows in closed
+//!   form ([`crate::solution::dubrovin`]: Dubrovin's equations at the half
+//!   periods; where they refuse, none known, the chain rule at auxiliary
+//!   divisors of [`crate::solution::velocity`]). No theta function, no divisor
+//!   of `l0`, no Abel map: the frequencies are a property of the level set.
+//!   Where neither gives the velocities, the state takes the second route.
+//! * [`flow_data`] on a [`Solution`] (`sol.torus`): the solution's `U` and the
+//!   closed form of `U'` in the solution's sign convention, each checked
+//!   against the theta quotients' fit at `v0`.
 //!
-//! They agree to the accuracy of the level-set constants (~1e-13 relative on
-//! the shared tops; `tests/test_tori_solution.py`, `tori::tests`).
+//! Both take the same closed form on the same curve, so they agree to the
+//! last bits (`tests/data/closed_u_frequencies.py`).
 
 use num_complex::Complex64 as C;
 
@@ -21,6 +23,9 @@ use super::{frequencies_of_state, second_flow_b, Char, FlowData, MapEntry, RealT
 use crate::error::{Error, Result, SingularKind};
 use crate::numeric::cancel::Cancel;
 use crate::so4;
+use crate::solution::dubrovin::{
+    half_period_velocities, lattice_rates_dd, CLOSED_FORM, CLOSED_VS_FIT_RTOL,
+};
 use crate::solution::velocity::algebraic_rates;
 use crate::solution::{a_periods_of, level_set_curve, Solution};
 
@@ -56,10 +61,28 @@ pub fn flow_data(sol: &Solution, b2: &[f64; 4]) -> Result<FlowData> {
             ),
         });
     }
+    // The velocity itself in closed form (the solution's sign convention),
+    // which the fit must reproduce.
+    let u2_closed = sol.closed_rates(&[*b2])?.u[0];
+    let dev = (u2_closed[0] - u2[0])
+        .norm()
+        .max((u2_closed[1] - u2[1]).norm())
+        / u2[0].norm().max(u2[1].norm()).max(f64::MIN_POSITIVE);
+    if dev.is_nan() || dev > CLOSED_VS_FIT_RTOL {
+        return Err(Error::Singular {
+            what: INCONSISTENT,
+            kind: SingularKind::InconsistentQuotients,
+            reason: format!(
+                "the theta quotients (9)-(10) at v0 move along the second flow at a velocity \
+                 {dev:e} (relative) away from the closed form: the solution's set-up is wrong \
+                 at this state; its frequencies would be too"
+            ),
+        });
+    }
     Ok(FlowData {
         tau: [[t[0], t[1]], [t[2], t[3]]],
         u: sol.rate(),
-        u2,
+        u2: u2_closed,
         chars,
     })
 }
@@ -90,10 +113,11 @@ pub fn classify(e: &Error) -> Status {
 
 /// `τ`, `U`, `U'` and the characteristics from the level set of `l0` alone:
 /// the reduction's constants, the curve and its periods, and the velocities
-/// of the top `(a, b)` and of the second flow `(a, b2)` by the chain rule at
-/// auxiliary divisors. `U` and `U'` share one sign convention (that of
-/// [`algebraic_rates`]); the frequencies do not depend on it (the basis is
-/// oriented so that `ν ≥ 0`).
+/// of the top `(a, b)` and of the second flow `(a, b2)` in closed form
+/// ([`half_period_velocities`], the lattice coordinates in DD with the real
+/// structure imposed), or where that refuses by the chain rule at auxiliary
+/// divisors ([`algebraic_rates`]). `U` and `U'` share one sign convention; the
+/// frequencies do not depend on it (the basis is oriented so that `ν ≥ 0`).
 pub fn level_set_flow_data(
     a: &[f64; 4],
     b: &[f64; 4],
@@ -115,12 +139,21 @@ pub fn level_set_flow_data_c4(
 ) -> Result<FlowData> {
     let (c4, c2) = (*c4, *c2);
     let ls = level_set_curve(a, l0)?;
-    let alg = algebraic_rates(&ls.kotter, &ls.kcurve, &a_periods_of(&ls.curve), &[c4, c2])?;
+    let rates = match half_period_velocities(&ls.kotter, l0, &[*b, *b2]) {
+        Ok(hp) => {
+            let e_lo = hp.branch_point_errors(&ls.curve);
+            lattice_rates_dd(&ls.curve, e_lo.as_ref().map(|e| &e[..]), &hp.v_dd)?.u
+        }
+        Err(Error::InvalidArgument {
+            what: CLOSED_FORM, ..
+        }) => algebraic_rates(&ls.kotter, &ls.kcurve, &a_periods_of(&ls.curve), &[c4, c2])?.rates,
+        Err(e) => return Err(e),
+    };
     let t = ls.curve.tau_row_major();
     Ok(FlowData {
         tau: [[t[0], t[1]], [t[2], t[3]]],
-        u: alg.rates[0],
-        u2: alg.rates[1],
+        u: rates[0],
+        u2: rates[1],
         chars: ls
             .chars
             .iter()
