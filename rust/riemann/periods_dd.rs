@@ -21,9 +21,12 @@ use crate::numeric::dd::{Cdd, Dd};
 
 type C = Complex64;
 
-/// `ln(1/ε)` of the DD quadrature target, `ρ^{-2N} ≤ e^{-47}` ≈ 4e-21: the
-/// periods are wanted to ~1e-19, two digits below what the frequencies need.
-const TARGET_LN_DD: f64 = 47.0;
+/// `ln(1/ε)` of the DD quadrature target, `ρ^{-2N} ≤ e^{-41}` ≈ 1.6e-18, the
+/// double quadrature's: the lattice rates come out to ~1e-19 (measured against
+/// 60-digit mpmath periods: ≤ 1.4e-19 on 34 states; e^{-47} gave ≤ 1e-21 at
+/// ~15 % more nodes), a thousand times below their rounding to double, which
+/// is what the phase of `l(t)` needs.
+const TARGET_LN_DD: f64 = 41.0;
 
 /// π in double-double.
 const PI_DD: Dd = Dd {
@@ -92,21 +95,28 @@ fn cheb_rule_dd(n: usize) -> Option<&'static RuleDd> {
 
 /// `1/P` in DD, where `P² = Π_m w_m` and `p0` is `P` in double on the wanted
 /// branch: one Newton step `P = p0 + (Π w_m − p0²)/(2 p0)` (with `p0²` exact)
-/// doubles the digits of `p0` and keeps its branch.
+/// doubles the digits of `p0` and keeps its branch; then `1/P = q0 (1 + e)`,
+/// `q0 = 1/p0` in double and `e = 1 − P q0` from the exact products `p0 q0`
+/// (a DD division costs twice that).
 fn inv_root_product(ws: &[Cdd], p0: C) -> Cdd {
-    let prod = ws
-        .iter()
-        .fold(Cdd::new(C::new(1.0, 0.0)), |acc, w| acc.mul(*w));
+    let prod = ws[1..].iter().fold(ws[0], |acc, w| acc.mul(*w));
     let sq = Cdd {
         re: Dd::prod(p0.re, p0.re).sub(Dd::prod(p0.im, p0.im)),
         im: Dd::prod(p0.re, p0.im).mul_f64(2.0),
     };
     let corr = crate::numeric::complex::cdiv(prod.sub(sq).to_c(), 2.0 * p0);
-    let root = Cdd {
-        re: Dd::sum(p0.re, corr.re),
-        im: Dd::sum(p0.im, corr.im),
+    let q0 = crate::numeric::complex::cdiv(C::new(1.0, 0.0), p0);
+    // P q0 = p0 q0 + corr q0, the first exactly
+    let pq = Cdd {
+        re: Dd::prod(p0.re, q0.re).sub(Dd::prod(p0.im, q0.im)),
+        im: Dd::prod(p0.re, q0.im).add(Dd::prod(p0.im, q0.re)),
     };
-    root.recip()
+    let e = Cdd::new(C::new(1.0, 0.0)).sub(pq).to_c() - corr * q0;
+    let d = q0 * e;
+    Cdd {
+        re: Dd::sum(q0.re, d.re),
+        im: Dd::sum(q0.im, d.im),
+    }
 }
 
 /// Gauss–Legendre on `[0, 1]` in DD: the double nodes polished by one Newton
@@ -162,35 +172,6 @@ fn gl_rule_dd(n: usize) -> &'static GlDd {
         .position(|&m| m >= n)
         .unwrap_or(GL_LADDER.len() - 1);
     GL_RULES[i].get_or_init(|| gl_dd(GL_LADDER[i]))
-}
-
-/// Pieces of `[0, 1]` on which Gauss–Legendre with at most 64 nodes reaches
-/// `e^{−47}` given the singular points `sing` (as `quad::plan_pieces`, with
-/// the DD target).
-fn plan_pieces_dd(sing: &[C]) -> Option<Vec<quad::Piece>> {
-    let mut out = Vec::new();
-    let mut stack: Vec<(f64, f64)> = vec![(0.0, 1.0)];
-    while let Some((a, b)) = stack.pop() {
-        let (mid, half) = (0.5 * (a + b), 0.5 * (b - a));
-        let lr = sing
-            .iter()
-            .map(|&z| quad::log_rho((z - mid) / half))
-            .fold(f64::INFINITY, f64::min);
-        let n = (TARGET_LN_DD / (2.0 * lr)).ceil();
-        if n <= quad::GL_MAX as f64 {
-            out.push(quad::Piece {
-                a,
-                b,
-                n: (n as usize).max(4),
-            });
-        } else if out.len() + stack.len() >= 800 || half < 1e-17 {
-            return None;
-        } else {
-            stack.push((mid, b));
-            stack.push((a, mid));
-        }
-    }
-    Some(out)
 }
 
 /// The period matrices in DD: `a[i][j] = ∮_{a_j} x^i dx/y`, `b` likewise.
@@ -356,7 +337,8 @@ impl HyperellipticCurve {
                 [s, -s]
             })
             .collect();
-        let pieces = plan_pieces_dd(&sing)?;
+        let mut pieces = Vec::new();
+        quad::plan_pieces(&sing, &mut pieces).ok()?;
         let mut acc = vec![Cdd::ZERO; g];
         let mut ws = Vec::with_capacity(ms.len());
         for pc in &pieces {
@@ -446,8 +428,9 @@ mod tests {
             let halves = curve.edge_period_halves_dd(p, q, &lo).unwrap();
             for (a, b) in cheb.iter().zip(&halves) {
                 let d = a.sub(*b).to_c().norm();
-                // both quadratures stop at e^{-47} ≈ 4e-21 (TARGET_LN_DD)
-                assert!(d <= 1e-20 * a.to_c().norm(), "edge {p}-{q}: {d:e}");
+                // both quadratures stop at e^{-41} ≈ 1.6e-18 (TARGET_LN_DD);
+                // measured 2.1e-19
+                assert!(d <= 2e-18 * a.to_c().norm(), "edge {p}-{q}: {d:e}");
             }
         }
         let e2 = [

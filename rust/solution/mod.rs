@@ -92,6 +92,7 @@ pub const LABELS: [&str; 7] = ["P0", "P23", "P31", "P12", "P14", "P24", "P34"];
 #[derive(Debug)]
 pub struct Solution {
     a: [f64; 4],
+    b: [f64; 4],
     c4: [f64; 6],
     l0: [f64; 6],
     kotter: KotterConstants,
@@ -203,7 +204,7 @@ impl Solution {
         // [`dubrovin`]), with its lattice coordinates in DD and the real
         // structure imposed: one for every sign pattern of the C_L below. Where
         // it refuses (none known), U is the theta quotients' fit at v0.
-        let closed = dubrovin::half_period_velocities(&kotter, l0, &[*b]).and_then(|hp| {
+        let closed = dubrovin::half_period_velocities(&kotter, l0, &[*b], true).and_then(|hp| {
             let e_lo = hp.branch_point_errors(&curve);
             let lat = dubrovin::lattice_rates_dd(&curve, e_lo.as_ref().map(|e| &e[..]), &hp.v_dd)?;
             Ok((hp.v[0], lat))
@@ -278,6 +279,7 @@ impl Solution {
         };
         Ok(Solution {
             a: *a,
+            b: *b,
             c4,
             l0: *l0,
             kotter,
@@ -310,6 +312,11 @@ impl Solution {
     /// The parameters `a`.
     pub fn a(&self) -> &[f64; 4] {
         &self.a
+    }
+
+    /// The parameters `b`.
+    pub fn b(&self) -> &[f64; 4] {
+        &self.b
     }
 
     /// The Manakov `c_ij` (2), state order.
@@ -354,14 +361,22 @@ impl Solution {
     /// `b` in `bs` on this level set, in closed form ([`dubrovin`]) and in
     /// this solution's sign convention, with their lattice coordinates (the
     /// real structure imposed). For the solution's own `b` this is `U`.
-    pub fn closed_rates(&self, bs: &[[f64; 4]]) -> Result<dubrovin::LatticeRates> {
-        let hp = dubrovin::half_period_velocities(&self.kotter, &self.l0, bs)?;
+    /// `dd`: the closed form and the periods in double-double on the unrounded
+    /// curve (`X, Y` to ~1e-19, as the solution's own phase), else in double
+    /// with the curve's double periods (to ~1e-15, as the frequency map: a few
+    /// times cheaper).
+    pub fn closed_rates(&self, bs: &[[f64; 4]], dd: bool) -> Result<dubrovin::LatticeRates> {
+        let hp = dubrovin::half_period_velocities(&self.kotter, &self.l0, bs, dd)?;
         let v: Vec<_> = hp
             .v_dd
             .iter()
             .map(|z| z.map(|x| x.mul_f64(self.v_sign)))
             .collect();
-        let e_lo = hp.branch_point_errors(&self.curve);
+        let e_lo = if dd {
+            hp.branch_point_errors(&self.curve)
+        } else {
+            None
+        };
         dubrovin::lattice_rates_dd(&self.curve, e_lo.as_ref().map(|e| &e[..]), &v)
     }
 

@@ -61,9 +61,13 @@ pub fn flow_data(sol: &Solution, b2: &[f64; 4]) -> Result<FlowData> {
             ),
         });
     }
-    // The velocity itself in closed form (the solution's sign convention),
-    // which the fit must reproduce.
-    let u2_closed = sol.closed_rates(&[*b2])?.u[0];
+    // The velocities themselves in closed form (the solution's sign
+    // convention) with the curve's double periods, as the frequency map takes
+    // them (the same numbers, so the two routes give the same frequencies);
+    // the fit must reproduce the second flow's.
+    let b = sol.b();
+    let lat = sol.closed_rates(&[*b, *b2], false)?;
+    let (u, u2_closed) = (lat.u[0], lat.u[1]);
     let dev = (u2_closed[0] - u2[0])
         .norm()
         .max((u2_closed[1] - u2[1]).norm())
@@ -81,7 +85,7 @@ pub fn flow_data(sol: &Solution, b2: &[f64; 4]) -> Result<FlowData> {
     }
     Ok(FlowData {
         tau: [[t[0], t[1]], [t[2], t[3]]],
-        u: sol.rate(),
+        u,
         u2: u2_closed,
         chars,
     })
@@ -139,11 +143,11 @@ pub fn level_set_flow_data_c4(
 ) -> Result<FlowData> {
     let (c4, c2) = (*c4, *c2);
     let ls = level_set_curve(a, l0)?;
-    let rates = match half_period_velocities(&ls.kotter, l0, &[*b, *b2]) {
-        Ok(hp) => {
-            let e_lo = hp.branch_point_errors(&ls.curve);
-            lattice_rates_dd(&ls.curve, e_lo.as_ref().map(|e| &e[..]), &hp.v_dd)?.u
-        }
+    // In double with the curve's double periods: frequencies to ~1e-15 (the
+    // DD of the solution's phase would cost about as much as the rest of the
+    // state), and `flow_data` takes the same numbers.
+    let rates = match half_period_velocities(&ls.kotter, l0, &[*b, *b2], false) {
+        Ok(hp) => lattice_rates_dd(&ls.curve, None, &hp.v_dd)?.u,
         Err(Error::InvalidArgument {
             what: CLOSED_FORM, ..
         }) => algebraic_rates(&ls.kotter, &ls.kcurve, &a_periods_of(&ls.curve), &[c4, c2])?.rates,
