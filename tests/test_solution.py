@@ -381,9 +381,7 @@ def test_closed_form_identities_hold_in_the_reference(a, b, l0) -> None:
 def test_U_is_the_closed_form_of_the_reference(a, b, l0) -> None:
     sol = manakov.ManakovTop(a, b).solve(l0)
     c = sol.curve
-    w, _, _ = closed_ref.exact_rates(
-        a, b, l0, c.cycle_edges, c.symplectic_basis, c.cycle_periods
-    )
+    w, _, _ = closed_ref.exact_rates(a, b, l0, c.cycle_edges, c.symplectic_basis, c.cycle_periods)
     x = np.array([float(t) for t in w])
     u_ref = x[:2] + sol.tau @ x[2:]
     # the reference fixes no sign (the involution); the package's is that of the motion
