@@ -20,15 +20,19 @@
 //!   `D(v) = θ(v) − ε C_0 θ_0(v)`;
 //! * (23): `l` is linear in `ξ, η`, hence `l_q(v) = N_q(v)/D(v)` with
 //!   `N_q` a fixed combination of six theta functions — (9)–(10) as they truly read;
-//! * `U` from the equations of motion: `d l/dt = (1)` at `v0` and
-//!   `d l/dt = (∇N_q − l_q ∇D)·U / D`, a 6 × 2 complex linear system solved
-//!   by least squares (theta gradients at `v0`).
+//! * `U` in closed form ([`dubrovin`]): Dubrovin's equations at the half
+//!   periods `d_0 + d_p`, where the state and its derivative along the flow are
+//!   explicit, give `V = A U` from the level-set constants; its lattice
+//!   coordinates in double-double (periods in DD on the unrounded curve) with
+//!   the real structure imposed. Its sign, and a guard, from the quotients' own
+//!   velocity at `v0`: `d l/dt = (∇N_q − l_q ∇D)·U / D = (1)`, a 6 × 2 complex
+//!   linear system solved by least squares (theta gradients at `v0`).
 //!
 //! Evaluation at large `t`: `v = x + τ y` with real lattice coordinates
 //! `x(t) = x0 + X t`, `y(t) = y0 + Y t`, reduced modulo 2 (an even lattice
 //! vector multiplies every `θ[χ]` by one common factor, so the quotients are
-//! exact); the products `X t`, `Y t` are split error-free (fma), so the phase
-//! keeps its digits at `t = 10^6`.
+//! exact); the products `X t`, `Y t` are split error-free (fma) and `X, Y`
+//! carried in double-double, so the phase keeps its digits at `t = 10^6`.
 
 use nalgebra::{DMatrix, DVector};
 use num_complex::Complex64;
