@@ -272,14 +272,15 @@ def frequency_map(
     reduction's constants (19)–(26), (40)–(41), the curve (8) and its period
     matrix ``τ``, the characteristics of ``l``, and the velocities ``U`` of
     the top and ``U'`` of a second commuting flow (the Manakov top with
-    ``b'`` of :func:`second_flow_b`), both by the chain rule of (1) through
-    ``l`` as a function of a divisor (27)–(28), (37), (42), (23), taken at
-    auxiliary divisors (docs/theorem.md, docs/tori.md §2). No theta function
-    and no Abel map of ``l0`` enter. Then ``U = ν1 λ1 + ν2 λ2`` on the
-    reduced basis of :func:`real_torus` (:func:`torus_of_state` and
-    ``sol.torus`` give the same torus through the Theorem's solution; the
-    frequencies agree to 2.4e-15 (median) and 4e-12 (max) relative on the
-    100 random states of ``tests/data/tori_naff_random100.py``).
+    ``b'`` of :func:`second_flow_b`), both in closed form from Dubrovin's
+    equations at the half periods ``d_0 + d_p`` of the curve, where ``l`` as a
+    function of a divisor (27)–(28), (37), (42), (23) and its rate under (1) are
+    explicit (docs/theorem.md, docs/tori.md §2). No theta function and no Abel
+    map of ``l0`` enter. Then ``U = ν1 λ1 + ν2 λ2`` on the reduced basis of
+    :func:`real_torus` (:func:`torus_of_state` and ``sol.torus`` give the same
+    torus through the Theorem's solution, from the same closed form: the
+    frequencies are equal to the last bit on the 10^4 states of
+    ``tests/data/closed_u_frequencies.py``).
 
     Each state is first normalized and classified, as :meth:`ManakovTop.solve`
     does (docs/degenerate.md): an exactly self-dual or so(3)-block state (an
@@ -319,8 +320,9 @@ def frequency_map(
         (``h1² = 4h0²``, coinciding branch points, ...) gets its code of
         :data:`STATUS_NAMES` and NaN frequencies; no exception is raised for it.
         (Codes 3, 10 and 11 belong to the solution's route, ``sol.torus``; the
-        map meets them only where it falls back on that route, when the
-        auxiliary divisors do not agree; no such state is known.)
+        map meets them only where it falls back on that route, when neither
+        the closed form nor the chain rule at auxiliary divisors gives the
+        velocities; no such state is known.)
 
     Raises
     ------

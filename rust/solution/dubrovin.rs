@@ -701,12 +701,6 @@ pub(crate) fn lattice_rates_dd(
     })
 }
 
-/// [`lattice_rates_dd`] for velocities in double and the periods in double.
-pub fn lattice_rates(curve: &HyperellipticCurve, v: &[[C; 2]]) -> Result<LatticeRates> {
-    let vd: Vec<[Cdd; 2]> = v.iter().map(|z| z.map(Cdd::new)).collect();
-    lattice_rates_dd(curve, None, &vd)
-}
-
 /// The closed form and the theta quotients' fit at `v0` agree on `V` to this,
 /// relative (measured ≤ 3.4e-15 on the shared tops and ≤ 2e-13 on random
 /// states: the fit's own error); a wrong sign or constant gives O(1).
