@@ -572,8 +572,8 @@ const FIXED_TOL: f64 = 1e-8;
 /// (`D Π̄ = Π T`, `Π = [A B]`). The velocities of a real motion are fixed by it
 /// (`T w = w`), so `w` is replaced by `(w + T w)/2`: components that are zero
 /// by symmetry become exactly zero instead of ~1e-16 (which would move the
-/// motion off the real torus by `1e-16 t`). Where no such `D` fixes the first
-/// velocity (a complex level set), nothing is imposed.
+/// motion off the real torus by `1e-16 t`). Where no such `D` fixes every
+/// velocity (a complex level set, or all of them zero), nothing is imposed.
 pub(crate) fn lattice_rates_dd(
     curve: &HyperellipticCurve,
     e_lo: Option<&[C]>,
@@ -633,39 +633,45 @@ pub(crate) fn lattice_rates_dd(
         .iter()
         .map(|z| solve([z[0].re, z[1].re, z[0].im, z[1].im]).ok_or_else(singular))
         .collect::<Result<_>>()?;
-    // The involution: the candidate D that fixes the first velocity and maps
-    // the lattice to itself (found in double: T is an integer matrix).
+    // The involution: the candidate D that fixes every velocity (at least one
+    // of them non-zero) and maps the lattice to itself (found in double: T is
+    // an integer matrix).
     let i = C::new(0.0, 1.0);
     let one = C::new(1.0, 0.0);
+    let vc: Vec<[C; 2]> = v.iter().map(|z| z.map(|x| x.to_c())).collect();
+    let nonzero = vc.iter().any(|z| z[0].norm().max(z[1].norm()) > 0.0);
     let mut involution = None;
-    if let Some(v0) = v.first().map(|z| z.map(|x| x.to_c())) {
-        let scale = v0[0].norm().max(v0[1].norm());
-        for dg in [[one, one], [-one, -one], [i, -i], [-i, i]] {
-            let moved = (dg[0] * v0[0].conj() - v0[0])
+    for dg in [[one, one], [-one, -one], [i, -i], [-i, i]] {
+        if !nonzero {
+            break;
+        }
+        let fixed = vc.iter().all(|z| {
+            let moved = (dg[0] * z[0].conj() - z[0])
                 .norm()
-                .max((dg[1] * v0[1].conj() - v0[1]).norm());
-            if moved.is_nan() || moved > FIXED_TOL * scale {
-                continue;
-            }
-            let mut t = [[0i64; 4]; 4];
-            let mut ok = true;
-            for (k, col) in cols.iter().enumerate() {
-                let image = real4([dg[0] * col[0].conj(), dg[1] * col[1].conj()]);
-                match lu.solve(&image) {
-                    Some(tk) => {
-                        for r in 0..4 {
-                            let n = tk[r].round();
-                            ok &= (tk[r] - n).abs() <= INTEGER_TOL && n.abs() < 1e6;
-                            t[r][k] = n as i64;
-                        }
+                .max((dg[1] * z[1].conj() - z[1]).norm());
+            moved <= FIXED_TOL * z[0].norm().max(z[1].norm())
+        });
+        if !fixed {
+            continue;
+        }
+        let mut t = [[0i64; 4]; 4];
+        let mut ok = true;
+        for (k, col) in cols.iter().enumerate() {
+            let image = real4([dg[0] * col[0].conj(), dg[1] * col[1].conj()]);
+            match lu.solve(&image) {
+                Some(tk) => {
+                    for r in 0..4 {
+                        let n = tk[r].round();
+                        ok &= (tk[r] - n).abs() <= INTEGER_TOL && n.abs() < 1e6;
+                        t[r][k] = n as i64;
                     }
-                    None => ok = false,
                 }
+                None => ok = false,
             }
-            if ok {
-                involution = Some(t);
-                break;
-            }
+        }
+        if ok {
+            involution = Some(t);
+            break;
         }
     }
     if let Some(t) = involution {
