@@ -407,3 +407,12 @@ def test_frequency_map_and_solution_frequencies_agree() -> None:
     for l0, nu in zip(states[ok], fm.nu[ok]):
         ref = top.solve(l0).frequencies
         assert np.max(np.abs(nu - ref)) <= FREQUENCY_AGREEMENT_RTOL * np.max(np.abs(ref))
+
+
+def test_U_keeps_the_real_structure_exactly() -> None:
+    """On 'wide' (imaginary branch points) the real torus is the one of real U: the
+    lattice rates Y vanish by symmetry and are imposed exactly, so U = X has no
+    imaginary part at all (it carried ~1e-15 before, a drift off the real torus)."""
+    p = manakov.problem("wide")
+    sol = manakov.ManakovTop(p.a, p.b).solve(p.l0)
+    assert np.all(sol.U.imag == 0.0), sol.U
