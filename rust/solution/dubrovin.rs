@@ -76,7 +76,7 @@ const LABELS: [(usize, usize); 6] = [(2, 3), (3, 1), (1, 2), (1, 4), (2, 4), (3,
 #[derive(Debug, Clone, PartialEq)]
 pub struct HalfPeriodVelocities {
     /// `V = A U` of each flow (unnormalised differentials `(1, x) dx/y`), in the
-    /// order of the `b` passed, rounded from DD.
+    /// order of the `c` passed, rounded from DD.
     pub v: Vec<[C; 2]>,
     /// The half period `D_p = d_0 + d_p` they were taken at (`p` in `1 … 4`).
     pub p: usize,
@@ -272,12 +272,14 @@ impl Level<Cdd> {
     }
 }
 
-/// The six `c_ij` of (2) (state order), exact to DD.
-fn c_dd(a: &[f64; 4], b: &[f64; 4]) -> [Cdd; 6] {
-    std::array::from_fn(|q| {
-        let (i, j) = PAIRS4[q];
-        Cdd::real(Dd::sum(b[i], -b[j]).div(Dd::sum(a[i], -a[j])))
-    })
+/// The six `c_ij` of (2) (state order) as given, in DD. They arrive in
+/// double (`(b_i − b_j)/(a_i − a_j)` rounded, or normalized): six rounded
+/// numbers are of the form (2) only to rounding, so the half periods agree to
+/// about that (far inside [`HALF_PERIOD_AGREE_RTOL`]), not to DD. A least-squares
+/// `b` does not help: on a top with one small spacing it moves that `c_ij` by
+/// the others' rounding over the spacing (1e-10 at `a_2 − a_1 = 1e-6`).
+fn c_dd(c4: &[f64; 6]) -> [Cdd; 6] {
+    c4.map(|x| Cdd::real(Dd::new(x)))
 }
 
 /// Frahm's field (1) `l̇_ij = Σ_k l_ik l_kj (c_kj − c_ik)` for a complex state.
@@ -401,9 +403,9 @@ fn velocity_at<T: Num>(lv: &Level<T>, hp: &HalfPeriod<T>, c: &[T; 6]) -> ([T; 2]
     ([v0, v1], res)
 }
 
-/// The velocities `V = A U` of the Manakov flows `ManakovTop(a, b)` for each
-/// `b` in `bs` on the level set of `k` (`a = k.a`), `l0` a state of that level
-/// set (it supplies `h1` exactly), in closed form (module docs). One sign
+/// The velocities `V = A U` of the Manakov flows (1) with coefficients `c`
+/// (state order) for each `c` in `cs` on the level set of `k` (`a = k.a`),
+/// `l0` a state of that level set (it supplies `h1` exactly), in closed form (module docs). One sign
 /// convention for all flows; the caller fixes it.
 ///
 /// The half period with the smallest state gives the result — in DD with
@@ -414,23 +416,23 @@ fn velocity_at<T: Num>(lv: &Level<T>, hp: &HalfPeriod<T>, c: &[T; 6]) -> ([T; 2]
 /// orders of magnitude), both are taken again in DD.
 ///
 /// Errors ([`Error::InvalidArgument`] naming [`CLOSED_FORM`]): no flow, a
-/// non-finite `b`, `√c_j` not finite, fewer than two half periods with a
+/// non-finite `c`, `√c_j` not finite, fewer than two half periods with a
 /// finite state, or the two half periods disagreeing (constants that do not
 /// belong to one level set).
 pub fn half_period_velocities(
     k: &KotterConstants,
     l0: &[f64; 6],
-    bs: &[[f64; 4]],
+    cs: &[[f64; 6]],
     dd: bool,
 ) -> Result<HalfPeriodVelocities> {
-    if bs.is_empty() {
+    if cs.is_empty() {
         return Err(Error::InvalidArgument {
             what: CLOSED_FORM,
             reason: "no flow given".into(),
         });
     }
-    for b in bs {
-        crate::error::check_finite("b", b)?;
+    for c in cs {
+        crate::error::check_finite("c", c)?;
     }
     let lv = Level::new(k, l0)?;
     let lr = lv.rounded();
@@ -454,11 +456,11 @@ pub fn half_period_velocities(
     // The DD states, built when first needed.
     let mut best_dd: Option<HalfPeriod<Cdd>> = None;
     let mut check_dd: Option<HalfPeriod<Cdd>> = None;
-    let mut v = Vec::with_capacity(bs.len());
-    let mut v_dd = Vec::with_capacity(bs.len());
+    let mut v = Vec::with_capacity(cs.len());
+    let mut v_dd = Vec::with_capacity(cs.len());
     let mut agreement = 0.0f64;
-    for b in bs {
-        let c = c_dd(&k.a, b);
+    for c4 in cs {
+        let c = c_dd(c4);
         let cc = c.map(|x| x.to_c());
         // The result in the precision asked, the check in double; where they
         // miss (double loses digits on widely spread d_j, ~1e-11 at |d_4| ~
@@ -760,6 +762,7 @@ mod tests {
     use crate::solution::tests::TOPS;
     use crate::solution::velocity::algebraic_rates;
     use crate::solution::{a_periods_of, level_set_curve, Solution};
+    use crate::tori::solve::c_pairs;
 
     /// Relative distance of `x` from `±y` (the sign of `y` left open).
     fn dist_up_to_sign(x: &[C; 2], y: &[C; 2]) -> f64 {
@@ -777,7 +780,7 @@ mod tests {
     fn closed_form_matches_the_theta_fit_on_the_shared_tops() {
         for (n, (a, b, l0)) in TOPS.iter().enumerate() {
             let sol = Solution::new(a, b, l0).unwrap();
-            let hp = half_period_velocities(sol.kotter(), l0, &[*b], true).unwrap();
+            let hp = half_period_velocities(sol.kotter(), l0, &[*sol.c4()], true).unwrap();
             let (fit, _) = sol.rates(&[*sol.c4()]).unwrap()[0];
             let (_, dev) = sign_against(sol.curve(), &hp.v[0], &fit);
             assert!(dev <= 1e-13, "top {n}: {dev:e}");
@@ -794,11 +797,10 @@ mod tests {
         let tol = [1e-13, 1e-13, 1e-13, 1e-10];
         for (n, (a, b, l0)) in TOPS.iter().enumerate() {
             let ls = level_set_curve(a, l0).unwrap();
-            let c = crate::so4::manakov_c(a, b).unwrap();
-            let c = [c[1], c[2], c[3], c[6], c[7], c[11]];
+            let c = c_pairs(a, b).unwrap();
             let alg =
                 algebraic_rates(&ls.kotter, &ls.kcurve, &a_periods_of(&ls.curve), &[c]).unwrap();
-            let hp = half_period_velocities(&ls.kotter, l0, &[*b], true).unwrap();
+            let hp = half_period_velocities(&ls.kotter, l0, &[c], true).unwrap();
             let dev = dist_up_to_sign(&hp.v[0], &alg.v[0]);
             assert!(dev <= tol[n], "top {n}: {dev:e}");
         }
@@ -812,7 +814,11 @@ mod tests {
         let (a, b, l0) = TOPS[0];
         let k = crate::kotter::kotter_constants(&a, &l0).unwrap();
         let lv = Level::new(&k, &l0).unwrap();
-        let c = c_dd(&a, &b);
+        // c exactly of the form (2), to DD: the identity holds to DD
+        let c: [Cdd; 6] = std::array::from_fn(|q| {
+            let (i, j) = crate::so4::PAIRS4[q];
+            Cdd::real(Dd::sum(b[i], -b[j]).div(Dd::sum(a[i], -a[j])))
+        });
         let vs: Vec<[Cdd; 2]> = (1..5)
             .map(|p| {
                 let (v, res) = velocity_at(&lv, &half_period(&lv, p), &c);
@@ -862,9 +868,10 @@ mod tests {
     fn inconsistent_constants_are_refused() {
         let (a, b, l0) = TOPS[0];
         let mut k = crate::kotter::kotter_constants(&a, &l0).unwrap();
-        assert!(half_period_velocities(&k, &l0, &[b], true).is_ok());
+        let c = c_pairs(&a, &b).unwrap();
+        assert!(half_period_velocities(&k, &l0, &[c], true).is_ok());
         k.u[0][0] *= 1.0 + 1e-9;
-        match half_period_velocities(&k, &l0, &[b], true) {
+        match half_period_velocities(&k, &l0, &[c], true) {
             Err(Error::InvalidArgument { what, reason }) => {
                 assert_eq!(what, CLOSED_FORM);
                 assert!(reason.contains("inconsistent"), "{reason}");
@@ -887,9 +894,8 @@ mod tests {
     fn velocities_are_linear_in_b_with_one_sign() {
         let (a, b, l0) = TOPS[0];
         let k = crate::kotter::kotter_constants(&a, &l0).unwrap();
-        let hp =
-            half_period_velocities(&k, &l0, &[b, a.map(|x| x * x), a.map(|x| x * x * x)], true)
-                .unwrap();
+        let cs = [b, a.map(|x| x * x), a.map(|x| x * x * x)].map(|b| c_pairs(&a, &b).unwrap());
+        let hp = half_period_velocities(&k, &l0, &cs, true).unwrap();
         let v = nalgebra::Matrix4::from_fn(|i, j| a[i].powi(j as i32));
         let p = v
             .lu()
@@ -910,7 +916,7 @@ mod tests {
         for (n, zeros) in [(0usize, [0usize, 3]), (2, [2, 3])] {
             let (a, b, l0) = TOPS[n];
             let sol = Solution::new(&a, &b, &l0).unwrap();
-            let lat = sol.closed_rates(&[b], true).unwrap();
+            let lat = sol.closed_rates(&[*sol.c4()], true).unwrap();
             let t = lat.involution.expect("a real level set has its involution");
             let w = lat.w[0];
             for z in zeros {
@@ -940,7 +946,7 @@ mod tests {
             let h1: f64 = l.iter().map(|x| x * x).sum();
             l[5] = (e * h1 - rest) / l[0];
             let sol = Solution::new(&a, &b, &l).unwrap();
-            let hp = half_period_velocities(sol.kotter(), &l, &[b], true).unwrap();
+            let hp = half_period_velocities(sol.kotter(), &l, &[*sol.c4()], true).unwrap();
             let (fit, _) = sol.rates(&[*sol.c4()]).unwrap()[0];
             let (_, dev) = sign_against(sol.curve(), &hp.v[0], &fit);
             assert!(dev <= 1e-13, "h0/h1 = {e:e}: {dev:e}");
@@ -975,8 +981,8 @@ mod tests {
             3.195363984068542,
         ];
         let sol = Solution::new(&a, &b, &l0).unwrap();
-        let fast = half_period_velocities(sol.kotter(), &l0, &[b], false).unwrap();
-        let full = half_period_velocities(sol.kotter(), &l0, &[b], true).unwrap();
+        let fast = half_period_velocities(sol.kotter(), &l0, &[*sol.c4()], false).unwrap();
+        let full = half_period_velocities(sol.kotter(), &l0, &[*sol.c4()], true).unwrap();
         assert!(dist_up_to_sign(&fast.v[0], &full.v[0]) <= 1e-15);
         assert!(fast.agreement <= 1e-14, "{:e}", fast.agreement);
         let (fit, _) = sol.rates(&[*sol.c4()]).unwrap()[0];

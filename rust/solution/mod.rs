@@ -96,7 +96,6 @@ pub const LABELS: [&str; 7] = ["P0", "P23", "P31", "P12", "P14", "P24", "P34"];
 #[derive(Debug)]
 pub struct Solution {
     a: [f64; 4],
-    b: [f64; 4],
     c4: [f64; 6],
     l0: [f64; 6],
     kotter: KotterConstants,
@@ -208,7 +207,7 @@ impl Solution {
         // [`dubrovin`]), with its lattice coordinates in DD and the real
         // structure imposed: one for every sign pattern of the C_L below. Where
         // it refuses (none known), U is the theta quotients' fit at v0.
-        let closed = dubrovin::half_period_velocities(&kotter, l0, &[*b], true).and_then(|hp| {
+        let closed = dubrovin::half_period_velocities(&kotter, l0, &[c4], true).and_then(|hp| {
             let e_lo = hp.branch_point_errors(&curve);
             let lat = dubrovin::lattice_rates_dd(&curve, e_lo.as_ref().map(|e| &e[..]), &hp.v_dd)?;
             Ok((hp.v[0], lat))
@@ -283,7 +282,6 @@ impl Solution {
         };
         Ok(Solution {
             a: *a,
-            b: *b,
             c4,
             l0: *l0,
             kotter,
@@ -316,11 +314,6 @@ impl Solution {
     /// The parameters `a`.
     pub fn a(&self) -> &[f64; 4] {
         &self.a
-    }
-
-    /// The parameters `b`.
-    pub fn b(&self) -> &[f64; 4] {
-        &self.b
     }
 
     /// The Manakov `c_ij` (2), state order.
@@ -361,16 +354,17 @@ impl Solution {
         c4s.iter().map(|c4| sys.rate(c4, "U'")).collect()
     }
 
-    /// The velocities `U` of the Manakov flows `ManakovTop(a, b)` for each
-    /// `b` in `bs` on this level set, in closed form ([`dubrovin`]) and in
-    /// this solution's sign convention, with their lattice coordinates (the
-    /// real structure imposed). For the solution's own `b` this is `U`.
+    /// The velocities `U` of the Manakov flows (1) with coefficients `c`
+    /// (state order) for each `c` in `cs` on this level set, in closed form
+    /// ([`dubrovin`]) and in this solution's sign convention, with their
+    /// lattice coordinates (the real structure imposed). For the solution's
+    /// own `c4` this is `U`.
     /// `dd`: the closed form and the periods in double-double on the unrounded
     /// curve (`X, Y` to ~1e-19, as the solution's own phase), else in double
     /// with the curve's double periods (to ~1e-15, as the frequency map: a few
     /// times cheaper).
-    pub fn closed_rates(&self, bs: &[[f64; 4]], dd: bool) -> Result<dubrovin::LatticeRates> {
-        let hp = dubrovin::half_period_velocities(&self.kotter, &self.l0, bs, dd)?;
+    pub fn closed_rates(&self, cs: &[[f64; 6]], dd: bool) -> Result<dubrovin::LatticeRates> {
+        let hp = dubrovin::half_period_velocities(&self.kotter, &self.l0, cs, dd)?;
         let v: Vec<_> = hp
             .v_dd
             .iter()

@@ -65,8 +65,7 @@ pub fn flow_data(sol: &Solution, b2: &[f64; 4]) -> Result<FlowData> {
     // convention) with the curve's double periods, as the frequency map takes
     // them (the same numbers, so the two routes give the same frequencies);
     // the fit must reproduce the second flow's.
-    let b = sol.b();
-    let lat = sol.closed_rates(&[*b, *b2], false)?;
+    let lat = sol.closed_rates(&[*sol.c4(), c2], false)?;
     let (u, u2_closed) = (lat.u[0], lat.u[1]);
     let dev = (u2_closed[0] - u2[0])
         .norm()
@@ -146,7 +145,7 @@ pub fn level_set_flow_data_c4(
     // In double with the curve's double periods: frequencies to ~1e-15 (the
     // DD of the solution's phase would cost about as much as the rest of the
     // state), and `flow_data` takes the same numbers.
-    let rates = match half_period_velocities(&ls.kotter, l0, &[*b, *b2], false) {
+    let rates = match half_period_velocities(&ls.kotter, l0, &[c4, c2], false) {
         Ok(hp) => lattice_rates_dd(&ls.curve, None, &hp.v_dd)?.u,
         Err(Error::InvalidArgument {
             what: CLOSED_FORM, ..
