@@ -116,6 +116,9 @@ pub struct Solution {
     /// The sign of the closed-form velocities ([`dubrovin`]) in this
     /// solution's convention.
     v_sign: f64,
+    /// Whether `U` is the closed form (else the theta quotients' fit at
+    /// `v0`, where the closed form refused and `v_sign` is not known).
+    closed_u: bool,
     /// Theta indices (FLINT order): `θ`, then the seven labels.
     idx: [usize; 8],
     /// Characteristics `(a, b)` of the seven labels.
@@ -296,6 +299,7 @@ impl Solution {
             lat_rate,
             lat_rate_lo,
             v_sign,
+            closed_u: closed.is_ok(),
             idx,
             chars,
             cl,
@@ -363,7 +367,19 @@ impl Solution {
     /// curve (`X, Y` to ~1e-19, as the solution's own phase), else in double
     /// with the curve's double periods (to ~1e-15, as the frequency map: a few
     /// times cheaper).
+    ///
+    /// Errors: [`Error::InvalidArgument`] naming [`dubrovin::CLOSED_FORM`]
+    /// where the closed form refuses, or refused for this solution's own `U`
+    /// (its sign convention is then unknown).
     pub fn closed_rates(&self, cs: &[[f64; 6]], dd: bool) -> Result<dubrovin::LatticeRates> {
+        if !self.closed_u {
+            return Err(Error::InvalidArgument {
+                what: dubrovin::CLOSED_FORM,
+                reason: "the solution's U is the theta quotients' fit: the closed form \
+                         refused at its set-up"
+                    .into(),
+            });
+        }
         let hp = dubrovin::half_period_velocities(&self.kotter, &self.l0, cs, dd)?;
         let v: Vec<_> = hp
             .v_dd
