@@ -61,6 +61,17 @@ pub enum Error {
     NoRealTorus { failure: TorusFailure },
     /// The computation was cancelled (Ctrl-C in Python; see [`crate::numeric::cancel`]).
     Interrupted,
+    /// `count` items of `what` would take `bytes` bytes, more than one call may
+    /// allocate ([`crate::numeric::alloc::MAX_BYTES`]); checked before any work.
+    /// Python sees a `MemoryError` (as numpy's for an array it cannot allocate).
+    TooLarge {
+        what: &'static str,
+        count: usize,
+        bytes: f64,
+    },
+    /// `bytes` bytes for `what`, within the budget, could not be allocated.
+    /// Python sees a `MemoryError`.
+    OutOfMemory { what: &'static str, bytes: f64 },
     /// Row `row` of a batch of `rows` failed with `source` (Python sees the
     /// exception of `source`, its message prefixed with the row).
     InRow {
@@ -120,6 +131,9 @@ pub enum TorusFailure {
     NoRealLattice { residual: f64 },
 }
 
+/// Bytes in a GiB (sizes in messages).
+const GIB: f64 = (1u64 << 30) as f64;
+
 /// `Result` with the crate's [`Error`].
 pub type Result<T> = std::result::Result<T, Error>;
 
@@ -167,6 +181,18 @@ impl fmt::Display for Error {
             ),
             Error::NoRealTorus { failure } => write!(f, "invalid real torus: {failure}"),
             Error::Interrupted => write!(f, "interrupted"),
+            Error::TooLarge { what, count, bytes } => write!(
+                f,
+                "cannot allocate {bytes:.0} bytes ({:.4} GiB) for {what} of {count} items: \
+                 more than the {:.0} GiB one call may allocate; split the work into smaller calls",
+                bytes / GIB,
+                crate::numeric::alloc::MAX_BYTES as f64 / GIB
+            ),
+            Error::OutOfMemory { what, bytes } => write!(
+                f,
+                "cannot allocate {bytes:.0} bytes ({:.3} GiB) for {what}: out of memory",
+                bytes / GIB
+            ),
             Error::InRow { row, rows, source } => write!(f, "row {row} of {rows}: {source}"),
         }
     }

@@ -10,26 +10,19 @@ use super::gauss::{run_gauss, GaussDyn, GaussFixed};
 use super::{batch, dop853, gauss_tables, taylor};
 use super::{check_budget, check_sample_times, Method, Options, Trajectory, VectorField, LANES};
 use crate::error::{check_finite, Error, Result};
+use crate::numeric::alloc::{check_size, try_collect, try_vec};
 use crate::numeric::cancel::{poll_during, Cancel};
 
-/// A zeroed output buffer of `n` doubles, allocated fallibly: a size the machine
-/// cannot hold is an `InvalidArgument` (ValueError), not an abort.
-pub(super) fn alloc_output(n: Option<usize>) -> Result<Vec<f64>> {
-    let err = |n: Option<usize>| Error::InvalidArgument {
-        what: "output size",
-        reason: format!(
-            "cannot allocate {} bytes for the samples; sample less often or integrate \
-             fewer states per call",
-            n.map_or(f64::INFINITY, |n| n as f64 * 8.0)
-        ),
-    };
-    let n = n
-        .filter(|&n| n <= isize::MAX as usize / 8)
-        .ok_or_else(|| err(n))?;
-    let mut v = Vec::new();
-    v.try_reserve_exact(n).map_err(|_| err(Some(n)))?;
-    v.resize(n, 0.0);
-    Ok(v)
+/// A zeroed output buffer of `rows` trajectories of `per` doubles, through the
+/// checked allocation of `numeric::alloc`: a size over the budget or one the
+/// machine cannot hold is an error naming it, not an abort.
+pub(super) fn alloc_output(rows: usize, per: usize) -> Result<Vec<f64>> {
+    check_size(
+        "samples",
+        rows,
+        per.saturating_mul(std::mem::size_of::<f64>()),
+    )?;
+    try_vec("samples", rows.saturating_mul(per), 0.0)
 }
 
 /// Integrates `ẏ = f(y)` from `y0` at time `t0`, recording the state at each of
@@ -86,7 +79,7 @@ pub fn integrate_partial<F: VectorField>(
     check_sample_times(t0, times)?;
     check_budget(opts.method, t0, times, opts.dt, opts.max_steps)?;
     taylor_coefficients(f, opts.method)?;
-    let mut y = alloc_output(times.len().checked_mul(m))?;
+    let mut y = alloc_output(times.len(), m)?;
     y.clear();
     let mut out = Trajectory {
         t: Vec::new(),
@@ -95,7 +88,8 @@ pub fn integrate_partial<F: VectorField>(
         evals: 0,
     };
     let res = integrate_into(f, y0, t0, times, opts, &mut out, cancel);
-    out.t = times[..out.y.len() / m.max(1)].to_vec();
+    let reached = &times[..out.y.len() / m.max(1)];
+    out.t = try_collect("samples", reached.len(), reached.iter().copied())?;
     Ok((out, res))
 }
 
@@ -320,7 +314,7 @@ pub fn integrate_many_with<F: VectorField>(
     taylor_coefficients(f, opts.method)?;
     let rows = y0s.len() / m;
     let per = times.len() * m;
-    let mut out = alloc_output(rows.checked_mul(per))?;
+    let mut out = alloc_output(rows, per)?;
     if out.is_empty() {
         return Ok((out, 0));
     }
@@ -353,12 +347,7 @@ pub fn integrate_many_with<F: VectorField>(
             )?,
             None => {
                 let one = |(y0, chunk): (&[f64], &mut [f64])| -> Result<u64> {
-                    let mut ys = Vec::new();
-                    ys.try_reserve_exact(per)
-                        .map_err(|_| Error::InvalidArgument {
-                            what: "output size",
-                            reason: "cannot allocate the scratch of one trajectory".into(),
-                        })?;
+                    let ys = crate::numeric::alloc::try_with_capacity("samples", per)?;
                     let mut tr = Trajectory {
                         t: Vec::new(),
                         y: ys,

@@ -257,7 +257,10 @@ pub fn check_sample_times(t0: f64, times: &[f64]) -> Result<()> {
 /// interval): over budget, the cause is `dt` when `(t_end − t0)/dt` alone exceeds
 /// the budget, else the sample spacing (intervals shorter than `dt` still cost a
 /// step each). The explicit methods' count depends on the error control; they are
-/// checked while stepping.
+/// checked while stepping — except for the lower bound that a largest step
+/// gives: Taylor's method never steps further than `dt > 0`, so it needs at
+/// least `(t_end − t0)/dt` steps (its dense output samples within a step, so
+/// the spacing adds nothing), and is refused on that bound before any work.
 pub fn check_budget(method: Method, t0: f64, times: &[f64], dt: f64, max_steps: u64) -> Result<()> {
     let gauss = method.stages().is_some();
     let (mut intervals, mut prev) = (0.0f64, t0);
@@ -282,6 +285,21 @@ pub fn check_budget(method: Method, t0: f64, times: &[f64], dt: f64, max_steps: 
                  points or a larger sample_every) or raise max_steps"
             ),
         });
+    }
+    if method == Method::Taylor && dt > 0.0 {
+        let t_end = times.iter().copied().fold(t0, f64::max);
+        let by_dt = (t_end - t0) / dt;
+        if by_dt > budget {
+            return Err(Error::InvalidArgument {
+                what: "max_steps",
+                reason: format!(
+                    "dt: (t_end - t0) / dt = {:e} / {dt:e} = {by_dt:e} steps at least (the \
+                     Taylor steps are at most dt), more than max_steps = {max_steps}; \
+                     increase dt, shorten t_end or raise max_steps",
+                    t_end - t0
+                ),
+            });
+        }
     }
     if gauss && total > budget {
         let by_dt = (prev - t0) / dt;

@@ -336,12 +336,33 @@ fn budget_is_checked_first_and_names_the_cause() {
     assert!(check_budget(Method::Gauss16, 0.0, &spacing, 0.6, 200).is_ok());
 }
 
+/// Taylor's largest step bounds its step count from below: a run that cannot
+/// fit `max_steps` at steps of at most `dt` is refused before any work.
+#[test]
+fn taylor_with_a_tiny_largest_step_is_refused_first() {
+    let times = [10.0];
+    let e = check_budget(Method::Taylor, 0.0, &times, 5e-324, 100_000_000).unwrap_err();
+    assert!(e.to_string().contains("dt: (t_end - t0) / dt"), "{e}");
+    // dt = 0 (no largest step) leaves the count to the error control.
+    assert!(check_budget(Method::Taylor, 0.0, &times, 0.0, 10).is_ok());
+    assert!(check_budget(Method::Taylor, 0.0, &times, 0.5, 20).is_ok());
+    assert!(check_budget(Method::Taylor, 0.0, &times, 0.5, 19).is_err());
+    // Dense samples cost a Taylor run no steps beyond the intervals' own.
+    let dense: Vec<f64> = (1..=100).map(|k| 0.1 * k as f64).collect();
+    assert!(check_budget(Method::Taylor, 0.0, &dense, 0.5, 100).is_ok());
+}
+
 /// An output that cannot be allocated is an error, not an abort.
 #[test]
 fn huge_output_is_an_error() {
-    assert!(alloc_output(None).is_err());
-    assert!(alloc_output(Some(usize::MAX / 4)).is_err());
-    assert_eq!(alloc_output(Some(3)).unwrap(), vec![0.0; 3]);
+    assert!(matches!(
+        alloc_output(usize::MAX, 2),
+        Err(Error::TooLarge { .. })
+    ));
+    assert!(alloc_output(usize::MAX / 4, 1).is_err());
+    let just_over = crate::numeric::alloc::MAX_BYTES / 48 + 1;
+    assert!(alloc_output(just_over, 6).is_err());
+    assert_eq!(alloc_output(1, 3).unwrap(), vec![0.0; 3]);
 }
 
 #[test]

@@ -3,8 +3,14 @@
 //! gathered into row-major arrays, and one policy for failing rows — masked
 //! (NaN fields, `ok = false`) or the first failure returned with its row.
 
-use super::{kotter, kotter_along, kotter_constants, KotterState, C};
+use super::{kotter, kotter_along_step, kotter_constants, KotterState, C};
 use crate::error::{Error, Result};
+use crate::numeric::alloc::{check_size, try_with_capacity};
+use crate::numeric::cancel::Cancel;
+
+/// Bytes of one row of a [`KotterBatch`]: 4 doubles, 85 complex numbers,
+/// 5 branch bytes and the `ok` flag (the sizes of [`KotterBatch::with_capacity`]).
+pub const ROW_BYTES: usize = 4 * 8 + 85 * 16 + 5 + 1;
 
 /// The fields of `n` mapped states, row-major with leading axis `n` (the
 /// arrays of `manakov.Kotter`); see [`KotterState`] and
@@ -54,39 +60,42 @@ pub struct KotterBatch {
 }
 
 impl KotterBatch {
-    fn with_capacity(n: usize) -> Self {
-        let v = |m: usize| Vec::with_capacity(n * m);
-        KotterBatch {
+    /// Room for `n` rows, allocated fallibly after the whole batch is checked
+    /// against the allocation budget ([`ROW_BYTES`] a row).
+    fn with_capacity(n: usize) -> Result<Self> {
+        check_size("l", n, ROW_BYTES)?;
+        let v = |m: usize| try_with_capacity::<C>("Kotter fields", n * m);
+        Ok(KotterBatch {
             n: 0,
-            h: Vec::with_capacity(4 * n),
-            s: v(4),
-            sigma: v(4),
-            sqrt_fprime: v(4),
-            l_p: v(12),
-            delta_det: v(9),
-            xi: v(3),
-            eta: v(3),
-            sqrt_d: v(3),
-            d: v(3),
-            alpha: v(3),
-            beta: v(3),
-            gamma: v(3),
-            delta: v(3),
-            a_coef: v(3),
-            b_coef: v(3),
-            abgd39: v(4),
-            eps: v(1),
-            k: v(1),
-            p0: v(1),
-            g: v(1),
-            z1: v(1),
-            y1: v(1),
-            z2: v(1),
-            y2: v(1),
-            zd: v(10),
-            branch: Vec::with_capacity(5 * n),
-            ok: Vec::with_capacity(n),
-        }
+            h: try_with_capacity("Kotter fields", 4 * n)?,
+            s: v(4)?,
+            sigma: v(4)?,
+            sqrt_fprime: v(4)?,
+            l_p: v(12)?,
+            delta_det: v(9)?,
+            xi: v(3)?,
+            eta: v(3)?,
+            sqrt_d: v(3)?,
+            d: v(3)?,
+            alpha: v(3)?,
+            beta: v(3)?,
+            gamma: v(3)?,
+            delta: v(3)?,
+            a_coef: v(3)?,
+            b_coef: v(3)?,
+            abgd39: v(4)?,
+            eps: v(1)?,
+            k: v(1)?,
+            p0: v(1)?,
+            g: v(1)?,
+            z1: v(1)?,
+            y1: v(1)?,
+            z2: v(1)?,
+            y2: v(1)?,
+            zd: v(10)?,
+            branch: try_with_capacity("Kotter fields", 5 * n)?,
+            ok: try_with_capacity("Kotter fields", n)?,
+        })
     }
 
     /// Appends the fields of one state.
@@ -171,20 +180,27 @@ impl KotterBatch {
 /// false; without, the first failure is returned as
 /// [`Error::InRow`] naming the row (a single row's error as it is).
 ///
-/// Errors: those of [`kotter_constants`] for `l0` (whatever `mask`).
+/// Errors: those of [`kotter_constants`] for `l0` (whatever `mask`);
+/// [`Error::TooLarge`] or [`Error::OutOfMemory`] for a batch whose fields
+/// cannot be held (checked before the first row); [`Error::Interrupted`]
+/// once `cancel` is cancelled (checked before every row, ~30–70 µs of work).
 pub fn kotter_batch(
     a: &[f64; 4],
     rows: &[[f64; 6]],
     l0: Option<&[f64; 6]>,
     mask: bool,
+    cancel: &Cancel,
 ) -> Result<KotterBatch> {
-    let all: Vec<Result<KotterState>> = match l0 {
-        Some(l0) => kotter_along(&kotter_constants(a, l0)?, rows),
-        None => rows.iter().map(|r| kotter(a, r)).collect(),
-    };
-    let n = all.len();
-    let mut out = KotterBatch::with_capacity(n);
-    for (row, r) in all.into_iter().enumerate() {
+    let n = rows.len();
+    let mut out = KotterBatch::with_capacity(n)?;
+    let constants = l0.map(|l0| kotter_constants(a, l0)).transpose()?;
+    let mut prev = None;
+    for (row, l) in rows.iter().enumerate() {
+        cancel.check()?;
+        let r = match &constants {
+            Some(k) => kotter_along_step(k, l, &mut prev),
+            None => kotter(a, l),
+        };
         match r {
             Ok(st) => out.push(&st),
             Err(_) if mask => out.push_masked(),
@@ -214,7 +230,8 @@ mod tests {
     #[test]
     fn the_batch_holds_each_rows_state() {
         let rows = [L0, L0.map(|v| 0.9 * v)];
-        let b = kotter_batch(&A, &rows, None, false).unwrap();
+        let never = Cancel::never();
+        let b = kotter_batch(&A, &rows, None, false, &never).unwrap();
         assert_eq!((b.n, b.ok.clone()), (2, vec![true, true]));
         for (i, r) in rows.iter().enumerate() {
             let st = kotter(&A, r).unwrap();
@@ -226,8 +243,8 @@ mod tests {
             assert_eq!(b.l_p[12 * i + 3], st.l_p[1][0]);
         }
         // Along l0's level set: the states of kotter_along.
-        let along = kotter_batch(&A, &rows[..1], Some(&L0), false).unwrap();
-        let st = kotter_along(&kotter_constants(&A, &L0).unwrap(), &rows[..1]);
+        let along = kotter_batch(&A, &rows[..1], Some(&L0), false, &never).unwrap();
+        let st = super::super::kotter_along(&kotter_constants(&A, &L0).unwrap(), &rows[..1]);
         assert_eq!(along.z1[0], st[0].as_ref().unwrap().points.z1);
     }
 
@@ -236,7 +253,8 @@ mod tests {
         assert_eq!(SELF_DUAL.iter().map(|v| v * v).sum::<f64>(), 28.0);
         assert!(kotter(&A, &SELF_DUAL).is_err());
         let rows = [L0, SELF_DUAL, L0];
-        let b = kotter_batch(&A, &rows, None, true).unwrap();
+        let never = Cancel::never();
+        let b = kotter_batch(&A, &rows, None, true, &never).unwrap();
         assert_eq!(b.ok, vec![true, false, true]);
         assert!(b.h[4..8].iter().all(|v| v.is_nan()));
         assert!(b.xi[3..6].iter().all(|v| v.re.is_nan() && v.im.is_nan()));
@@ -244,7 +262,7 @@ mod tests {
         assert_eq!(b.xi[6..9], b.xi[0..3]);
         // Without the mask: the row and the reduction's own error.
         let own = kotter(&A, &SELF_DUAL).unwrap_err();
-        let e = kotter_batch(&A, &rows, None, false).unwrap_err();
+        let e = kotter_batch(&A, &rows, None, false, &never).unwrap_err();
         assert_eq!(e.to_string(), format!("row 1 of 3: {own}"));
         assert!(matches!(
             e,
@@ -255,6 +273,22 @@ mod tests {
             }
         ));
         // A single row: its error as it is.
-        assert_eq!(kotter_batch(&A, &rows[1..2], None, false), Err(own));
+        assert_eq!(kotter_batch(&A, &rows[1..2], None, false, &never), Err(own));
+    }
+
+    #[test]
+    fn a_batch_stops_once_cancelled_and_refuses_sizes_over_the_budget() {
+        let cancelled = Cancel::never();
+        cancelled.cancel();
+        let rows = [L0; 3];
+        assert_eq!(
+            kotter_batch(&A, &rows, None, false, &cancelled),
+            Err(Error::Interrupted)
+        );
+        let n = crate::numeric::alloc::MAX_BYTES / ROW_BYTES + 1;
+        assert!(matches!(
+            KotterBatch::with_capacity(n),
+            Err(Error::TooLarge { what: "l", .. })
+        ));
     }
 }

@@ -284,16 +284,24 @@ pub fn follow_order(prev: &WurzelPoints, cur: &mut WurzelPoints) {
 pub fn kotter_along(constants: &KotterConstants, rows: &[[f64; 6]]) -> Vec<Result<KotterState>> {
     let mut prev: Option<WurzelPoints> = None;
     rows.iter()
-        .map(|l| {
-            on_level_set(constants, l)?;
-            let mut st = kotter_with(constants.clone(), l)?;
-            if let Some(p) = &prev {
-                follow_order(p, &mut st.points);
-            }
-            prev = Some(st.points);
-            Ok(st)
-        })
+        .map(|l| kotter_along_step(constants, l, &mut prev))
         .collect()
+}
+
+/// One row of [`kotter_along`]: `l` mapped with `constants`, its points in
+/// the order that follows `prev` (the last row mapped, updated on success).
+pub fn kotter_along_step(
+    constants: &KotterConstants,
+    l: &[f64; 6],
+    prev: &mut Option<WurzelPoints>,
+) -> Result<KotterState> {
+    on_level_set(constants, l)?;
+    let mut st = kotter_with(constants.clone(), l)?;
+    if let Some(p) = prev.as_ref() {
+        follow_order(p, &mut st.points);
+    }
+    *prev = Some(st.points);
+    Ok(st)
 }
 
 /// The inverse of [`kotter`]: the state `l` from the curve's points, `g`

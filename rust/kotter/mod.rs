@@ -47,14 +47,14 @@ mod polish;
 mod roots;
 mod schottky;
 
-pub use batch::{kotter_batch, KotterBatch};
+pub use batch::{kotter_batch, KotterBatch, ROW_BYTES};
 pub use constants::{
     constants_from_h, kotter_constants, l_from_xi_eta, l_p, xi_eta, Coefficients23,
     KotterConstants, H0_NEGLIGIBLE_RTOL, NEAR_SINGULAR_RTOL, REAL_RTOL, STRUCTURE_RTOL,
 };
 pub use map::{
-    follow_order, from_kotter, kotter, kotter_along, kotter_with, on_level_set, KotterState,
-    G42_RTOL, LEVEL_SET_RTOL, UNIFORM_RTOL,
+    follow_order, from_kotter, kotter, kotter_along, kotter_along_step, kotter_with, on_level_set,
+    KotterState, G42_RTOL, LEVEL_SET_RTOL, UNIFORM_RTOL,
 };
 pub use pairs::PAIR_ROUTE_RTOL;
 pub use roots::{quartic_f, quartic_roots, REPEATED_ROOT_RTOL, ROOT_STAGNATION};

@@ -11,9 +11,12 @@
 //! * [`cancel`]: cooperative cancellation ([`cancel::Cancel`]), the poll of a
 //!   parallel computation from the calling thread ([`cancel::poll_during`])
 //!   and the step count between two checks ([`cancel::CHECK_EVERY`]).
+//! * [`alloc`]: the one path for allocations sized by user input (a size
+//!   budget, then fallible allocation: an error naming the size, never an abort).
 //! * [`tol`]: thresholds shared by several layers (the smallest step of the
 //!   explicit integrators, the two tests for the singular level sets).
 
+pub mod alloc;
 pub mod cancel;
 pub mod compensated;
 pub mod complex;

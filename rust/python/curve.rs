@@ -10,9 +10,21 @@ use numpy::{
 };
 use pyo3::prelude::*;
 
-use super::arrays::{array1, rows, vec1};
+use super::arrays::{array1, check_call, out_shape_err, rows, vec1};
+use super::errors::py_cancel;
 use crate::curve::{CurvePoint, KotterCurve};
 use crate::error::Error;
+use crate::numeric::alloc::{items_per_check, try_vec};
+
+/// An `(n, k)` array of zeros (the default), allocated fallibly.
+fn zeros2<T: Clone + Default>(what: &'static str, n: usize, k: usize) -> PyResult<Array2<T>> {
+    Array2::from_shape_vec((n, k), try_vec(what, n * k, T::default())?).map_err(out_shape_err)
+}
+
+/// Points between two checks for Ctrl-C in the maps below (~10 µs a point).
+fn every() -> usize {
+    items_per_check(1e4)
+}
 
 type C = Complex64;
 
@@ -75,14 +87,21 @@ fn curve_eval_py<'py>(
     x: PyReadonlyArray1<'py, C>,
 ) -> PyResult<(Bound<'py, PyArray1<C>>, Bound<'py, PyArray1<C>>)> {
     let k = curve_of(&d)?;
-    let xs = x.as_array().to_vec();
+    check_call("x", x.as_array().len(), 3 * 16)?;
+    let xs = vec1(&x, "x", None)?;
     if let Some(index) = xs
         .iter()
         .position(|v| !(v.re.is_finite() && v.im.is_finite()))
     {
         return Err(Error::NonFinite { what: "x", index }.into());
     }
-    let (r, y): (Vec<C>, Vec<C>) = py.detach(|| xs.iter().map(|&x| (k.r(x), k.y(x))).unzip());
+    let cancel = py_cancel();
+    let ry = py.detach(|| {
+        crate::numeric::alloc::try_map("x", &xs, items_per_check(100.0), &cancel, |&x| {
+            Ok([k.r(x), k.y(x)])
+        })
+    })?;
+    let (r, y): (Vec<C>, Vec<C>) = ry.iter().map(|v| (v[0], v[1])).unzip();
     Ok((
         Array1::from(r).into_pyarray(py),
         Array1::from(y).into_pyarray(py),
@@ -107,14 +126,21 @@ fn curve_wurzel_py<'py>(
 ) -> PyResult<(Bound<'py, PyArray2<C>>, Bound<'py, PyArray3<C>>)> {
     let k = curve_of(&d)?;
     let n = z1.as_array().len();
+    // Four points, eps, the offsets, P and Pjk a row.
+    check_call("z1", n, 4 * 16 + 5 + 10 * 16 + 30 * 16)?;
     let (z1, y1) = (vec1(&z1, "z1", Some(n))?, vec1(&y1, "y1", Some(n))?);
     let (z2, y2) = (vec1(&z2, "z2", Some(n))?, vec1(&y2, "y2", Some(n))?);
     let eps: Option<Vec<[i8; 5]>> = eps.map(|e| rows(&e, "eps", Some(n))).transpose()?;
     let zd: Option<Vec<[C; 10]>> = zd.map(|z| rows(&z, "zd", Some(n))).transpose()?;
+    let mut p = zeros2::<C>("P", n, 5)?;
+    let pjk_flat = try_vec("Pjk", n * 25, C::default())?;
+    let mut pjk = Array3::from_shape_vec((n, 5, 5), pjk_flat).map_err(out_shape_err)?;
+    let cancel = py_cancel();
     let out = py.detach(|| -> Result<(Array2<C>, Array3<C>), Error> {
-        let mut p = Array2::<C>::zeros((n, 5));
-        let mut pjk = Array3::<C>::zeros((n, 5, 5));
         for i in 0..n {
+            if i % every() == 0 {
+                cancel.check()?;
+            }
             let e = eps.as_ref().map(|e| e[i]);
             let w = match &zd {
                 None => k.wurzel(z1[i], y1[i], z2[i], y2[i], e)?,
@@ -155,16 +181,22 @@ fn curve_xi_eta_py<'py>(
 ) -> PyResult<(Bound<'py, PyArray2<C>>, Bound<'py, PyArray2<C>>)> {
     let k = curve_of(&d)?;
     let n = z1.as_array().len();
+    // Four points, g, eps, the offsets, xi and eta a row.
+    check_call("z1", n, 5 * 16 + 5 + 10 * 16 + 6 * 16)?;
     let (z1, y1) = (vec1(&z1, "z1", Some(n))?, vec1(&y1, "y1", Some(n))?);
     let (z2, y2) = (vec1(&z2, "z2", Some(n))?, vec1(&y2, "y2", Some(n))?);
     let g = vec1(&g, "g", Some(n))?;
     let eps: Option<Vec<[i8; 5]>> = eps.map(|e| rows(&e, "eps", Some(n))).transpose()?;
     let zd: Option<Vec<[C; 10]>> = zd.map(|z| rows(&z, "zd", Some(n))).transpose()?;
     let sqrt_c: Option<[C; 3]> = sqrt_c.map(|s| array1(&s, "sqrt_c")).transpose()?;
+    let mut xi = zeros2::<C>("xi", n, 3)?;
+    let mut eta = zeros2::<C>("eta", n, 3)?;
+    let cancel = py_cancel();
     let out = py.detach(|| -> Result<(Array2<C>, Array2<C>), Error> {
-        let mut xi = Array2::<C>::zeros((n, 3));
-        let mut eta = Array2::<C>::zeros((n, 3));
         for i in 0..n {
+            if i % every() == 0 {
+                cancel.check()?;
+            }
             let e = eps.as_ref().map(|e| e[i]);
             let (x, h) = match &zd {
                 None => k.xi_eta(z1[i], y1[i], z2[i], y2[i], g[i], e, sqrt_c)?,
@@ -205,18 +237,24 @@ fn curve_points_from_xi_eta_py<'py>(
 )> {
     let k = curve_of(&d)?;
     let n = xi.as_array().shape()[0];
+    // xi, eta, g_ref, the points, eps, the residual and the offsets a row.
+    check_call("xi", n, 7 * 16 + 5 * 16 + 5 + 8 + 10 * 16)?;
     let xi: Vec<[C; 3]> = rows(&xi, "xi", Some(n))?;
     let eta: Vec<[C; 3]> = rows(&eta, "eta", Some(n))?;
     let g_ref = g_ref.map(|g| vec1(&g, "g_ref", Some(n))).transpose()?;
     let sqrt_c: Option<[C; 3]> = sqrt_c.map(|s| array1(&s, "sqrt_c")).transpose()?;
     type Out = (Array2<C>, Array2<i8>, Array1<f64>, Array2<C>);
+    // Columns: z1, y1, z2, y2, g.
+    let mut pts = zeros2::<C>("points", n, 5)?;
+    let mut eps = zeros2::<i8>("eps", n, 5)?;
+    let mut res = Array1::from(try_vec("residual", n, 0.0)?);
+    let mut zd = zeros2::<C>("zd", n, 10)?;
+    let cancel = py_cancel();
     let out = py.detach(|| -> Result<Out, Error> {
-        // Columns: z1, y1, z2, y2, g.
-        let mut pts = Array2::<C>::zeros((n, 5));
-        let mut eps = Array2::<i8>::zeros((n, 5));
-        let mut res = Array1::<f64>::zeros(n);
-        let mut zd = Array2::<C>::zeros((n, 10));
         for i in 0..n {
+            if i % every() == 0 {
+                cancel.check()?;
+            }
             let gr = g_ref.as_ref().map(|g| g[i]);
             let b = k.points_from_xi_eta(xi[i], eta[i], sqrt_c, gr, rtol)?;
             for (j, v) in [b.z1, b.y1, b.z2, b.y2, b.g].into_iter().enumerate() {

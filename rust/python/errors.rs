@@ -3,7 +3,7 @@
 use std::sync::{Arc, Mutex};
 
 use pyo3::create_exception;
-use pyo3::exceptions::{PyKeyboardInterrupt, PyRuntimeError, PyValueError};
+use pyo3::exceptions::{PyKeyboardInterrupt, PyMemoryError, PyRuntimeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::PyErr;
 
@@ -37,6 +37,9 @@ fn exception(e: &Error, msg: String) -> PyErr {
         Error::NoConvergence { .. } => ConvergenceError::new_err(msg),
         Error::Unverified { .. } => ClosedFormError::new_err(msg),
         Error::Interrupted => PyKeyboardInterrupt::new_err(msg),
+        // A size over the budget, or one the machine cannot hold: numpy's
+        // exception for an array it cannot allocate.
+        Error::OutOfMemory { .. } | Error::TooLarge { .. } => PyMemoryError::new_err(msg),
         // A batch row's error: its own exception, the message naming the row.
         Error::InRow { source, .. } => exception(source, msg),
         Error::Shape { .. }

@@ -2,11 +2,13 @@
 //! (field, energy, integration with the GIL released), and one holding the
 //! Clebsch conjugacy (the maps to and from the conjugate Manakov top).
 
-use numpy::{IntoPyArray, PyArray1, PyArray2, PyArray3, PyReadonlyArray1, PyReadonlyArray2};
+use numpy::{
+    IntoPyArray, PyArray1, PyArray2, PyArray3, PyArrayMethods, PyReadonlyArray1, PyReadonlyArray2,
+};
 use pyo3::prelude::*;
 
-use super::arrays::{array1, rows, stack, vec1};
-use super::integrate::{run_many, run_partial, IntegrateOut};
+use super::arrays::{array1, map_rows, rows, shape_err, vec1, vec2};
+use super::integrate::{check_samples, run_many, run_partial, IntegrateOut};
 use crate::fluid::clebsch::ClebschConjugacy;
 use crate::fluid::{self, KirchhoffBody, SpaceMotion, DIM, SPACE_DIM};
 use crate::integrate::Options;
@@ -15,6 +17,26 @@ use crate::integrate::Options;
 fn mat3(x: &PyReadonlyArray2<'_, f64>, what: &'static str) -> PyResult<[f64; 9]> {
     let r = rows::<f64, 3>(x, what, Some(3))?;
     Ok(std::array::from_fn(|k| r[k / 3][k % 3]))
+}
+
+/// Checks that `y` holds states of [`DIM`] entries on its last axis.
+fn check_six(y: &PyReadonlyArray2<'_, f64>, what: &'static str) -> PyResult<()> {
+    let v = y.as_array();
+    if v.ncols() != DIM {
+        return Err(shape_err(what, format!("(n, {DIM})"), v.shape()));
+    }
+    Ok(())
+}
+
+/// `f` of one state as the row of `K` values of [`map_rows`].
+fn six<const K: usize>(
+    f: impl Fn(&[f64; DIM]) -> [f64; K],
+) -> impl Fn(&[f64], &mut [f64]) -> crate::error::Result<()> {
+    move |x, o| {
+        let x: [f64; DIM] = std::array::from_fn(|k| x[k]);
+        o.copy_from_slice(&f(&x));
+        Ok(())
+    }
 }
 
 /// A rigid body in an ideal fluid, `H = ½ (Mᵀ A M + 2 Mᵀ B p + pᵀ C p)`.
@@ -49,10 +71,8 @@ impl KirchhoffCore {
         py: Python<'py>,
         y: PyReadonlyArray2<'py, f64>,
     ) -> PyResult<Bound<'py, PyArray2<f64>>> {
-        let ys = rows::<f64, 6>(&y, "y", None)?;
-        let out: Vec<[f64; 6]> =
-            py.detach(|| ys.iter().map(|s| self.body.vector_field(s)).collect());
-        Ok(stack(out)?.into_pyarray(py))
+        check_six(&y, "y")?;
+        map_rows(py, &y, "y", DIM, 20.0, six(|s| self.body.vector_field(s)))
     }
 
     /// The energy at each row of `y` (N, 6).
@@ -61,9 +81,10 @@ impl KirchhoffCore {
         py: Python<'py>,
         y: PyReadonlyArray2<'py, f64>,
     ) -> PyResult<Bound<'py, PyArray1<f64>>> {
-        let ys = rows::<f64, 6>(&y, "y", None)?;
-        let out: Vec<f64> = py.detach(|| ys.iter().map(|s| self.body.hamiltonian(s)).collect());
-        Ok(out.into_pyarray(py))
+        check_six(&y, "y")?;
+        let rows = y.as_array().nrows();
+        let out = map_rows(py, &y, "y", 1, 20.0, six(|s| [self.body.hamiltonian(s)]))?;
+        out.reshape([rows])
     }
 
     /// Integrates from `y0` (6,) at `t0`, sampling at `times`: `(y (S', 6), steps,
@@ -83,6 +104,7 @@ impl KirchhoffCore {
         max_steps: u64,
     ) -> PyResult<IntegrateOut<'py>> {
         let y0: [f64; DIM] = array1(&y0, "y0")?;
+        check_samples(times.as_array().len(), 1, DIM)?;
         let times = vec1(&times, "times", None)?;
         let opts = Options::parse(method, dt, rtol, atol, max_steps)?;
         run_partial(py, &self.body, &y0, t0, &times, &opts, None)
@@ -104,9 +126,9 @@ impl KirchhoffCore {
         max_steps: u64,
         parallel: bool,
     ) -> PyResult<(Bound<'py, PyArray3<f64>>, u64)> {
-        let y0s = rows::<f64, 6>(&y0s, "y0s", None)?;
-        let n = y0s.len();
-        let flat: Vec<f64> = y0s.into_iter().flatten().collect();
+        check_six(&y0s, "y0s")?;
+        check_samples(times.as_array().len(), y0s.as_array().nrows(), DIM)?;
+        let (flat, n, _) = vec2(&y0s, "y0s")?;
         let times = vec1(&times, "times", None)?;
         let opts = Options::parse(method, dt, rtol, atol, max_steps)?;
         run_many(py, &self.body, &flat, n, t0, &times, &opts, parallel, None)
@@ -129,6 +151,7 @@ impl KirchhoffCore {
         max_steps: u64,
     ) -> PyResult<IntegrateOut<'py>> {
         let s0: [f64; SPACE_DIM] = array1(&s0, "s0")?;
+        check_samples(times.as_array().len(), 1, SPACE_DIM)?;
         let times = vec1(&times, "times", None)?;
         let opts = Options::parse(method, dt, rtol, atol, max_steps)?;
         run_partial(
@@ -149,9 +172,8 @@ fn kirchhoff_casimirs_py<'py>(
     py: Python<'py>,
     y: PyReadonlyArray2<'py, f64>,
 ) -> PyResult<Bound<'py, PyArray2<f64>>> {
-    let ys = rows::<f64, 6>(&y, "y", None)?;
-    let out: Vec<[f64; 2]> = py.detach(|| ys.iter().map(fluid::casimirs).collect());
-    Ok(stack(out)?.into_pyarray(py))
+    check_six(&y, "y")?;
+    map_rows(py, &y, "y", 2, 10.0, six(fluid::casimirs))
 }
 
 /// The linear conjugacy of a Clebsch body to a Manakov top.
@@ -217,9 +239,8 @@ impl ClebschCore {
         py: Python<'py>,
         y: PyReadonlyArray2<'py, f64>,
     ) -> PyResult<Bound<'py, PyArray2<f64>>> {
-        let ys = rows::<f64, 6>(&y, "y", None)?;
-        let out: Vec<[f64; 6]> = py.detach(|| ys.iter().map(|s| self.conj.to_so4(s)).collect());
-        Ok(stack(out)?.into_pyarray(py))
+        check_six(&y, "y")?;
+        map_rows(py, &y, "y", DIM, 20.0, six(|s| self.conj.to_so4(s)))
     }
 
     /// `y = L⁻¹ l` for each row of `l` (N, 6).
@@ -228,9 +249,8 @@ impl ClebschCore {
         py: Python<'py>,
         l: PyReadonlyArray2<'py, f64>,
     ) -> PyResult<Bound<'py, PyArray2<f64>>> {
-        let ls = rows::<f64, 6>(&l, "l", None)?;
-        let out: Vec<[f64; 6]> = py.detach(|| ls.iter().map(|s| self.conj.to_body(s)).collect());
-        Ok(stack(out)?.into_pyarray(py))
+        check_six(&l, "l")?;
+        map_rows(py, &l, "l", DIM, 20.0, six(|s| self.conj.to_body(s)))
     }
 }
 

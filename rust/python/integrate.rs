@@ -4,9 +4,9 @@ use numpy::ndarray::{Array2, Array3};
 use numpy::{IntoPyArray, PyArray1, PyArray2, PyArray3, PyReadonlyArray1, PyReadonlyArray2};
 use pyo3::prelude::*;
 
-use super::arrays::{out_shape_err, vec1};
+use super::arrays::{check_call, out_shape_err, vec1, vec2};
 use super::errors::{callback_or, py_cancel_progress};
-use super::so4::{check_states, top_from_c, vec2};
+use super::so4::{check_states, top_from_c};
 use crate::error::Error;
 use crate::integrate::{self, Method, Options, VectorField};
 
@@ -72,6 +72,17 @@ pub(super) fn run_many<'py, F: VectorField>(
     Ok((y, steps))
 }
 
+/// Checks before any copy that `samples` sample times and the states of
+/// `rows` trajectories of `m` entries at them fit the allocation budget.
+pub(super) fn check_samples(samples: usize, rows: usize, m: usize) -> PyResult<()> {
+    let each = rows.max(1).saturating_mul(m).saturating_add(1);
+    check_call(
+        "samples",
+        samples,
+        each.saturating_mul(std::mem::size_of::<f64>()),
+    )
+}
+
 /// Integrates (1) from l0 at t0, sampling at `times`; returns `(l (S', m), steps,
 /// evals, error)`: on a failure or Ctrl-C after the run started, `error` is the
 /// exception to raise (not raised here) and `l` holds the `S' < S` samples reached.
@@ -94,6 +105,8 @@ fn integrate_py<'py>(
     progress: Option<Py<PyAny>>,
 ) -> PyResult<IntegrateOut<'py>> {
     let top = top_from_c(&c)?;
+    // The sample times and the states at them, before anything is copied.
+    check_samples(times.as_array().len(), 1, top.dim())?;
     let (l0, times) = (vec1(&l0, "l0", None)?, vec1(&times, "times", None)?);
     let opts = Options::parse(method, dt, rtol, atol, max_steps)?;
     run_partial(py, &top, &l0, t0, &times, &opts, progress)
@@ -119,8 +132,10 @@ fn integrate_many_py<'py>(
     progress: Option<Py<PyAny>>,
 ) -> PyResult<(Bound<'py, PyArray3<f64>>, u64)> {
     let top = top_from_c(&c)?;
-    let (l0s, rows, cols) = vec2(&l0s);
+    let (rows, cols) = l0s.as_array().dim();
     check_states("l0s", cols, top.dim())?;
+    check_samples(times.as_array().len(), rows, cols)?;
+    let (l0s, _, _) = vec2(&l0s, "l0s")?;
     let times = vec1(&times, "times", None)?;
     let opts = Options::parse(method, dt, rtol, atol, max_steps)?;
     run_many(py, &top, &l0s, rows, t0, &times, &opts, parallel, progress)
@@ -136,6 +151,7 @@ fn check_budget_py(
     dt: f64,
     max_steps: u64,
 ) -> PyResult<()> {
+    check_samples(times.as_array().len(), 0, 0)?;
     let times = vec1(&times, "times", None)?;
     integrate::check_sample_times(t0, &times)?;
     integrate::check_budget(Method::from_name(method)?, t0, &times, dt, max_steps)?;
@@ -146,6 +162,7 @@ fn check_budget_py(
 /// most `dt` (see `integrate::gauss_steps`).
 #[pyfunction(name = "gauss_steps")]
 fn gauss_steps_py(t0: f64, times: PyReadonlyArray1<'_, f64>, dt: f64) -> PyResult<u64> {
+    check_samples(times.as_array().len(), 0, 0)?;
     let times = vec1(&times, "times", None)?;
     integrate::check_sample_times(t0, &times)?;
     if !(dt > 0.0 && dt.is_finite()) {

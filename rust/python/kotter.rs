@@ -5,9 +5,23 @@ use numpy::{Complex64, IntoPyArray, PyReadonlyArray1, PyReadonlyArray2, PyReadon
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
-use super::arrays::{array1, out_shape_err, rows, shape_err, stack, vec1};
+use super::arrays::{array1, check_call, out_shape_err, rows, shape_err, stack, vec1};
+use super::errors::py_cancel;
 use crate::error::Error;
 use crate::kotter;
+use crate::numeric::alloc::{items_per_check, try_map};
+
+/// Rows of an `(n, K)` input, checked first: `n` rows of `each` bytes of
+/// inputs and results must fit the allocation budget.
+fn rows_checked<T: numpy::Element + Copy, const K: usize>(
+    x: &PyReadonlyArray2<'_, T>,
+    what: &'static str,
+    n: Option<usize>,
+    each: usize,
+) -> PyResult<Vec<[T; K]>> {
+    check_call(what, x.as_array().nrows(), each)?;
+    rows(x, what, n)
+}
 
 type C = Complex64;
 type LmPair = ([C; 3], [C; 3]);
@@ -22,19 +36,19 @@ fn kotter_schottky_py<'py>(
     sqrt_g: PyReadonlyArray1<'py, C>,
 ) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyAny>)> {
     let a: [f64; 4] = array1(&a, "a")?;
-    let rows = rows::<f64, 6>(&l, "l", None)?;
+    // l, s, sqrt_g and the two rows of 3 complex results.
+    let rows = rows_checked::<f64, 6>(&l, "l", None, 48 + 2 * 16 + 6 * 16 + 6 * 16)?;
     let n = rows.len();
     let s = vec1(&s, "s", Some(n))?;
     let sg = vec1(&sqrt_g, "sqrt_g", Some(n))?;
+    let cancel = py_cancel();
+    let idx: Vec<usize> = (0..n).collect();
     let res: Result<Vec<LmPair>, Error> = py.detach(|| {
         crate::error::check_finite("a", &a)?;
-        rows.iter()
-            .zip(s.iter().zip(sg.iter()))
-            .map(|(r, (&si, &gi))| {
-                crate::error::check_finite("l", r)?;
-                kotter::schottky(&a, r, si, gi)
-            })
-            .collect()
+        try_map("l", &idx, items_per_check(200.0), &cancel, |&i| {
+            crate::error::check_finite("l", &rows[i])?;
+            kotter::schottky(&a, &rows[i], s[i], sg[i])
+        })
     });
     let res = res?;
     let lv = stack(res.iter().map(|x| x.0))?;
@@ -57,15 +71,16 @@ fn kotter_lax_m_py<'py>(
 ) -> PyResult<Bound<'py, PyAny>> {
     let a: [f64; 4] = array1(&a, "a")?;
     let b: [f64; 4] = array1(&b, "b")?;
-    let rows = rows::<f64, 6>(&l, "l", None)?;
+    let rows = rows_checked::<f64, 6>(&l, "l", None, 48 + 2 * 16 + 2 * 3 * 16)?;
     let n = rows.len();
     let s = vec1(&s, "s", Some(n))?;
     let sg = vec1(&sqrt_g, "sqrt_g", Some(n))?;
+    let cancel = py_cancel();
+    let idx: Vec<usize> = (0..n).collect();
     let res: Result<Vec<[C; 3]>, Error> = py.detach(|| {
-        rows.iter()
-            .zip(s.iter().zip(sg.iter()))
-            .map(|(r, (&si, &gi))| kotter::lax_m(&a, &b, r, si, gi))
-            .collect()
+        try_map("l", &idx, items_per_check(200.0), &cancel, |&i| {
+            kotter::lax_m(&a, &b, &rows[i], s[i], sg[i])
+        })
     });
     Ok(stack(res?)?.into_pyarray(py).into_any())
 }
@@ -78,15 +93,14 @@ fn kotter_quartic_py<'py>(
     h: PyReadonlyArray2<'py, f64>,
 ) -> PyResult<Bound<'py, PyAny>> {
     let a: [f64; 4] = array1(&a, "a")?;
-    let rows = rows::<f64, 4>(&h, "h", None)?;
+    let rows = rows_checked::<f64, 4>(&h, "h", None, 32 + 2 * 40)?;
+    let cancel = py_cancel();
     let res: Result<Vec<[f64; 5]>, Error> = py.detach(|| {
         crate::error::check_finite("a", &a)?;
-        rows.iter()
-            .map(|r| {
-                crate::error::check_finite("h", r)?;
-                kotter::quartic_f(&a, r)
-            })
-            .collect()
+        try_map("h", &rows, items_per_check(100.0), &cancel, |r| {
+            crate::error::check_finite("h", r)?;
+            kotter::quartic_f(&a, r)
+        })
     });
     Ok(stack(res?)?.into_pyarray(py).into_any())
 }
@@ -106,12 +120,14 @@ fn kotter_batch_py<'py>(
     mask: bool,
 ) -> PyResult<Bound<'py, PyDict>> {
     let a: [f64; 4] = array1(&a, "a")?;
-    let rows = rows::<f64, 6>(&l, "l", None)?;
+    // The copy of l and the batch's fields, before either is allocated.
+    let rows = rows_checked::<f64, 6>(&l, "l", None, 48 + kotter::ROW_BYTES)?;
     let l0: Option<[f64; 6]> = match l0 {
         Some(v) => Some(array1(&v, "l0")?),
         None => None,
     };
-    let b = py.detach(|| kotter::kotter_batch(&a, &rows, l0.as_ref(), mask))?;
+    let cancel = py_cancel();
+    let b = py.detach(|| kotter::kotter_batch(&a, &rows, l0.as_ref(), mask, &cancel))?;
     let n = b.n;
     let dict = PyDict::new(py);
     let two = |v: Vec<C>, m: usize| -> PyResult<Bound<'py, PyAny>> {
@@ -179,6 +195,8 @@ fn kotter_from_points_py<'py>(
     zd: Option<PyReadonlyArray3<'py, C>>,
 ) -> PyResult<Bound<'py, PyAny>> {
     let n = z1.as_array().len();
+    // Twenty complex inputs, the branch, the offsets and the state, a row.
+    check_call("z1", n, 20 * 16 + 5 + 10 * 16 + 48)?;
     let al = rows::<C, 3>(&alpha, "alpha", Some(n))?;
     let be = rows::<C, 3>(&beta, "beta", Some(n))?;
     let ga = rows::<C, 3>(&gamma, "gamma", Some(n))?;
@@ -197,33 +215,33 @@ fn kotter_from_points_py<'py>(
             if z.shape() != [n, 2, 5] {
                 return Err(shape_err("zd", format!("({n}, 2, 5)"), z.shape()));
             }
-            Some(
-                (0..n)
-                    .map(|i| std::array::from_fn(|p| std::array::from_fn(|j| z[[i, p, j]])))
-                    .collect(),
-            )
+            Some(crate::numeric::alloc::try_collect(
+                "zd",
+                n,
+                (0..n).map(|i| std::array::from_fn(|p| std::array::from_fn(|j| z[[i, p, j]]))),
+            )?)
         }
     };
+    let cancel = py_cancel();
+    let idx: Vec<usize> = (0..n).collect();
     let res: Result<Vec<[f64; 6]>, Error> = py.detach(|| {
-        (0..n)
-            .map(|i| {
-                let coef = kotter::Coefficients23 {
-                    alpha: al[i],
-                    beta: be[i],
-                    gamma: ga[i],
-                    delta: de[i],
-                };
-                kotter::from_kotter(
-                    &coef,
-                    dv[i],
-                    [z1[i], z2[i]],
-                    [y1[i], y2[i]],
-                    zd.as_ref().map(|v| v[i]),
-                    g[i],
-                    br[i],
-                )
-            })
-            .collect()
+        try_map("z1", &idx, items_per_check(2000.0), &cancel, |&i| {
+            let coef = kotter::Coefficients23 {
+                alpha: al[i],
+                beta: be[i],
+                gamma: ga[i],
+                delta: de[i],
+            };
+            kotter::from_kotter(
+                &coef,
+                dv[i],
+                [z1[i], z2[i]],
+                [y1[i], y2[i]],
+                zd.as_ref().map(|v| v[i]),
+                g[i],
+                br[i],
+            )
+        })
     });
     Ok(stack(res?)?.into_pyarray(py).into_any())
 }

@@ -6,8 +6,9 @@ use numpy::ndarray::{Array1, Array2};
 use numpy::{Complex64, IntoPyArray, PyArray1, PyArray2, PyReadonlyArray1, PyReadonlyArray2};
 use pyo3::prelude::*;
 
-use super::arrays::{out_shape_err, shape_err, vec1};
+use super::arrays::{check_call, out_shape_err, shape_err, vec1};
 use super::errors::py_cancel;
+use crate::numeric::alloc::try_collect;
 use crate::riemann::{AbelRoute, HyperellipticCurve};
 
 type C = Complex64;
@@ -91,8 +92,10 @@ impl HyperellipticCore {
         x: PyReadonlyArray1<'py, C>,
         sheet: i8,
     ) -> PyResult<Bound<'py, PyArray1<C>>> {
+        check_call("x", x.as_array().len(), 2 * 16)?;
         let xs = vec1(&x, "x", None)?;
-        let out = py.detach(|| self.curve.y_many(&xs, sheet))?;
+        let cancel = py_cancel();
+        let out = py.detach(|| self.curve.y_many(&xs, sheet, &cancel))?;
         Ok(Array1::from(out).into_pyarray(py))
     }
 
@@ -106,9 +109,11 @@ impl HyperellipticCore {
         y: PyReadonlyArray1<'py, C>,
         route: Option<i64>,
     ) -> PyResult<Bound<'py, PyArray2<C>>> {
+        let g = self.curve.genus();
+        check_call("x", x.as_array().len(), (2 + g) * 16)?;
         let xs = vec1(&x, "x", None)?;
         let ys = vec1(&y, "y", Some(xs.len()))?;
-        let (g, n) = (self.curve.genus(), xs.len());
+        let n = xs.len();
         let route = match route {
             None => AbelRoute::Best,
             Some(r) if r < 0 => AbelRoute::Infinity,
@@ -130,9 +135,11 @@ impl HyperellipticCore {
         dx: PyReadonlyArray1<'py, C>,
         y: PyReadonlyArray1<'py, C>,
     ) -> PyResult<Bound<'py, PyArray2<C>>> {
+        let g = self.curve.genus();
+        check_call("dx", dx.as_array().len(), (2 + g) * 16)?;
         let dxs = vec1(&dx, "dx", None)?;
         let ys = vec1(&y, "y", Some(dxs.len()))?;
-        let (g, n) = (self.curve.genus(), dxs.len());
+        let n = dxs.len();
         let cancel = py_cancel();
         let out = py.detach(|| self.curve.abel_near_branch_many(k, &dxs, &ys, &cancel))?;
         Ok(Array2::from_shape_vec((n, g), out)
@@ -189,8 +196,10 @@ impl HyperellipticCore {
         if v.ncols() != g {
             return Err(shape_err("z", format!("(N, {g})"), v.shape()));
         }
-        let flat: Vec<C> = v.iter().copied().collect();
-        let out = self.curve.reduce_many(&flat)?;
+        check_call("z", v.nrows(), 2 * g * 16)?;
+        let flat: Vec<C> = try_collect("z", v.len(), v.iter().copied())?;
+        let cancel = py_cancel();
+        let out = py.detach(|| self.curve.reduce_many(&flat, &cancel))?;
         Ok(Array2::from_shape_vec((v.nrows(), g), out)
             .map_err(out_shape_err)?
             .into_pyarray(py))
@@ -208,7 +217,8 @@ impl HyperellipticCore {
         if v.ncols() != g {
             return Err(shape_err("u", format!("(N, {g})"), v.shape()));
         }
-        let flat: Vec<C> = v.iter().copied().collect();
+        check_call("u", v.nrows(), (g + 4) * 16)?;
+        let flat: Vec<C> = try_collect("u", v.len(), v.iter().copied())?;
         let n = v.nrows();
         let cancel = py_cancel();
         let (xs, ys) = py.detach(|| self.curve.invert_many(&flat, &cancel))?;

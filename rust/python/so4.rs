@@ -1,30 +1,29 @@
 //! Bindings for `crate::so4`.
 
-use numpy::ndarray::{Array2, Array3};
-use numpy::{IntoPyArray, PyArray1, PyArray2, PyArray3, PyReadonlyArray1, PyReadonlyArray2};
+use numpy::ndarray::Array2;
+use numpy::PyReadonlyArray2;
+use numpy::{IntoPyArray, PyArray1, PyArray2, PyArray3, PyArrayMethods, PyReadonlyArray1};
 use pyo3::prelude::*;
 
-use super::arrays::{array1, out_shape_err, rows, stack, vec1};
+use super::arrays::{array1, map_rows, out_shape_err, vec1, vec2};
 use crate::error::Error;
 use crate::so4::{self, FrahmTop};
 
-/// Copies a read-only 2-d array (any strides) into a row-major Vec with its shape.
-pub(super) fn vec2(x: &PyReadonlyArray2<'_, f64>) -> (Vec<f64>, usize, usize) {
-    let v = x.as_array();
-    let (r, c) = v.dim();
-    (v.iter().copied().collect(), r, c)
-}
-
-pub(super) fn top_from_c(c: &PyReadonlyArray2<'_, f64>) -> Result<FrahmTop, Error> {
-    let (cv, r, k) = vec2(c);
+/// The top of a symmetric `c` `(n, n)`; `n` is checked against `so4::MAX_N`
+/// before `c` is copied.
+pub(super) fn top_from_c(c: &PyReadonlyArray2<'_, f64>) -> PyResult<FrahmTop> {
+    let (r, k) = c.as_array().dim();
     if r != k {
         return Err(Error::Shape {
             what: "c",
             expected: "(n, n)".into(),
             got: format!("({r}, {k})"),
-        });
+        }
+        .into());
     }
-    FrahmTop::new(r, &cv)
+    so4::check_n("c", r)?;
+    let (cv, _, _) = vec2(c, "c")?;
+    Ok(FrahmTop::new(r, &cv)?)
 }
 
 pub(super) fn check_states(what: &'static str, cols: usize, m: usize) -> Result<(), Error> {
@@ -38,6 +37,16 @@ pub(super) fn check_states(what: &'static str, cols: usize, m: usize) -> Result<
     Ok(())
 }
 
+/// Nanoseconds of (1) at one state of so(n), about (for the cancellation
+/// checks of a batch; so(4) has its own fast path).
+fn field_cost_ns(n: usize) -> f64 {
+    if n == 4 {
+        5.0
+    } else {
+        (n * n * n) as f64
+    }
+}
+
 /// Manakov's c_ij (2) from a, b.
 #[pyfunction(name = "manakov_c")]
 fn manakov_c_py<'py>(
@@ -45,6 +54,7 @@ fn manakov_c_py<'py>(
     a: PyReadonlyArray1<'py, f64>,
     b: PyReadonlyArray1<'py, f64>,
 ) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    so4::check_n("a", a.as_array().len())?;
     let (a, b) = (vec1(&a, "a", None)?, vec1(&b, "b", None)?);
     let n = a.len();
     let c = py.detach(|| so4::manakov_c(&a, &b))?;
@@ -68,18 +78,12 @@ fn vector_field_py<'py>(
     l: PyReadonlyArray2<'py, f64>,
 ) -> PyResult<Bound<'py, PyArray2<f64>>> {
     let top = top_from_c(&c)?;
-    let (lv, rows, cols) = vec2(&l);
-    check_states("l", cols, top.dim())?;
-    let out = py.detach(|| {
-        let mut out = vec![0.0; lv.len()];
-        for (x, o) in lv.chunks(cols.max(1)).zip(out.chunks_mut(cols.max(1))) {
-            top.vector_field(x, o);
-        }
-        out
-    });
-    Ok(Array2::from_shape_vec((rows, cols), out)
-        .map_err(out_shape_err)?
-        .into_pyarray(py))
+    let m = top.dim();
+    check_states("l", l.as_array().ncols(), m)?;
+    map_rows(py, &l, "l", m, field_cost_ns(top.n()), |x, o| {
+        top.vector_field(x, o);
+        Ok(())
+    })
 }
 
 /// The Hamiltonian (4) at each row of l.
@@ -90,10 +94,13 @@ fn hamiltonian_py<'py>(
     l: PyReadonlyArray2<'py, f64>,
 ) -> PyResult<Bound<'py, PyArray1<f64>>> {
     let top = top_from_c(&c)?;
-    let (lv, _, cols) = vec2(&l);
+    let (rows, cols) = l.as_array().dim();
     check_states("l", cols, top.dim())?;
-    let out: Vec<f64> = py.detach(|| lv.chunks(cols.max(1)).map(|x| top.hamiltonian(x)).collect());
-    Ok(out.into_pyarray(py))
+    let out = map_rows(py, &l, "l", 1, top.dim() as f64, |x, o| {
+        o[0] = top.hamiltonian(x);
+        Ok(())
+    })?;
+    out.reshape([rows])
 }
 
 /// The so(4) integrals [H0, H1, H2, H3] (6)-(7), corrected, at each row of l (N, 6).
@@ -104,15 +111,23 @@ fn so4_integrals_py<'py>(
     l: PyReadonlyArray2<'py, f64>,
 ) -> PyResult<Bound<'py, PyArray2<f64>>> {
     let a4: [f64; 4] = array1(&a, "a")?;
-    let ls = rows::<f64, 6>(&l, "l", None)?;
-    let out: Vec<[f64; 4]> = py.detach(|| ls.iter().map(|x| so4::integrals4(&a4, x)).collect());
-    Ok(stack(out)?.into_pyarray(py))
+    check_states("l", l.as_array().ncols(), 6)?;
+    map_rows(py, &l, "l", 4, 30.0, |x, o| {
+        let x: &[f64; 6] = x.try_into().map_err(|_| Error::Shape {
+            what: "l",
+            expected: "(..., 6)".into(),
+            got: format!("(..., {})", x.len()),
+        })?;
+        o.copy_from_slice(&so4::integrals4(&a4, x));
+        Ok(())
+    })
 }
 
 /// Labels (k, j) of Manakov's integrals on so(n).
 #[pyfunction(name = "manakov_integral_labels")]
-fn manakov_integral_labels_py(n: usize) -> Vec<(usize, usize)> {
-    so4::manakov_integral_labels(n)
+fn manakov_integral_labels_py(n: usize) -> PyResult<Vec<(usize, usize)>> {
+    so4::check_n("n", n)?;
+    Ok(so4::manakov_integral_labels(n))
 }
 
 /// Manakov's integrals (coefficients of tr (l + λA)^k) at each row of l.
@@ -122,19 +137,17 @@ fn manakov_integrals_py<'py>(
     a: PyReadonlyArray1<'py, f64>,
     l: PyReadonlyArray2<'py, f64>,
 ) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    so4::check_n("a", a.as_array().len())?;
     let a = vec1(&a, "a", None)?;
     let n = a.len();
-    let (lv, rows, cols) = vec2(&l);
-    check_states("l", cols, so4::state_dim(n))?;
+    check_states("l", l.as_array().ncols(), so4::state_dim(n))?;
     let k = so4::manakov_integral_labels(n).len();
-    let out: Vec<f64> = py.detach(|| {
-        lv.chunks(cols.max(1))
-            .flat_map(|x| so4::manakov_integrals(&a, x))
-            .collect()
-    });
-    Ok(Array2::from_shape_vec((rows, k), out)
-        .map_err(out_shape_err)?
-        .into_pyarray(py))
+    // n powers of an n x n matrix, each n^3: n^5 a state.
+    let cost = (n as f64).powi(5);
+    map_rows(py, &l, "l", k, cost, |x, o| {
+        o.copy_from_slice(&so4::manakov_integrals(&a, x));
+        Ok(())
+    })
 }
 
 /// The Poisson tensor (3) at each row of l, shape (N, m, m).
@@ -143,7 +156,7 @@ fn poisson_tensor_py<'py>(
     py: Python<'py>,
     l: PyReadonlyArray2<'py, f64>,
 ) -> PyResult<Bound<'py, PyArray3<f64>>> {
-    let (lv, rows, cols) = vec2(&l);
+    let (rows, cols) = l.as_array().dim();
     let n = so4::n_from_state_dim(cols)
         .filter(|&n| n >= 2)
         .ok_or_else(|| Error::Shape {
@@ -151,16 +164,12 @@ fn poisson_tensor_py<'py>(
             expected: "(..., n(n-1)/2)".into(),
             got: format!("(..., {cols})"),
         })?;
-    let out = py.detach(|| {
-        let mut out = vec![0.0; rows * cols * cols];
-        for (x, o) in lv.chunks(cols).zip(out.chunks_mut(cols * cols)) {
-            so4::poisson_tensor(n, x, o);
-        }
-        out
-    });
-    Ok(Array3::from_shape_vec((rows, cols, cols), out)
-        .map_err(out_shape_err)?
-        .into_pyarray(py))
+    so4::check_n("l", n)?;
+    let out = map_rows(py, &l, "l", cols * cols, (cols * cols) as f64, |x, o| {
+        so4::poisson_tensor(n, x, o);
+        Ok(())
+    })?;
+    out.reshape([rows, cols, cols])
 }
 
 /// Adds this module's functions to `manakov._core`.

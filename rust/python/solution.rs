@@ -7,8 +7,9 @@ use pyo3::prelude::*;
 
 use std::sync::Arc;
 
-use super::arrays::{array1, out_shape_err};
+use super::arrays::{array1, check_call, out_shape_err, vec1};
 use super::errors::py_cancel;
+use crate::numeric::alloc::try_vec;
 use crate::solution::Solution;
 
 type C = Complex64;
@@ -55,10 +56,12 @@ impl SolutionCore {
         py: Python<'py>,
         t: PyReadonlyArray1<'_, f64>,
     ) -> PyResult<Bound<'py, PyArray2<f64>>> {
-        let t: Vec<f64> = t.as_array().iter().copied().collect();
+        // The times and the six components at each, before anything is copied.
+        check_call("t", t.as_array().len(), 7 * std::mem::size_of::<f64>())?;
+        let t = vec1(&t, "t", None)?;
         let n = t.len();
         let out = py.detach(|| -> crate::error::Result<Vec<f64>> {
-            let mut out = vec![0.0; 6 * n];
+            let mut out = try_vec("l(t)", 6 * n, 0.0)?;
             self.sol.l_batch(&t, &mut out, &py_cancel())?;
             Ok(out)
         })?;

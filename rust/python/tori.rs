@@ -4,8 +4,9 @@ use numpy::ndarray::Array1;
 use numpy::{Complex64, IntoPyArray, PyArray1, PyArray2, PyReadonlyArray1, PyReadonlyArray2};
 use pyo3::prelude::*;
 
-use super::arrays::{array1, rows, stack};
+use super::arrays::{array1, check_call, rows, stack};
 use super::errors::py_cancel;
+use crate::numeric::alloc::try_collect;
 use crate::tori::{self, Char};
 
 type C = Complex64;
@@ -51,11 +52,13 @@ fn frequency_map_py<'py>(
 ) -> PyResult<(Bound<'py, PyArray2<f64>>, Bound<'py, PyArray1<u8>>)> {
     let a: [f64; 4] = array1(&a, "a")?;
     let b: [f64; 4] = array1(&b, "b")?;
+    // The states, their results and the two output arrays.
+    check_call("states", states.as_array().nrows(), 48 + 64 + 17)?;
     let ls: Vec<[f64; 6]> = rows(&states, "states", None)?;
     let cancel = py_cancel();
     let out = py.detach(|| tori::solve::frequency_map(&a, &b, &ls, &cancel))?;
     let nu = stack(out.iter().map(|e| e.nu))?;
-    let status: Vec<u8> = out.iter().map(|e| e.status as u8).collect();
+    let status: Vec<u8> = try_collect("status", out.len(), out.iter().map(|e| e.status as u8))?;
     Ok((nu.into_pyarray(py), Array1::from(status).into_pyarray(py)))
 }
 

@@ -3,7 +3,9 @@
 //! compare the routes), and the finiteness checks of the inputs.
 
 use super::*;
+use crate::numeric::alloc::{items_per_check, try_map, try_vec, try_with_capacity};
 use crate::numeric::cancel::Cancel;
+use crate::theta::MAX_REDUCTION;
 
 /// Points per chunk between two cancellation checks: ~2 ms of Abel
 /// integrals (the 0.5 s promised for Ctrl-C leaves ample room).
@@ -33,12 +35,27 @@ fn check_finite_c(what: &'static str, v: &[C]) -> Result<()> {
 }
 
 impl HyperellipticCurve {
-    /// `y(x, sheet)` at each `x` ([`HyperellipticCurve::y`]).
+    /// `y(x, sheet)` at each `x` ([`HyperellipticCurve::y`]); `cancel` is
+    /// checked about every millisecond.
     ///
-    /// Errors: a non-finite `x`.
-    pub fn y_many(&self, x: &[C], sheet: i8) -> Result<Vec<C>> {
+    /// Errors: a non-finite `x`; an `x` so large that `y` overflows.
+    pub fn y_many(&self, x: &[C], sheet: i8, cancel: &Cancel) -> Result<Vec<C>> {
         check_finite_c("x", x)?;
-        Ok(x.iter().map(|&v| self.y(v, sheet)).collect())
+        try_map("y", x, items_per_check(50.0), cancel, |&v| {
+            let y = self.y(v, sheet);
+            if !is_finite_c(y) {
+                return Err(Error::InvalidArgument {
+                    what: "x",
+                    reason: format!(
+                        "y(x) overflows at x = {}: |y|^2 = |R(x)| ~ |x|^{} is beyond the \
+                         double range",
+                        crate::error::cnum(v),
+                        self.e.len()
+                    ),
+                });
+            }
+            Ok(y)
+        })
     }
 
     /// The Abel map of the points `(x_i, y_i)`, row-major `(N, g)`, along
@@ -54,7 +71,7 @@ impl HyperellipticCurve {
                 got: format!("({},)", y.len()),
             });
         }
-        let mut out = vec![C::new(0.0, 0.0); n * g];
+        let mut out = try_vec("u", n * g, C::new(0.0, 0.0))?;
         for (k, chunk) in out.chunks_mut(CHUNK * g).enumerate() {
             cancel.check()?;
             let lo = k * CHUNK;
@@ -92,7 +109,7 @@ impl HyperellipticCurve {
                 got: format!("({},)", y.len()),
             });
         }
-        let mut out = Vec::with_capacity(n * self.g);
+        let mut out = try_with_capacity("u", n * self.g)?;
         for (i, (&d, &w)) in dx.iter().zip(y).enumerate() {
             if i % CHUNK == 0 {
                 cancel.check()?;
@@ -102,12 +119,40 @@ impl HyperellipticCurve {
         Ok(out)
     }
 
-    /// The rows of `z` (row-major `(N, g)`) reduced modulo the lattice.
+    /// The rows of `z` (row-major `(N, g)`) reduced modulo the lattice;
+    /// `cancel` is checked about every millisecond.
     ///
-    /// Errors: a non-finite entry.
-    pub fn reduce_many(&self, z: &[C]) -> Result<Vec<C>> {
+    /// Errors: a non-finite entry; lattice coordinates beyond
+    /// [`MAX_REDUCTION`] (there a double has no fractional part, so the
+    /// reduced point is not determined to any digit: the bound of the theta
+    /// functions' own reduction).
+    pub fn reduce_many(&self, z: &[C], cancel: &Cancel) -> Result<Vec<C>> {
         check_finite_c("z", z)?;
-        Ok(z.chunks(self.g).flat_map(|r| self.reduce(r)).collect())
+        let g = self.g.max(1);
+        let mut out = try_with_capacity("z", z.len())?;
+        for (i, row) in z.chunks(g).enumerate() {
+            if i % items_per_check(100.0) == 0 {
+                cancel.check()?;
+            }
+            let (alpha, beta) = self.lattice_coordinates(row);
+            if let Some(c) = alpha
+                .iter()
+                .chain(&beta)
+                .find(|c| c.is_nan() || c.abs() > MAX_REDUCTION)
+            {
+                return Err(Error::InvalidArgument {
+                    what: "z",
+                    reason: format!(
+                        "row {i} has a lattice coordinate {}: beyond {MAX_REDUCTION:e} a \
+                         double has no fractional part, so z modulo the lattice is not \
+                         determined",
+                        crate::error::num(*c)
+                    ),
+                });
+            }
+            out.extend(self.reduce(row));
+        }
+        Ok(out)
     }
 
     /// [`HyperellipticCurve::invert`] of the rows of `u` (row-major `(N, 2)`):
@@ -115,8 +160,8 @@ impl HyperellipticCurve {
     /// `INVERT_CHUNK` rows.
     pub fn invert_many(&self, u: &[C], cancel: &Cancel) -> Result<(Vec<C>, Vec<C>)> {
         let n = u.len() / self.g.max(1);
-        let mut xs = Vec::with_capacity(2 * n);
-        let mut ys = Vec::with_capacity(2 * n);
+        let mut xs = try_with_capacity("x", 2 * n)?;
+        let mut ys = try_with_capacity("y", 2 * n)?;
         for (i, row) in u.chunks(self.g).enumerate() {
             if i % INVERT_CHUNK == 0 {
                 cancel.check()?;

@@ -248,7 +248,7 @@ fn batches_follow_the_point_by_point_maps() {
     ];
     let h = HyperellipticCurve::new(&e).unwrap();
     let x = [c(0.4, 0.3), c(-0.2, -0.8), c(1.7, 1.1)];
-    let y = h.y_many(&x, 1).unwrap();
+    let y = h.y_many(&x, 1, &Cancel::never()).unwrap();
     assert_eq!(y, x.map(|v| h.y(v, 1)));
     let never = Cancel::never();
     let best = h.abel_many(&x, &y, AbelRoute::Best, &never).unwrap();
@@ -271,14 +271,14 @@ fn batches_follow_the_point_by_point_maps() {
     let hit = |z: C| xs.iter().any(|w| (w - z).norm() < 1e-9);
     assert!(hit(x[0]) && hit(x[1]), "{xs:?}");
     assert_eq!(
-        h.reduce_many(&[c(0.0, 0.0), c(f64::NAN, 0.0)]),
+        h.reduce_many(&[c(0.0, 0.0), c(f64::NAN, 0.0)], &Cancel::never()),
         Err(Error::NonFinite {
             what: "z",
             index: 1
         })
     );
     assert!(matches!(
-        h.y_many(&[c(f64::INFINITY, 0.0)], 1),
+        h.y_many(&[c(f64::INFINITY, 0.0)], 1, &Cancel::never()),
         Err(Error::NonFinite { what: "x", .. })
     ));
     assert!(matches!(

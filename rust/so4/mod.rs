@@ -42,9 +42,32 @@ pub fn pair_index(n: usize, i: usize, j: usize) -> usize {
     i * (2 * n - i - 1) / 2 + (j - i - 1)
 }
 
-/// The `n` with `n(n-1)/2 = m`, if any.
+/// The `n` with `n(n-1)/2 = m`, if any (`n ≥ 2`; O(1) in `m`).
 pub fn n_from_state_dim(m: usize) -> Option<usize> {
-    (2..=m + 2).find(|&n| state_dim(n) == m)
+    // n = (1 + sqrt(1 + 8m))/2, rounded, then checked exactly (the square root
+    // of a double is within one of the integer root for every usize m).
+    let guess = ((1.0 + (1.0 + 8.0 * m as f64).sqrt()) / 2.0).round() as usize;
+    (guess.saturating_sub(1)..=guess + 1).find(|&n| n >= 2 && n.checked_mul(n - 1) == Some(2 * m))
+}
+
+/// Largest `n` of a top on so(n). One evaluation of (1) costs ~`n³` ns and an
+/// integrator checks for Ctrl-C every `numeric::cancel::CHECK_EVERY` steps of
+/// up to ~120 evaluations (gauss16): at `n = 32` that is ~0.25 s, within the
+/// 0.5 s promised; Manakov's integrals (`n⁵`) stay at ~30 ms a state.
+pub const MAX_N: usize = 32;
+
+/// Refuses `n` above [`MAX_N`] (checked before anything of size `n²` is built).
+pub fn check_n(what: &'static str, n: usize) -> Result<()> {
+    if n > MAX_N {
+        return Err(Error::InvalidArgument {
+            what,
+            reason: format!(
+                "a top on so(n) with n = {n}: n must be at most {MAX_N} (the cost of \
+                 Frahm's equations grows like n^3)"
+            ),
+        });
+    }
+    Ok(())
 }
 
 /// Entry `L_ik` of the full skew matrix of the state `l` of so(n).
@@ -98,6 +121,7 @@ pub fn manakov_c(a: &[f64], b: &[f64]) -> Result<Vec<f64>> {
             got: format!("({n},)"),
         });
     }
+    check_n("a", n)?;
     check_finite("a", a)?;
     check_finite("b", b)?;
     let mut c = vec![0.0; n * n];
@@ -166,6 +190,7 @@ impl FrahmTop {
                 got: format!("{} entries for n = {n}", c.len()),
             });
         }
+        check_n("c", n)?;
         check_finite("c", c)?;
         let mut max_asym: f64 = 0.0;
         let mut bad = false;

@@ -6,6 +6,7 @@
 use super::reduce::Reduced;
 use super::{pi, ThetaJet, ThetaPlan, Workspace, MAX_GENUS};
 use crate::error::{Error, Result};
+use crate::numeric::cancel::Cancel;
 use num_complex::Complex64;
 
 impl ThetaPlan {
@@ -43,6 +44,21 @@ impl ThetaPlan {
         values: &mut [Complex64],
         gradient: &mut [Complex64],
         hessian: &mut [Complex64],
+    ) -> Result<f64> {
+        self.eval_into_cancel(z, ws, values, gradient, hessian, None)
+    }
+
+    /// [`ThetaPlan::eval_into`] whose lattice sum checks `cancel` every few
+    /// dozen rows (a single point may take up to `MAX_SECONDS_PER_POINT`)
+    /// and stops with [`Error::Interrupted`].
+    pub fn eval_into_cancel(
+        &self,
+        z: &[Complex64],
+        ws: &mut Workspace,
+        values: &mut [Complex64],
+        gradient: &mut [Complex64],
+        hessian: &mut [Complex64],
+        cancel: Option<&Cancel>,
     ) -> Result<f64> {
         let g = self.g;
         let n = 1usize << (2 * g);
@@ -93,12 +109,12 @@ impl ThetaPlan {
             ws.s2.iter_mut().for_each(|v| *v = Complex64::new(0.0, 0.0));
         }
         match (self.fast_g2, order) {
-            (true, 0) => self.sum_g2::<0>(zr, wr, ws),
-            (true, 1) => self.sum_g2::<1>(zr, wr, ws),
-            (true, _) => self.sum_g2::<2>(zr, wr, ws),
-            (false, 0) => self.sum_generic::<0>(zr, wr, ws),
-            (false, 1) => self.sum_generic::<1>(zr, wr, ws),
-            (false, _) => self.sum_generic::<2>(zr, wr, ws),
+            (true, 0) => self.sum_g2::<0>(zr, wr, ws, cancel)?,
+            (true, 1) => self.sum_g2::<1>(zr, wr, ws, cancel)?,
+            (true, _) => self.sum_g2::<2>(zr, wr, ws, cancel)?,
+            (false, 0) => self.sum_generic::<0>(zr, wr, ws, cancel)?,
+            (false, 1) => self.sum_generic::<1>(zr, wr, ws, cancel)?,
+            (false, _) => self.sum_generic::<2>(zr, wr, ws, cancel)?,
         }
         self.combine(&red, ws, order, values, gradient, hessian);
         Ok(red.log_scale)
@@ -161,6 +177,7 @@ impl ThetaPlan {
             buf,
             vrow,
             grow,
+            ..
         } = ws;
         for a in 0..nh {
             let rows = &self.class_of[a * nh..(a + 1) * nh];

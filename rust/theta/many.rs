@@ -153,12 +153,13 @@ impl ThetaPlan {
             if i % every == 0 {
                 cancel.check()?;
             }
-            log_scale[i] = self.eval_into(
+            log_scale[i] = self.eval_into_cancel(
                 &z[i * g..(i + 1) * g],
                 &mut ws,
                 &mut values[i * n..(i + 1) * n],
                 &mut gradient[i * gstride..(i + 1) * gstride],
                 &mut hessian[i * hstride..(i + 1) * hstride],
+                Some(cancel),
             )?;
         }
         Ok(())

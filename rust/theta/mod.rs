@@ -57,7 +57,7 @@ mod sum;
 pub use bound::tail_bound;
 pub use chars::{char_from_index, char_index, paper_char_index, parity, MAX_GENUS, PAPER_TABLE_35};
 pub use many::apply_scale;
-pub use reduce::rem2;
+pub use reduce::{rem2, MAX_REDUCTION};
 pub use selected::{LatticeLanes, SelectedBlock, BLOCK};
 
 use crate::error::Result;
@@ -166,6 +166,8 @@ pub struct Workspace {
     buf: Vec<Complex64>,
     vrow: Vec<Complex64>,
     grow: Vec<Complex64>,
+    /// Rows summed, for the cancellation checks of the sums (`sum.rs`).
+    rows: u32,
 }
 
 fn pi() -> f64 {

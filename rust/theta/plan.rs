@@ -175,6 +175,7 @@ impl ThetaPlan {
             buf: vec![Complex64::new(0.0, 0.0); 1 << self.g],
             vrow: vec![Complex64::new(0.0, 0.0); 1 << self.g],
             grow: vec![Complex64::new(0.0, 0.0); self.g << self.g],
+            rows: 0,
         }
     }
 }

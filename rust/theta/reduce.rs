@@ -12,7 +12,7 @@ use num_complex::Complex64;
 
 /// Largest `|Re z_k|` and `|(Im τ)^{-1} Im z|_k` accepted: beyond 2^52 a double
 /// has no fractional part, so θ is not determined to any digit.
-const MAX_REDUCTION: f64 = 4.5e15;
+pub const MAX_REDUCTION: f64 = 4.5e15;
 
 /// The nearest integer to the reduced real part `re` of an entry `z_re` of z,
 /// refused beyond [`MAX_REDUCTION`], where double precision no longer fixes it.

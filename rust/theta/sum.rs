@@ -11,9 +11,29 @@
 //! two complex products and no exponential.
 
 use super::{ThetaPlan, Workspace};
+use crate::error::Result;
+use crate::numeric::cancel::Cancel;
 use num_complex::Complex64;
 
 type C = Complex64;
+
+/// Rows of a lattice sum between two checks for cancellation: 64 rows are
+/// ~3 µs of the genus-2 walk and ~30 µs of the generic path, so the check
+/// (~50 ns) costs nothing and a single point summed for a second (the cost
+/// cap, `MAX_SECONDS_PER_POINT`) still stops within the 0.5 s promised.
+const ROWS_PER_CHECK: u32 = 64;
+
+/// Counts a row and checks `cancel` every [`ROWS_PER_CHECK`] rows.
+#[inline(always)]
+fn poll(ws: &mut Workspace, cancel: Option<&Cancel>) -> Result<()> {
+    if let Some(c) = cancel {
+        ws.rows = ws.rows.wrapping_add(1);
+        if ws.rows % ROWS_PER_CHECK == 0 {
+            c.check()?;
+        }
+    }
+    Ok(())
+}
 
 impl ThetaPlan {
     /// `iπ/4 jᵀτ'j + iπ jᵀz_r + π w_rᵀYw_r`, real part written as `-π Q(j/2 + w_r)`
@@ -56,7 +76,13 @@ impl ThetaPlan {
     ///
     /// The hot loop of the per-point path; its steps ([`G2Rows`],
     /// [`ThetaPlan::walk_g2`], [`row_sums`], [`add_row`]) are inlined into it.
-    pub(super) fn sum_g2<const ORDER: usize>(&self, zr: &[C], wr: &[f64], ws: &mut Workspace) {
+    pub(super) fn sum_g2<const ORDER: usize>(
+        &self,
+        zr: &[C],
+        wr: &[f64],
+        ws: &mut Workspace,
+        cancel: Option<&Cancel>,
+    ) -> Result<()> {
         let rows = G2Rows::new(self, wr);
         let q11 = self.qmat[0];
         let kc = round_i64(rows.row(rows.j1c).0);
@@ -72,14 +98,14 @@ impl ThetaPlan {
             ainv: self.qmat[3] / a0,
             bs: bup,
         };
-        self.walk_g2::<ORDER>(1, &rows, up, ws);
+        self.walk_g2::<ORDER>(1, &rows, up, ws, cancel)?;
         let mut down = G2Cursor {
             bs: q11 / bup,
             ..up
         };
         // the first row of the downward pass is j1c - 1
         down.next_row(q11, self.qinv[1], self.qmat[1], -1);
-        self.walk_g2::<ORDER>(-1, &rows, down, ws);
+        self.walk_g2::<ORDER>(-1, &rows, down, ws, cancel)
     }
 
     /// One pass of [`ThetaPlan::sum_g2`] over the rows from the cursor's on,
@@ -91,11 +117,13 @@ impl ThetaPlan {
         rows: &G2Rows,
         mut cur: G2Cursor,
         ws: &mut Workspace,
-    ) {
+        cancel: Option<&Cancel>,
+    ) -> Result<()> {
         let (q11, q12, q22) = (self.qmat[0], self.qmat[1], self.qmat[3]);
         let (q12i, q22i) = (self.qinv[1], self.qinv[3]);
         let (q12s, q12si) = if dir == 1 { (q12, q12i) } else { (q12i, q12) };
         while (dir == 1 && cur.j1 <= rows.j1max) || (dir == -1 && cur.j1 >= rows.j1min) {
+            poll(ws, cancel)?;
             let (target, lo, hi) = rows.bounds(cur.j1);
             if lo <= hi {
                 while cur.k < target {
@@ -117,17 +145,25 @@ impl ThetaPlan {
             }
             cur.next_row(q11, q12s, q12si, dir);
         }
+        Ok(())
     }
 
     /// Any genus: enumerate the outer coordinates `j_1..j_{g-1}` over the
     /// ellipsoid (Fincke–Pohst style, from the factorisation of `Q`); each inner
     /// row starts from a directly computed term at its lower end and is swept
     /// upward with the recurrence (no division, so no overflow for large `Im τ`).
-    pub(super) fn sum_generic<const ORDER: usize>(&self, zr: &[C], wr: &[f64], ws: &mut Workspace) {
-        let mut j = vec![0i64; self.g];
-        self.level::<ORDER>(0, 0.0, &mut j, zr, wr, ws);
+    pub(super) fn sum_generic<const ORDER: usize>(
+        &self,
+        zr: &[C],
+        wr: &[f64],
+        ws: &mut Workspace,
+        cancel: Option<&Cancel>,
+    ) -> Result<()> {
+        let mut j = [0i64; super::MAX_GENUS];
+        self.level::<ORDER>(0, 0.0, &mut j[..self.g], zr, wr, ws, cancel)
     }
 
+    #[allow(clippy::too_many_arguments)]
     fn level<const ORDER: usize>(
         &self,
         i: usize,
@@ -136,11 +172,13 @@ impl ThetaPlan {
         zr: &[C],
         wr: &[f64],
         ws: &mut Workspace,
-    ) {
+        cancel: Option<&Cancel>,
+    ) -> Result<()> {
+        poll(ws, cancel)?;
         let g = self.g;
         let rem = self.rq - partial;
         if rem < 0.0 {
-            return;
+            return Ok(());
         }
         let t: f64 = (0..i)
             .map(|k| self.ldl_l[i * g + k] * (0.5 * j[k] as f64 + wr[k]))
@@ -152,12 +190,13 @@ impl ThetaPlan {
             for v in lo..=hi {
                 j[i] = v;
                 let dv = 0.5 * v as f64 + wr[i] + t;
-                self.level::<ORDER>(i + 1, partial + self.ldl_d[i] * dv * dv, j, zr, wr, ws);
+                let part = partial + self.ldl_d[i] * dv * dv;
+                self.level::<ORDER>(i + 1, part, j, zr, wr, ws, cancel)?;
             }
-            return;
+            return Ok(());
         }
         if lo > hi {
-            return;
+            return Ok(());
         }
         j[i] = lo;
         let mut e = self.log_term(j, zr, wr).exp();
@@ -204,6 +243,7 @@ impl ThetaPlan {
                 }
             }
         }
+        Ok(())
     }
 }
 

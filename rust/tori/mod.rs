@@ -624,12 +624,7 @@ where
     F: Fn(&S) -> T + Sync,
 {
     let wave = BLOCK * rayon::current_num_threads().max(1);
-    let mut out = Vec::new();
-    out.try_reserve_exact(states.len())
-        .map_err(|_| Error::InvalidArgument {
-            what: "states",
-            reason: format!("cannot allocate results for {} states", states.len()),
-        })?;
+    let mut out = crate::numeric::alloc::try_with_capacity("states", states.len())?;
     for part in states.chunks(wave) {
         cancel.check()?;
         let res: Result<Vec<Vec<T>>> = part
