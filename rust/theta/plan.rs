@@ -3,7 +3,7 @@
 //! summation ellipsoid from the proven tail bound ([`super::tail_bound`]) and
 //! the cost model that refuses sums too large to run.
 
-use super::linalg::{invert_spd, ldl_reversed, min_eigenvalue, shortest_vector};
+use super::linalg::{invert_spd, ldl_reversed, min_eigenvalue, shortest_vector_reduced};
 use super::{pi, tail_bound, PlanInfo, ThetaPlan, Workspace, MAX_GENUS, MAX_SECONDS_PER_POINT};
 use super::{MAX_TERMS, SYMMETRY_RTOL};
 use crate::error::{check_finite, Error, Result};
@@ -45,7 +45,10 @@ impl ThetaPlan {
         let (s, taur) = reduce_real_part(&sym, g);
         let x: Vec<f64> = taur.iter().map(|c| c.re).collect();
         let re_tau: Vec<f64> = sym.iter().map(|c| c.re).collect();
-        let rho = pi().sqrt() * shortest_vector(&ldl_d, &ldl_l, g).sqrt();
+        // On an LLL-reduced basis: the enumeration on Im tau as given visits
+        // ~Y_ii^{g/2}/sqrt(det Y) points, 1e12-1e18 for an ill-conditioned Im tau
+        // (minutes, before the cost check below could refuse it).
+        let rho = pi().sqrt() * shortest_vector_reduced(&y, &ldl_d, &ldl_l, g).sqrt();
         // |m_k - c_k| ≤ sqrt((Y^{-1})_kk / π) |x| (Cauchy–Schwarz in the Y metric).
         let sk = (0..g)
             .map(|k| (yinv[k * g + k] / pi()).sqrt())
