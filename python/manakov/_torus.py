@@ -59,8 +59,20 @@ class Torus(NamedTuple):
         -------
         ndarray, shape (..., 2)
             Angles in ``[0, 1)`` (cycles).
+
+        Raises
+        ------
+        ValueError
+            ``t`` not real numbers, or not finite.
         """
-        tt = np.asarray(t, dtype=float)[..., None]
+        ta = np.asarray(t)
+        if ta.dtype == object or not (
+            np.issubdtype(ta.dtype, np.integer) or np.issubdtype(ta.dtype, np.floating)
+        ):
+            raise ValueError(f"t must be real numbers, got dtype {ta.dtype}")
+        tt = np.asarray(ta, dtype=float)[..., None]
+        if not np.all(np.isfinite(tt)):
+            raise ValueError("t must be finite (no NaN or infinity)")
         return np.mod(tt * self.frequencies, 1.0)
 
 

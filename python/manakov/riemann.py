@@ -126,9 +126,23 @@ class HyperellipticCurve:
         return f"HyperellipticCurve(genus={self.genus}, branch_points={self._e.tolist()})"
 
     def R(self, x: Any) -> Any:
-        """``R(x) = prod_k (x - e_k)``; scalar in, scalar out."""
+        """``R(x) = prod_k (x - e_k)``; scalar in, scalar out.
+
+        Raises
+        ------
+        ValueError
+            Non-finite ``x``, or ``R(x)`` beyond the double range.
+        """
         xa = _c(x, "x")
-        out = np.prod(xa[..., None] - self._e, axis=-1)
+        if not np.all(np.isfinite(xa)):
+            raise ValueError("x must be finite (no NaN or infinity)")
+        with np.errstate(over="ignore", invalid="ignore"):
+            out = np.prod(xa[..., None] - self._e, axis=-1)
+        if not np.all(np.isfinite(out)):
+            raise ValueError(
+                f"R(x) overflows: |R(x)| ~ |x|^{self._e.size} is beyond the double range "
+                f"for |x| up to {np.max(np.abs(xa)):.3e}"
+            )
         return out[()] if out.ndim == 0 else out
 
     def y(self, x: Any, *, sheet: int = 1) -> Any:

@@ -539,7 +539,22 @@ impl HyperellipticCurve {
                 v[i]
             }
         });
-        Ok(self.normalise(&raw))
+        let u = self.normalise(&raw);
+        // A path through (or within rounding of) another branch point can make
+        // the quadrature NaN without tripping its own distance test: an error,
+        // as for the paths that do trip it, never a NaN returned.
+        if !u.iter().all(|&c| is_finite_c(c)) {
+            return Err(Error::InvalidArgument {
+                what: "path",
+                reason: format!(
+                    "the integral from branch point {k} to x = e_{k} + {} is not finite in \
+                     double precision (the path passes too close to another branch point); \
+                     use abel(x, y) for points far from e_{k}",
+                    crate::error::cnum(dx)
+                ),
+            });
+        }
+        Ok(u)
     }
 
     /// [`Self::abel`] into `out` (length `g`), without allocating: the
