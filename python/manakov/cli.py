@@ -59,7 +59,14 @@ import numpy as np
 
 from . import __version__, _cli_fluid, problem_names
 from ._checks import _show
-from .integrate import ADAPTIVE_METHODS, DEFAULT_MAX_STEPS, METHODS, Trajectory, gauss_steps
+from .integrate import (
+    ADAPTIVE_METHODS,
+    DEFAULT_MAX_STEPS,
+    MAX_SAMPLES,
+    METHODS,
+    Trajectory,
+    gauss_steps,
+)
 from .problems import Problem, as_problem, read_problem
 from .top import ManakovTop, state_dim
 
@@ -270,6 +277,10 @@ def _sample_times(t_end: float, samples: int | None, dt: float, explicit: bool) 
             samples = max(2, min(samples, gauss_steps([t_end], dt) + 1))
     elif samples < 2:
         raise ValueError(f"--samples must be >= 2, got {samples}")
+    elif samples > MAX_SAMPLES:
+        raise ValueError(
+            f"--samples must be at most {MAX_SAMPLES:.0e} (the samples of one run), got {samples}"
+        )
     return np.linspace(0.0, t_end, samples)
 
 
@@ -472,6 +483,8 @@ def _run_theorem(args: argparse.Namespace) -> int:
     out = Path(args.output or f"{pr.name}-theorem.png")
     if not out.parent.is_dir():
         raise ValueError(f"cannot write {out}: {out.parent} is not a directory")
+    if args.samples > MAX_SAMPLES:
+        raise ValueError(f"--samples must be at most {MAX_SAMPLES:.0e}, got {args.samples}")
     try:
         err = _plots().plot_theorem(
             pr, out, t_end=args.t_end, samples=args.samples, dt=args.dt, progress=_progress(args)
