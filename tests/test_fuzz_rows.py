@@ -1,0 +1,295 @@
+"""Regression tests of the second fuzzing round: aborts, unkillable calls, silent NaN.
+
+Each test names the defect it guards against. Aborts and Ctrl-C are checked in a
+child process: an abort kills the child (a negative return code) instead of
+failing one test, and SIGINT is only meaningful in a process of its own.
+"""
+
+from __future__ import annotations
+
+import resource
+import signal
+import subprocess
+import sys
+import textwrap
+import time
+
+import numpy as np
+import pytest
+
+import manakov
+from manakov import HyperellipticCurve
+
+#: Ctrl-C must stop a call within this long (the project's promise).
+STOP_WITHIN_S = 0.5
+
+#: An ill-conditioned tau is refused within this long: the refusal needs no
+#: lattice sum, only an LLL reduction and the cost model (microseconds); the
+#: bound leaves room for a loaded 2-core runner.
+REFUSE_WITHIN_S = 0.25
+
+#: Address space of the allocation children: far below the machine's memory,
+#: so that an allocation that is not checked aborts there instead of swapping.
+CHILD_ADDRESS_SPACE = 3 << 30
+
+P = manakov.problem("generic")
+TOP = manakov.ManakovTop(P.a, P.b)
+L0 = np.asarray(P.l0, dtype=float)
+
+posix = pytest.mark.skipif(sys.platform == "win32", reason="POSIX signals and rlimits")
+
+
+def _limited() -> None:  # runs in the child before exec
+    resource.setrlimit(resource.RLIMIT_AS, (CHILD_ADDRESS_SPACE, CHILD_ADDRESS_SPACE))
+
+
+ALLOC_CHILD = textwrap.dedent(
+    """
+    import numpy as np
+    import manakov
+    p = manakov.problem("generic")
+    top = manakov.ManakovTop(p.a, p.b)
+    l0 = np.asarray(p.l0, dtype=float)
+    cases = {{
+        "poisson_tensor": lambda: manakov.poisson_tensor(np.zeros(1999000)),
+        "Solution.l": lambda: top.solve(l0).l(np.broadcast_to(0.0, (10**8, 10))),
+        "kotter": lambda: manakov.kotter(p.a, p.b, np.broadcast_to(l0, (10**8, 6))),
+        "integrate": lambda: top.integrate(l0, 1.0, t_eval=np.broadcast_to(0.0, (10**9,))),
+    }}
+    try:
+        cases[{case!r}]()
+    except (MemoryError, ValueError) as e:
+        print(type(e).__name__, str(e)[:300], flush=True)
+    """
+)
+
+
+@posix
+@pytest.mark.parametrize("case", ["poisson_tensor", "Solution.l", "kotter", "integrate"])
+def test_sizes_beyond_memory_are_an_error_never_an_abort(case):
+    # Before: SIGABRT ("memory allocation of ... bytes failed") under an
+    # address-space limit, from the infallible vec![0.0; n] of the bindings.
+    t0 = time.perf_counter()
+    proc = subprocess.run(
+        [sys.executable, "-c", ALLOC_CHILD.format(case=case)],
+        capture_output=True,
+        text=True,
+        timeout=120,
+        preexec_fn=_limited,
+    )
+    elapsed = time.perf_counter() - t0
+    assert proc.returncode == 0, (case, proc.returncode, proc.stderr[-2000:])
+    assert proc.stdout.startswith(("MemoryError", "ValueError")), (proc.stdout, proc.stderr)
+    # Refused before any work: the error names the size (bytes, GiB or the n of so(n)).
+    assert any(s in proc.stdout for s in ("bytes", "GiB", "n = 2000")), proc.stdout
+    assert elapsed < 30.0, elapsed
+
+
+#: The bindings' allocation budget per call (``numeric::alloc::MAX_BYTES``).
+BUDGET_BYTES = 1 << 34
+
+#: Bytes a row of each binding counts (its input copy and its results): a
+#: broadcast view of ``BUDGET_BYTES / bytes + 1`` rows is just over the budget
+#: (and costs no memory here); before the checked path, copying it aborted.
+CORE_CHILD = textwrap.dedent(
+    """
+    import numpy as np
+    import manakov
+    from manakov import _core
+    p = manakov.problem("generic")
+    top = manakov.ManakovTop(p.a, p.b)
+    a, b, l0 = (np.asarray(v, dtype=float) for v in (p.a, p.b, p.l0))
+    n = lambda each: {budget} // each + 1
+    rows = lambda each, k: np.broadcast_to(l0[:k], (n(each), k))
+    flat = lambda each, v: np.broadcast_to(np.asarray(v), (n(each),))
+    curve = _core.HyperellipticCore(np.arange(5.0) + 0j)
+    body = _core.KirchhoffCore(np.eye(3), np.zeros((3, 3)), np.eye(3))
+    cases = {{
+        "vector_field": lambda: _core.vector_field(top.c, rows(96, 6)),
+        "hamiltonian": lambda: _core.hamiltonian(top.c, rows(56, 6)),
+        "so4_integrals": lambda: _core.so4_integrals(a, rows(80, 6)),
+        "kotter_batch": lambda: _core.kotter_batch(a, rows(1446, 6), None, False),
+        "Solution.l": lambda: _core.SolutionCore(a, b, l0).l(flat(56, 0.0)),
+        "integrate": lambda: _core.integrate(
+            top.c, l0, 0.0, flat(56, 0.0), "gauss16", 1e-2, 1e-12, 1e-12, 10**8
+        ),
+        "curve.y": lambda: curve.y(flat(32, 0.5 + 0j), 1),
+        "frequency_map": lambda: _core.frequency_map(a, b, rows(129, 6)),
+        "Kirchhoff.vector_field": lambda: body.vector_field(rows(96, 6)),
+    }}
+    try:
+        cases[{case!r}]()
+    except MemoryError as e:
+        print(type(e).__name__, str(e)[:300], flush=True)
+    """
+)
+
+CORE_CASES = [
+    "vector_field",
+    "hamiltonian",
+    "so4_integrals",
+    "kotter_batch",
+    "Solution.l",
+    "integrate",
+    "curve.y",
+    "frequency_map",
+    "Kirchhoff.vector_field",
+]
+
+
+@posix
+@pytest.mark.parametrize("case", CORE_CASES)
+def test_a_binding_refuses_a_size_just_over_its_budget_before_copying(case):
+    child = CORE_CHILD.format(budget=BUDGET_BYTES, case=case)
+    t0 = time.perf_counter()
+    proc = subprocess.run(
+        [sys.executable, "-c", child],
+        capture_output=True,
+        text=True,
+        timeout=120,
+        preexec_fn=_limited,
+    )
+    elapsed = time.perf_counter() - t0
+    assert proc.returncode == 0, (case, proc.returncode, proc.stderr[-2000:])
+    assert proc.stdout.startswith("MemoryError"), (proc.stdout, proc.stderr[-2000:])
+    assert "bytes" in proc.stdout and "split the work" in proc.stdout, proc.stdout
+    assert elapsed < 30.0, elapsed
+
+
+def test_so_n_beyond_the_cap_is_refused_before_building_n_squared_arrays():
+    with pytest.raises(ValueError, match="n = 2000"):
+        manakov.poisson_tensor(np.zeros((1, 1999000)))
+
+
+SIGINT_CHILD = textwrap.dedent(
+    """
+    import sys, time
+    import numpy as np
+    import manakov
+    p = manakov.problem("generic")
+    l = np.tile(np.asarray(p.l0, dtype=float), ({n}, 1))
+    level = manakov.LevelSet(p.a, p.b, p.l0)
+    call = {{
+        "kotter": lambda: manakov.kotter(p.a, p.b, l),
+        "LevelSet.kotter": lambda: level.kotter(l),
+    }}[{case!r}]
+    print("ready", flush=True)
+    t0 = time.perf_counter()
+    try:
+        call()
+    except KeyboardInterrupt:
+        print("interrupted", time.perf_counter() - t0, flush=True)
+        sys.exit(130)
+    print("finished", time.perf_counter() - t0, flush=True)
+    """
+)
+
+
+def _sigint_after(child: str, delay: float) -> tuple[str, float, subprocess.Popen]:
+    proc = subprocess.Popen(
+        [sys.executable, "-c", child],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+    assert proc.stdout is not None
+    assert proc.stdout.readline().strip() == "ready"
+    time.sleep(delay)
+    sent = time.perf_counter()
+    proc.send_signal(signal.SIGINT)
+    line = proc.stdout.readline()
+    return line, time.perf_counter() - sent, proc
+
+
+@posix
+@pytest.mark.parametrize("case", ["kotter", "LevelSet.kotter"])
+def test_sigint_stops_the_kotter_batch_of_a_million_states(case):
+    # Before: KeyboardInterrupt after 30.3 s (kotter) and 21.7 s (LevelSet.kotter).
+    line, stopped, proc = _sigint_after(SIGINT_CHILD.format(n=10**6, case=case), 1.0)
+    out, err = proc.communicate(timeout=120)
+    assert line.startswith("interrupted"), (line, out, err[-2000:])
+    assert proc.returncode == 130
+    assert stopped < STOP_WITHIN_S, f"{case}: stopped {stopped:.3f} s after SIGINT"
+
+
+def _ill_conditioned_tau(g: int) -> np.ndarray:
+    rng = np.random.default_rng(23)
+    s = rng.normal(size=(g, g))
+    return (s + s.T) / 2 + 1j * (np.ones((g, g)) + 1e-12 * np.eye(g))
+
+
+@pytest.mark.parametrize("g", [3, 4])
+def test_an_ill_conditioned_tau_is_refused_at_once(g):
+    # Before: genus 3 refused after 16-23 s, genus 4 ran > 590 s (the shortest
+    # lattice vector was enumerated on the basis as given).
+    tau = _ill_conditioned_tau(g)
+    t0 = time.perf_counter()
+    with pytest.raises(ValueError, match="ill-conditioned"):
+        manakov.theta_all(np.zeros(g), tau)
+    assert time.perf_counter() - t0 < REFUSE_WITHIN_S
+
+
+def test_taylor_with_a_tiny_largest_step_is_refused_before_any_work():
+    # Before: the whole max_steps budget ran (1e8 steps, ~17 min) before failing.
+    t0 = time.perf_counter()
+    with pytest.raises(ValueError, match="dt"):
+        TOP.integrate(L0, 10.0, dt=5e-324, method="taylor")
+    assert time.perf_counter() - t0 < 1.0
+
+
+@pytest.mark.parametrize("t", [np.nan, np.inf, -np.inf, None, "x", [0.0, np.nan]])
+def test_angles_of_a_non_finite_time_raise(t):
+    # Before: [nan, nan].
+    sol = TOP.solve(L0)
+    with pytest.raises(ValueError, match="t must be"):
+        sol.angles(t)
+    with pytest.raises(ValueError, match="t must be"):
+        sol.torus.angles(t)
+    assert np.all(np.isfinite(sol.angles([0.0, 1.5])))
+
+
+def test_hyperelliptic_r_and_y_raise_instead_of_nan_or_inf():
+    # Before: R(nan) -> nan, R(1e100) -> inf+nanj, y(1e308) -> nan+nanj.
+    c = HyperellipticCurve([0, 1, 2, 3, 4])
+    with pytest.raises(ValueError, match="finite"):
+        c.R(np.nan)
+    with pytest.raises(ValueError, match="overflows"):
+        c.R(1e100)
+    with pytest.raises(ValueError, match="overflows"):
+        c.y(1e308)
+    assert np.isfinite(c.R(1e50)) and np.isfinite(c.y(1e50))
+
+
+@pytest.mark.parametrize("z", [[1e308 + 1e308j] * 2, [0, 1e308j]])
+def test_reduce_refuses_lattice_coordinates_without_a_fractional_part(z):
+    # Before: -inf j, or an unreduced ~1e292.
+    c = HyperellipticCurve([0, 1, 2, 3, 4])
+    with pytest.raises(ValueError, match="lattice coordinate"):
+        c.reduce(z)
+
+
+def test_abel_near_branch_is_finite_or_raises():
+    # Before: [nan+nanj, nan+nanj] for (2, 5.0, y(7)), 4-6 per 1,800 in a scan.
+    c = HyperellipticCurve([0, 1, 2, 3, 4])
+    for k in range(5):
+        for dx in np.linspace(-12.0, 12.0, 97):
+            x = c.branch_points[k] + dx
+            try:
+                u = c.abel_near_branch(k, dx, c.y(x))
+            except ValueError:
+                continue
+            assert np.all(np.isfinite(u)), (k, dx, u)
+
+
+def test_cli_samples_beyond_the_cap_are_a_clear_error(tmp_path):
+    # Before: numpy's _ArrayMemoryError traceback (7.28 TiB).
+    proc = subprocess.run(
+        [sys.executable, "-m", "manakov", "simulate", "wide", "--samples", "1000000000000"],
+        capture_output=True,
+        text=True,
+        timeout=60,
+        cwd=tmp_path,
+    )
+    assert proc.returncode != 0
+    assert "Traceback" not in proc.stderr, proc.stderr[-2000:]
+    assert "--samples must be at most" in proc.stderr, proc.stderr
