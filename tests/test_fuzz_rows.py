@@ -81,7 +81,7 @@ def test_sizes_beyond_memory_are_an_error_never_an_abort(case):
     assert proc.returncode == 0, (case, proc.returncode, proc.stderr[-2000:])
     assert proc.stdout.startswith(("MemoryError", "ValueError")), (proc.stdout, proc.stderr)
     # Refused before any work: the error names the size (bytes, GiB or the n of so(n)).
-    assert any(s in proc.stdout for s in ("bytes", "GiB", "n = 2000")), proc.stdout
+    assert any(s in proc.stdout for s in ("bytes", "GiB", "n = 2000", "MAX_SAMPLES")), proc.stdout
     assert elapsed < 30.0, elapsed
 
 
@@ -293,3 +293,38 @@ def test_cli_samples_beyond_the_cap_are_a_clear_error(tmp_path):
     assert proc.returncode != 0
     assert "Traceback" not in proc.stderr, proc.stderr[-2000:]
     assert "--samples must be at most" in proc.stderr, proc.stderr
+
+
+def test_t_eval_beyond_the_sample_cap_is_refused_before_any_work():
+    # Before: MemoryError after 49 s of integration (2e8 samples).
+    t_eval = np.broadcast_to(0.0, (2 * 10**8,))
+    t0 = time.perf_counter()
+    with pytest.raises(ValueError, match="MAX_SAMPLES"):
+        TOP.integrate(L0, 1.0, t_eval=t_eval)
+    assert time.perf_counter() - t0 < 1.0
+
+
+@pytest.mark.parametrize("top", [None, "x", manakov.FrahmTop(TOP.c)])
+def test_frequency_map_names_a_wrong_top(top):
+    # Before: AttributeError ('NoneType' object has no attribute 'a').
+    with pytest.raises(TypeError, match="top must be a ManakovTop"):
+        manakov.frequency_map(top, [L0])
+
+
+def test_real_torus_names_the_argument_and_its_shape():
+    # Before: TypeError "dimensionality mismatch: from=1, to=2".
+    sol = TOP.solve(L0)
+    u = np.array([0.3 + 0.1j, -0.2 + 0.4j])
+    with pytest.raises(ValueError, match=r"tau must have shape \(2, 2\)"):
+        manakov.real_torus(sol.tau[0], u, 1j * u, [[1, 0, 0, 0]])
+    with pytest.raises(ValueError, match=r"U2 must have shape \(2,\)"):
+        manakov.real_torus(sol.tau, u, [1.0], [[1, 0, 0, 0]])
+
+
+@pytest.mark.parametrize("char", [0, ([], [2]), "x"])
+def test_parity_validates_the_genus_first(char):
+    # Before: 9.3 s (parity(0, 10**9)) and > 20 s (([], [2]), 10**9).
+    t0 = time.perf_counter()
+    with pytest.raises(ValueError, match="genus must be in 1..6"):
+        manakov.parity(char, 10**9)
+    assert time.perf_counter() - t0 < 0.1

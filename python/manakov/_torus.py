@@ -118,6 +118,9 @@ def real_torus(tau: Any, U: Any, U2: Any, characteristics: Any) -> Torus:
     t = np.ascontiguousarray(np.asarray(tau, dtype=complex))
     u = np.ascontiguousarray(np.asarray(U, dtype=complex))
     u2 = np.ascontiguousarray(np.asarray(U2, dtype=complex))
+    for name, v, shape in (("tau", t, (2, 2)), ("U", u, (2,)), ("U2", u2, (2,))):
+        if v.shape != shape:
+            raise ValueError(f"{name} must have shape {shape}, got {v.shape}")
     ch = np.asarray(characteristics)
     if ch.ndim != 2 or ch.shape[1] != 4 or not np.all((ch == 0) | (ch == 1)):
         raise ValueError(f"characteristics must be (k, 4) of 0/1, got {ch!r}")

@@ -229,7 +229,8 @@ def sample_times(t_end: Any, t_eval: Any = None, sample_every: Any = None) -> np
     ------
     ValueError
         ``t_end`` negative or not finite, both ``t_eval`` and ``sample_every``,
-        unsorted ``t_eval`` or outside ``[0, t_end]``, ``sample_every <= 0`` or
+        unsorted ``t_eval`` or outside ``[0, t_end]``, ``t_eval`` of more than
+        :data:`MAX_SAMPLES` points, ``sample_every <= 0`` or
         more than :data:`MAX_SAMPLES` samples.
 
     Examples
@@ -244,6 +245,14 @@ def sample_times(t_end: Any, t_eval: Any = None, sample_every: Any = None) -> np
     if t_eval is not None and sample_every is not None:
         raise ValueError("give at most one of t_eval and sample_every")
     if t_eval is not None:
+        # The sample cap before any conversion or work (a view of 1e9 zeros
+        # would otherwise be copied, then integrated, then fail on the output).
+        size = np.size(t_eval)
+        if size > MAX_SAMPLES:
+            raise ValueError(
+                f"t_eval has {size} samples, more than MAX_SAMPLES = {MAX_SAMPLES:.0e} "
+                "of one call; split the run"
+            )
         te = _float_array(t_eval, "t_eval")
         if te.ndim != 1:
             raise ValueError(f"t_eval must be 1-d, got shape {te.shape}")

@@ -235,6 +235,10 @@ def parity(char: CharLike, g: int = 2) -> int:
 
 
 def _resolve_char(char: CharLike, g: int) -> int:
+    # The genus first: 4**g of a huge g is itself seconds of work.
+    g = operator.index(g)
+    if not 1 <= g <= 6:
+        raise ValueError(f"genus must be in 1..6, got {g}")
     n = 4**g
     if char is None:
         return 0

@@ -330,6 +330,8 @@ def frequency_map(
         ``states`` not of shape (..., 6) or not real, ``chunk_size`` not a
         positive integer, ``client`` not a ``dask.distributed.Client``, or
         ``progress`` not a bool or callable.
+    TypeError
+        ``top`` is not a Manakov top.
     KeyboardInterrupt
         On Ctrl-C, within a fraction of a second (locally). It carries the map
         of the chunks finished before it as ``err.partial``, a
@@ -347,8 +349,14 @@ def frequency_map(
     >>> fm.nu.shape, fm.counts()
     ((8, 8, 2), {'ok': 64})
     """
+    if not (hasattr(top, "a") and hasattr(top, "b")):
+        raise TypeError(f"top must be a ManakovTop (with its a and b), got {type(top).__name__}")
     a = np.ascontiguousarray(np.asarray(top.a, dtype=float))
     b = np.ascontiguousarray(np.asarray(top.b, dtype=float))
+    if a.shape != (4,) or b.shape != (4,):
+        raise ValueError(
+            f"top must be a Manakov top on so(4): a and b of shape (4,), got {a.shape}, {b.shape}"
+        )
     arr = np.asarray(states)
     # NaN and infinity are allowed (they get a status): only the type and the
     # shape are checked.
