@@ -20,8 +20,10 @@ magnitudes of the curve and reduction inputs to the whole double range.
 
 from __future__ import annotations
 
+import collections
 import copy
 import dataclasses
+import faulthandler
 import math
 import os
 from collections.abc import Callable
@@ -37,8 +39,11 @@ from manakov import reduction
 
 #: Cases per entry point in the default run (20 properties, ~1 s each).
 DEFAULT_EXAMPLES = 40
-#: Cases per entry point in the slow run: 20 entry points x 5000 = 10^5.
+#: Cases per entry point in the slow run: 26 properties x 5000 > 10^5.
 SLOW_EXAMPLES = 5000
+#: A case still running after this long is a hang: the process is stopped
+#: with every thread's traceback (faulthandler), which fails the run.
+WATCHDOG_S = 20.0
 SLOW = bool(os.environ.get("MANAKOV_FUZZ_SLOW"))
 
 #: Magnitudes of the curve's d_j and the reduction's states in the default run.
@@ -55,6 +60,10 @@ BASE_ALLOWED: tuple[type[BaseException], ...] = (
     MemoryError,
 )
 WITH_OVERFLOW = (*BASE_ALLOWED, OverflowError)
+
+
+#: Calls per entry point (qualified name), for the slow run's report.
+CALLS: collections.Counter[str] = collections.Counter()
 
 
 class Undocumented(AssertionError):
@@ -137,6 +146,8 @@ def check_call(
     Returns the result, or None when ``f`` raised an allowed exception.
     """
     before = [_snapshot(a) for a in args], {k: _snapshot(v) for k, v in kwargs.items()}
+    CALLS[getattr(f, "__qualname__", repr(f))] += 1
+    faulthandler.dump_traceback_later(WATCHDOG_S, exit=True)
     try:
         out = f(*args, **kwargs)
     except allowed:
@@ -146,6 +157,8 @@ def check_call(
             f"{getattr(f, '__qualname__', f)} raised {type(e).__module__}.{type(e).__name__}: "
             f"{e}\n  args = {args!r}\n  kwargs = {kwargs!r}"
         ) from e
+    finally:
+        faulthandler.cancel_dump_traceback_later()
     for i, (a, b) in enumerate(zip(args, before[0])):
         assert _same(a, b), f"{f.__qualname__} modified argument {i}: {b!r} -> {a!r}"
     for k, v in kwargs.items():
@@ -517,6 +530,121 @@ def prop_matrices(data: st.DataObject) -> None:
     check_call(manakov.poisson_tensor, l)
 
 
+def _hyperelliptic(data: st.DataObject) -> Any:
+    n = data.draw(st.sampled_from([5, 6]))
+    e = data.draw(array(curve_complexes(), (n,), complex))
+    return check_call(manakov.HyperellipticCurve, e)
+
+
+def prop_hyperelliptic(data: st.DataObject) -> None:
+    # The curve's evaluations: R, y, the Abel map (from infinity and near a
+    # branch point), reduction; non-finite results raise, never come back.
+    c = _hyperelliptic(data)
+    if c is None:
+        return
+    g = c.genus
+    x = data.draw(array(curve_complexes(), data.draw(st.sampled_from([(), (3,)])), complex))
+    check_call(c.R, x)
+    y = check_call(c.y, x, sheet=data.draw(st.sampled_from([1, -1])))
+    if y is not None:
+        check_call(c.abel, x, y)
+    k = data.draw(st.integers(-1, 2 * g + 2))
+    dx = data.draw(complexes(-12, 12))
+    try:
+        yk = c.y(c.branch_points[k % len(c.branch_points)] + dx)
+    except ValueError:
+        yk = 1.0
+    check_call(c.abel_near_branch, k, dx, yk)
+    z = data.draw(array(st.one_of(complexes(-5, 5), curve_complexes()), (2, g), complex))
+    check_call(c.reduce, z)
+
+
+_SOLUTIONS: dict[str, Any] = {}
+
+
+def _solution(p: Any) -> Any:
+    if p.name not in _SOLUTIONS:
+        try:
+            _SOLUTIONS[p.name] = manakov.ManakovTop(p.a, p.b).solve(p.l0)
+        except BASE_ALLOWED:
+            _SOLUTIONS[p.name] = None
+    return _SOLUTIONS[p.name]
+
+
+def prop_solution(data: st.DataObject) -> None:
+    # l(t), the angles of the torus, and the Abel map of states, at ordinary,
+    # huge and non-finite times (angles of NaN/inf/None raise, as l does).
+    sol = _solution(data.draw(st.sampled_from(PROBLEMS)))
+    if sol is None:
+        return
+    t = data.draw(
+        st.one_of(
+            array(reals(-1e3, 1e3), data.draw(st.sampled_from([(), (3,)])), float),
+            st.sampled_from([math.nan, math.inf, -math.inf, None, "x", 1e300]),
+        )
+    )
+    check_call(sol.l, t)
+    check_call(sol.angles, t)
+    check_call(sol.torus.angles, t)
+
+
+def prop_level_set(data: st.DataObject) -> None:
+    p = data.draw(st.sampled_from(PROBLEMS))
+    if len(p.a) != 4:
+        return
+    ls = check_call(reduction.LevelSet, p.a, p.b, p.l0)
+    if ls is None:
+        return
+    n = data.draw(st.integers(1, 4))
+    l = np.asarray(p.l0, dtype=float) * data.draw(array(bounded(0.5, 2.0), (n, 1), float))
+    errors = data.draw(st.sampled_from(["raise", "mask"]))
+    # Masked rows are NaN by design (documented): only the raise mode is checked
+    # for finiteness.
+    check_call(ls.kotter, l, errors=errors, finite=errors == "raise")
+
+
+def prop_frequency_map(data: st.DataObject) -> None:
+    p = data.draw(st.sampled_from(PROBLEMS))
+    if len(p.a) != 4:
+        return
+    top = data.draw(st.sampled_from([manakov.ManakovTop(p.a, p.b), None, "x"]))
+    ls = data.draw(states(4, wild=True))
+
+    # Singular states get a status and NaN frequencies by design.
+    # (The top is no array: _same compares objects by identity, so it is bound
+    # here rather than passed through check_call's copy-and-compare.)
+    def fmap(states: np.ndarray) -> Any:
+        return manakov.frequency_map(top, states)
+
+    check_call(fmap, ls, allowed=(*BASE_ALLOWED, TypeError), finite=False)
+
+
+def prop_parity(data: st.DataObject) -> None:
+    # Validation is O(1) in the size of the numbers given.
+    g = data.draw(st.one_of(st.integers(-2, 8), st.integers(10**6, 10**12)))
+    char = data.draw(
+        st.one_of(
+            st.none(),
+            st.integers(-1, 10**9),
+            st.tuples(st.lists(st.integers(0, 2)), st.lists(st.integers(0, 2))),
+        )
+    )
+    check_call(manakov.parity, char, g)
+
+
+def prop_kirchhoff(data: st.DataObject) -> None:
+    d = data.draw(array(bounded(0.1, 10.0), (3,), float))
+    body = check_call(manakov.KirchhoffBody, np.diag(d), np.zeros((3, 3)), np.diag(d[::-1]))
+    if body is None:
+        return
+    M = data.draw(array(reals(), (3,), float))
+    p_ = data.draw(array(reals(), (3,), float))
+    check_call(body.vector_field, M, p_)
+    check_call(body.hamiltonian, M, p_)
+    check_call(body.integrals, M, p_)
+    check_call(body.integrate, M, p_, data.draw(bounded(0.0, 1.0)), max_steps=10**4)
+
+
 PROPERTIES: list[Callable[[st.DataObject], None]] = [
     prop_theta,
     prop_theta_all,
@@ -538,6 +666,12 @@ PROPERTIES: list[Callable[[st.DataObject], None]] = [
     prop_integrate_many,
     prop_problem,
     prop_matrices,
+    prop_hyperelliptic,
+    prop_solution,
+    prop_level_set,
+    prop_frequency_map,
+    prop_parity,
+    prop_kirchhoff,
 ]
 
 
@@ -562,7 +696,10 @@ def test_fuzz(prop):
 @pytest.mark.skipif(not SLOW, reason="set MANAKOV_FUZZ_SLOW=1 (>= 10^5 cases, minutes)")
 @pytest.mark.parametrize("prop", PROPERTIES, ids=[p.__name__[5:] for p in PROPERTIES])
 def test_fuzz_slow(prop):
+    CALLS.clear()
     _run(prop, SLOW_EXAMPLES, derandomize=False)
+    # The counts per entry point (shown with -s).
+    print(f"\n{prop.__name__}: " + ", ".join(f"{k} {v}" for k, v in sorted(CALLS.items())))
 
 
 def test_integrate_does_not_return_the_callers_t_eval():
