@@ -39,7 +39,7 @@ from manakov import reduction
 
 #: Cases per entry point in the default run (20 properties, ~1 s each).
 DEFAULT_EXAMPLES = 40
-#: Cases per entry point in the slow run: 26 properties x 5000 > 10^5.
+#: Cases per entry point in the slow run: 27 properties x 5000 > 10^5.
 SLOW_EXAMPLES = 5000
 #: A case still running after this long is a hang: the process is stopped
 #: with every thread's traceback (faulthandler), which fails the run.
@@ -588,6 +588,23 @@ def prop_solution(data: st.DataObject) -> None:
     check_call(sol.torus.angles, t)
 
 
+def prop_solve(data: st.DataObject) -> None:
+    # top.solve of every kind: generic states (genus 2), states with zero
+    # components (Euler tops, so(3) blocks, equilibria) and wild ones; then the
+    # motion at a few times.
+    p = data.draw(st.sampled_from([q for q in PROBLEMS if len(q.a) == 4]))
+    top = manakov.ManakovTop(p.a, p.b)
+    l0 = np.asarray(p.l0, dtype=float) * data.draw(array(bounded(-2.0, 2.0), (6,), float))
+    zeros = data.draw(st.lists(st.booleans(), min_size=6, max_size=6))
+    l0 = np.where(zeros, 0.0, l0) if data.draw(st.booleans()) else l0
+    sol = check_call(top.solve, l0, allowed=(*BASE_ALLOWED, manakov.ClosedFormError))
+    if sol is None:
+        return
+    t = data.draw(array(reals(-50, 50), (3,), float))
+    check_call(sol.l, t, allowed=(*BASE_ALLOWED, manakov.ClosedFormError))
+    check_call(sol.angles, t)
+
+
 def prop_level_set(data: st.DataObject) -> None:
     p = data.draw(st.sampled_from(PROBLEMS))
     if len(p.a) != 4:
@@ -668,6 +685,7 @@ PROPERTIES: list[Callable[[st.DataObject], None]] = [
     prop_matrices,
     prop_hyperelliptic,
     prop_solution,
+    prop_solve,
     prop_level_set,
     prop_frequency_map,
     prop_parity,

@@ -12,6 +12,7 @@ from typing import Any, NamedTuple
 import numpy as np
 
 from . import _core
+from ._checks import _float_array
 
 __all__ = ["Torus", "real_torus", "second_flow_b", "torus_of_state"]
 
@@ -65,14 +66,7 @@ class Torus(NamedTuple):
         ValueError
             ``t`` not real numbers, or not finite.
         """
-        ta = np.asarray(t)
-        if ta.dtype == object or not (
-            np.issubdtype(ta.dtype, np.integer) or np.issubdtype(ta.dtype, np.floating)
-        ):
-            raise ValueError(f"t must be real numbers, got dtype {ta.dtype}")
-        tt = np.asarray(ta, dtype=float)[..., None]
-        if not np.all(np.isfinite(tt)):
-            raise ValueError("t must be finite (no NaN or infinity)")
+        tt = _float_array(t, "t")[..., None]
         return np.mod(tt * self.frequencies, 1.0)
 
 

@@ -428,8 +428,11 @@ class Solution:
         return float("inf") if n1 != 0.0 else float("nan")
 
     def angles(self, t: Any) -> np.ndarray:
-        """Torus angles ``(ν1 t, ν2 t) mod 1`` from the initial point, shape ``(..., 2)``."""
-        tt = np.asarray(t, dtype=float)[..., None]
+        """Torus angles ``(ν1 t, ν2 t) mod 1`` from the initial point, shape ``(..., 2)``.
+
+        Raises ValueError for ``t`` not real or not finite.
+        """
+        tt = _float_array(t, "t")[..., None]
         return np.mod(tt * self.frequencies, 1.0)
 
     def quotient(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
