@@ -110,6 +110,7 @@ CORE_CHILD = textwrap.dedent(
         "so4_integrals": lambda: _core.so4_integrals(a, rows(80, 6)),
         "kotter_batch": lambda: _core.kotter_batch(a, rows(1446, 6), None, False),
         "Solution.l": lambda: _core.SolutionCore(a, b, l0).l(flat(56, 0.0)),
+        "Motion.l": lambda: _core.MotionCore(a, b, l0).l(flat(56, 0.0)),
         "integrate": lambda: _core.integrate(
             top.c, l0, 0.0, flat(56, 0.0), "gauss16", 1e-2, 1e-12, 1e-12, 10**8
         ),
@@ -130,6 +131,7 @@ CORE_CASES = [
     "so4_integrals",
     "kotter_batch",
     "Solution.l",
+    "Motion.l",
     "integrate",
     "curve.y",
     "frequency_map",

@@ -42,7 +42,7 @@ fn kotter_schottky_py<'py>(
     let s = vec1(&s, "s", Some(n))?;
     let sg = vec1(&sqrt_g, "sqrt_g", Some(n))?;
     let cancel = py_cancel();
-    let idx: Vec<usize> = (0..n).collect();
+    let idx: Vec<usize> = crate::numeric::alloc::try_collect("l", n, 0..n)?;
     let res: Result<Vec<LmPair>, Error> = py.detach(|| {
         crate::error::check_finite("a", &a)?;
         try_map("l", &idx, items_per_check(200.0), &cancel, |&i| {
@@ -76,7 +76,7 @@ fn kotter_lax_m_py<'py>(
     let s = vec1(&s, "s", Some(n))?;
     let sg = vec1(&sqrt_g, "sqrt_g", Some(n))?;
     let cancel = py_cancel();
-    let idx: Vec<usize> = (0..n).collect();
+    let idx: Vec<usize> = crate::numeric::alloc::try_collect("l", n, 0..n)?;
     let res: Result<Vec<[C; 3]>, Error> = py.detach(|| {
         try_map("l", &idx, items_per_check(200.0), &cancel, |&i| {
             kotter::lax_m(&a, &b, &rows[i], s[i], sg[i])
@@ -223,7 +223,7 @@ fn kotter_from_points_py<'py>(
         }
     };
     let cancel = py_cancel();
-    let idx: Vec<usize> = (0..n).collect();
+    let idx: Vec<usize> = crate::numeric::alloc::try_collect("l", n, 0..n)?;
     let res: Result<Vec<[f64; 6]>, Error> = py.detach(|| {
         try_map("z1", &idx, items_per_check(2000.0), &cancel, |&i| {
             let coef = kotter::Coefficients23 {

@@ -5,10 +5,11 @@ use numpy::ndarray::{Array1, Array2};
 use numpy::{Complex64, IntoPyArray, PyArray1, PyArray2, PyReadonlyArray1};
 use pyo3::prelude::*;
 
-use super::arrays::{array1, out_shape_err, stack};
+use super::arrays::{array1, check_call, out_shape_err, stack, vec1};
 use super::errors::py_cancel;
 use super::solution::SolutionCore;
 use crate::error::Error;
+use crate::numeric::alloc::{try_vec, try_with_capacity};
 use crate::solution::jacobi::Jacobi;
 use crate::solution::motion::{Kind, Motion};
 use crate::solution::transverse::euler_frequencies_with;
@@ -58,10 +59,12 @@ impl MotionCore {
         py: Python<'py>,
         t: PyReadonlyArray1<'_, f64>,
     ) -> PyResult<Bound<'py, PyArray2<f64>>> {
-        let t: Vec<f64> = t.as_array().iter().copied().collect();
+        // The times and the six components at each, before anything is copied.
+        check_call("t", t.as_array().len(), 7 * std::mem::size_of::<f64>())?;
+        let t = vec1(&t, "t", None)?;
         let n = t.len();
         let out = py.detach(|| -> crate::error::Result<Vec<f64>> {
-            let mut out = vec![0.0; 6 * n];
+            let mut out = try_vec("l(t)", 6 * n, 0.0)?;
             self.motion.l_batch(&t, &mut out, &py_cancel())?;
             Ok(out)
         })?;
@@ -164,9 +167,16 @@ fn jacobi_ellipj_py<'py>(
     Bound<'py, PyArray1<f64>>,
 )> {
     let j = Jacobi::new(m, m1)?;
-    let u: Vec<f64> = u.as_array().iter().copied().collect();
+    // u and the four results.
+    check_call("u", u.as_array().len(), 5 * std::mem::size_of::<f64>())?;
+    let u = vec1(&u, "u", None)?;
     crate::error::check_finite("u", &u)?;
-    let mut out = [(); 4].map(|_| Vec::with_capacity(u.len()));
+    let mut out = [
+        try_with_capacity("sn", u.len())?,
+        try_with_capacity("cn", u.len())?,
+        try_with_capacity("dn", u.len())?,
+        try_with_capacity("am", u.len())?,
+    ];
     for &x in &u {
         let (s, c, d) = j.sncndn(x);
         out[0].push(s);
@@ -187,11 +197,12 @@ fn jacobi_ellipf_py<'py>(
     m1: f64,
 ) -> PyResult<(f64, Bound<'py, PyArray1<f64>>)> {
     let j = Jacobi::new(m, m1)?;
-    let f: Vec<f64> = phi
-        .as_array()
-        .iter()
-        .map(|&p| j.f(p))
-        .collect::<crate::error::Result<_>>()?;
+    let phi = phi.as_array();
+    check_call("phi", phi.len(), 2 * std::mem::size_of::<f64>())?;
+    let mut f: Vec<f64> = try_with_capacity("F", phi.len())?;
+    for &p in phi.iter() {
+        f.push(j.f(p)?);
+    }
     Ok((j.quarter_period(), Array1::from(f).into_pyarray(py)))
 }
 
