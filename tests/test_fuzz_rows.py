@@ -330,3 +330,39 @@ def test_parity_validates_the_genus_first(char):
     with pytest.raises(ValueError, match="genus must be in 1..6"):
         manakov.parity(char, 10**9)
     assert time.perf_counter() - t0 < 0.1
+
+
+NO_MATPLOTLIB = textwrap.dedent(
+    """
+    import sys
+    sys.modules["matplotlib"] = None  # import matplotlib now raises ImportError
+    from manakov.cli import main
+    sys.exit(main({argv!r}))
+    """
+)
+
+
+def test_cli_without_matplotlib_names_the_extra_and_writes_the_data(tmp_path):
+    # Before: a ModuleNotFoundError traceback and nothing written.
+    png = tmp_path / "m.png"
+    argv = ["frequency-map", "generic", "--grid", "3", "-o", str(png)]
+    proc = subprocess.run(
+        [sys.executable, "-c", NO_MATPLOTLIB.format(argv=argv)],
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
+    assert "Traceback" not in proc.stderr, proc.stderr[-2000:]
+    assert "manakov[plot]" in proc.stderr, proc.stderr
+    data = np.load(tmp_path / "m.npz")
+    assert data["status"].shape == (3, 3) and data["nu"].shape == (3, 3, 2)
+    argv = ["theorem", "generic", "-o", str(png), "--t-end", "1", "--samples", "3"]
+    proc = subprocess.run(
+        [sys.executable, "-c", NO_MATPLOTLIB.format(argv=argv)],
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
+    assert proc.returncode != 0
+    assert "Traceback" not in proc.stderr, proc.stderr[-2000:]
+    assert "manakov[plot]" in proc.stderr, proc.stderr

@@ -258,6 +258,18 @@ def _write(
     np.savetxt(target, data, delimiter=",", header=header, comments="", fmt="%.17g")
 
 
+#: What to install for the figures (the optional dependency group).
+PLOT_EXTRA_HINT = "matplotlib is not installed: pip install 'manakov[plot]' for the figure"
+
+
+def _have_matplotlib() -> bool:
+    try:
+        import matplotlib  # noqa: F401
+    except ImportError:
+        return False
+    return True
+
+
 def _try_plot(draw: Callable[[], None]) -> bool:
     """Draw a figure; False (and no figure) when matplotlib is not installed."""
     try:
@@ -485,6 +497,8 @@ def _run_theorem(args: argparse.Namespace) -> int:
         raise ValueError(f"cannot write {out}: {out.parent} is not a directory")
     if args.samples > MAX_SAMPLES:
         raise ValueError(f"--samples must be at most {MAX_SAMPLES:.0e}, got {args.samples}")
+    if not _have_matplotlib():
+        raise ValueError(f"{PLOT_EXTRA_HINT} (theorem draws its comparison)")
     try:
         err = _plots().plot_theorem(
             pr, out, t_end=args.t_end, samples=args.samples, dt=args.dt, progress=_progress(args)
@@ -526,6 +540,8 @@ def _run_frequency_map(args: argparse.Namespace) -> int:
     out = Path(args.output or f"{pr.name}-frequency-map.png")
     if not out.parent.is_dir():
         raise ValueError(f"cannot write {out}: {out.parent} is not a directory")
+    if not _have_matplotlib():
+        return _frequency_map_data(args, pr, out.with_suffix(".npz"))
     try:
         fm = _plots().plot_frequency_map(
             pr, args.grid, out, max_order=args.max_order, progress=_progress(args)
@@ -541,6 +557,30 @@ def _run_frequency_map(args: argparse.Namespace) -> int:
         ) from None
     print(f"{pr.name}: {fm.status.size} states ({_counts(fm)})")
     print(f"wrote {out}")
+    return 0
+
+
+def _frequency_map_data(args: argparse.Namespace, pr: Problem, path: Path) -> int:
+    """Without matplotlib: the map's data (no figure) to ``path``, and the hint."""
+    from .tori import casimir_slice, frequency_map
+
+    print(f"{PLOT_EXTRA_HINT}; writing the map's data to {path}", file=sys.stderr)
+    phi, ct, states = casimir_slice(pr.l0, args.grid)
+    try:
+        fm = frequency_map(ManakovTop(pr.a, pr.b), states, progress=_progress(args))
+    except KeyboardInterrupt as e:
+        part = getattr(e, "partial", None)
+        if part is None:
+            raise Interrupted("interrupted: no states done yet") from None
+        where = path.with_suffix(".partial.npz")
+        np.savez(where, phi=phi, ct=ct, nu=part.nu, status=part.status)
+        raise Interrupted(
+            f"interrupted: wrote the map of {part.status.size} states ({_counts(part)}) "
+            f"to {where} (partial)"
+        ) from None
+    np.savez(path, phi=phi, ct=ct, nu=fm.nu, status=fm.status)
+    print(f"{pr.name}: {fm.status.size} states ({_counts(fm)})")
+    print(f"wrote {path}")
     return 0
 
 
