@@ -366,3 +366,12 @@ def test_cli_without_matplotlib_names_the_extra_and_writes_the_data(tmp_path):
     assert proc.returncode != 0
     assert "Traceback" not in proc.stderr, proc.stderr[-2000:]
     assert "manakov[plot]" in proc.stderr, proc.stderr
+
+
+@pytest.mark.parametrize("scale", [1e-150, 1e150])
+def test_a_curve_beyond_the_double_range_names_its_scale(scale):
+    # Before: "Im tau must be positive definite; its smallest eigenvalue is NaN".
+    with pytest.raises(ValueError, match="scale"):
+        HyperellipticCurve((np.arange(5.0) + 1.0) * scale)
+    # The same curve at scale 1 is fine.
+    assert np.all(np.isfinite(HyperellipticCurve(np.arange(5.0) + 1.0).tau))

@@ -108,6 +108,25 @@ impl HyperellipticCurve {
         let c = self.intersection_numbers(&cycle_edges, &dirs);
         let msym = basis::symplectic_reduction(&c)?;
         let (a, b) = canonical_periods(&periods, &cycle_edges, &msym, g);
+        // The periods of x^k dx / y scale like |e|^{k+1-n/2}: branch points of
+        // magnitude ~1e-150 or ~1e150 put them beyond the double range. Name
+        // that cause (the scale) rather than the NaN it leaves in Im tau.
+        if !a
+            .iter()
+            .chain(b.iter())
+            .all(|v| v.re.is_finite() && v.im.is_finite())
+            || a.iter().all(|v| v.norm() == 0.0)
+        {
+            let scale = self.e_abs.iter().fold(0.0f64, |m, &v| m.max(v));
+            return Err(Error::InvalidArgument {
+                what: "branch_points",
+                reason: format!(
+                    "the periods of the curve are not finite in double precision at this \
+                     scale (largest |e_k| = {}): rescale x (e_k -> e_k / s) first",
+                    crate::error::num(scale)
+                ),
+            });
+        }
         let a_inv = a
             .clone()
             .try_inverse()
