@@ -127,3 +127,22 @@ def _out(values: np.ndarray, lead: tuple[int, ...]) -> Any:
     values = _finite_result(values)
     res = values.reshape(lead + values.shape[1:])
     return res[()] if res.ndim == 0 else res
+
+
+#: Largest ``|ν t|`` (cycles) whose fractional part a double still holds
+#: (2^52): beyond it the angle is not determined to any digit.
+MAX_PHASE = 4.5e15
+
+
+def _angles(t: Any, frequencies: Any) -> np.ndarray:
+    """``(ν t) mod 1`` for real finite ``t``; ValueError where it is not determined."""
+    tt = _float_array(t, "t")[..., None]
+    with np.errstate(over="ignore", invalid="ignore"):
+        phase = tt * np.asarray(frequencies, dtype=float)
+    if not np.all(np.abs(phase) <= MAX_PHASE):
+        worst = float(np.max(np.abs(np.nan_to_num(phase, nan=np.inf))))
+        raise ValueError(
+            f"the angles nu t are not determined in double precision: |nu t| reaches "
+            f"{worst:.3g} cycles, beyond {MAX_PHASE:.2g} (or the frequencies are not finite)"
+        )
+    return np.mod(phase, 1.0)

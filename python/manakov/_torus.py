@@ -12,7 +12,7 @@ from typing import Any, NamedTuple
 import numpy as np
 
 from . import _core
-from ._checks import _float_array
+from ._checks import _angles
 
 __all__ = ["Torus", "real_torus", "second_flow_b", "torus_of_state"]
 
@@ -64,10 +64,10 @@ class Torus(NamedTuple):
         Raises
         ------
         ValueError
-            ``t`` not real numbers, or not finite.
+            ``t`` not real numbers, or not finite, or ``|ν t|`` beyond 2^52
+            cycles (the angle is not determined in double precision).
         """
-        tt = _float_array(t, "t")[..., None]
-        return np.mod(tt * self.frequencies, 1.0)
+        return _angles(t, self.frequencies)
 
 
 def real_torus(tau: Any, U: Any, U2: Any, characteristics: Any) -> Torus:

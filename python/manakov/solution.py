@@ -43,7 +43,7 @@ from typing import Any, NamedTuple
 import numpy as np
 
 from . import _core
-from ._checks import _float_array, _one_state, _show, _states
+from ._checks import _angles, _float_array, _one_state, _show, _states
 from ._torus import Torus
 from .riemann import HyperellipticCurve
 
@@ -430,10 +430,10 @@ class Solution:
     def angles(self, t: Any) -> np.ndarray:
         """Torus angles ``(ν1 t, ν2 t) mod 1`` from the initial point, shape ``(..., 2)``.
 
-        Raises ValueError for ``t`` not real or not finite.
+        Raises ValueError for ``t`` not real or not finite, or ``|ν t|`` beyond
+        2^52 cycles (the angle is not determined in double precision).
         """
-        tt = _float_array(t, "t")[..., None]
-        return np.mod(tt * self.frequencies, 1.0)
+        return _angles(t, self.frequencies)
 
     def quotient(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """``(idx, num, den)``: ``l_q = Re(Σ_m num[q, m] θ[idx[m]](v) / Σ_m den[m] θ[idx[m]](v))``
