@@ -375,3 +375,13 @@ def test_a_curve_beyond_the_double_range_names_its_scale(scale):
         HyperellipticCurve((np.arange(5.0) + 1.0) * scale)
     # The same curve at scale 1 is fine.
     assert np.all(np.isfinite(HyperellipticCurve(np.arange(5.0) + 1.0).tau))
+
+
+def test_angles_beyond_double_precision_raise():
+    # Before: 0 for t = 1e300 (nu t has no fractional part), NaN on overflow.
+    sol = TOP.solve(L0)
+    with pytest.raises(ValueError, match="not determined"):
+        sol.angles(1e300)
+    with pytest.raises(ValueError, match="not determined"):
+        sol.torus.angles([0.0, 1e300])
+    assert np.all(np.isfinite(sol.angles(1e6)))
