@@ -20,6 +20,15 @@ use crate::numeric::dd::Cdd;
 /// residual is O(1).
 pub const STRUCTURE_RTOL: f64 = 1e-6;
 
+/// `Δ_j^(3)` (25) below this fraction of the size of its products
+/// `(|u_j^(1)| + |v_j^(1)|)(|u_j^(2)| + |v_j^(2)|)` is refused as 0 (`d_j` at
+/// infinity, (26)). It is small, not zero, near the degenerate level sets
+/// (so(3) blocks, single components: `|Δ_j^(3)|` ~ the distance to them, or a
+/// power of it), where `d_j` is large; the determinant is summed in DD from DD
+/// coefficients, so down to this fraction `d_j`, `α_j … δ_j` still carry
+/// double precision (DD's ~1e-32 relative to the products).
+pub const DELTA3_MIN_RTOL: f64 = 1e-16;
+
 /// The constants of Kötter's reduction for one level set `(a, h)`.
 ///
 /// Everything here depends only on `a` and the integrals `h`, hence is
@@ -348,9 +357,10 @@ fn coefficients_20(
             });
         }
         for (j, &aj) in a.iter().enumerate() {
-            // the offsets are accurate to a few ulps relative (root_offsets):
-            // only a root indistinguishable from a_j in double precision is 0/0
-            if roots[p].x[j].to_c().norm() <= 4.0 * f64::EPSILON * scale_a {
+            // the offsets are accurate to a few ulps relative (polish.rs, and
+            // exact from w² at a branch point, pairs.rs) however small: only a
+            // root at a_j itself is 0/0
+            if roots[p].x[j].to_c().norm() <= f64::MIN_POSITIVE * scale_a {
                 return Err(Error::Singular {
                     what: "state l",
                     kind: SingularKind::CoincidingBranchPoints,
@@ -445,7 +455,7 @@ impl BranchConstants {
             let d3 = dd[2][j];
             let size = (u[0][j].to_c().norm() + v[0][j].to_c().norm())
                 * (u[1][j].to_c().norm() + v[1][j].to_c().norm());
-            if d3.to_c().norm() <= 1e-12 * size {
+            if d3.to_c().norm() <= DELTA3_MIN_RTOL * size {
                 // √d_j = (Δ1 − iΔ2)/Δ3: d_j at infinity, where the curve (8)
                 // has its own branch point.
                 return Err(Error::Singular {

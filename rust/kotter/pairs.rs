@@ -19,10 +19,35 @@
 //!
 //! Everything after the roots is a function of `(s_p, σ_p, F'(s_p)/|h0|)`,
 //! finite at `h0 = 0` (docs/degenerate.md, "h0 = 0").
+//!
+//! **A root of `P` at a branch point `a_i` of `√G`** (so(3)-block states and
+//! single components, where `P(a_i) = 0`, and their neighbourhoods): the
+//! expansion above needs the split small against `|r − a_i|` and fails. In the
+//! local parameter `w = √(s − a_i)` of the curve `σ² = G(s)` at `a_i`,
+//! `σ = w √Π_i(s)`, `Π_i(s) = Π_{m≠i}(s − a_m)`, and
+//!
+//! ```text
+//! φ(w) = f(a_i + w²) = P(a_i + w²) + 2 h0 w √Π_i(a_i + w²)
+//!      = P(a_i) + 2 h0 √Π_i(a_i) w + P'(a_i) w² + O(h0 w³, w⁴)
+//! ```
+//!
+//! is analytic in `w` (`φ(−w)` is `f` on the other branch). Its two small
+//! zeros are the pair of roots of `F` near `a_i` (`w = O(h0)` when
+//! `P(a_i) = O(h0²)`), each on the branch `σ = w √Π_i`; they are seeded from the
+//! quadratic `P'(a_i) w² + 2 h0 √Π_i(a_i) w + P(a_i) = 0` and polished by Newton's
+//! method on `φ` in `w`, where nothing is singular; the root is then carried by
+//! its offset `t = w² = s − a_i`, exact however small (the double `s` rounds it
+//! away below `u |a_i|`; the quartic cannot separate the two roots, `|t|` apart,
+//! from each other or from `a_i`). For a real state the quadratic has real
+//! `B² − 4AC` (`B² = 4h0² Π_i(a_i)`): the two `t` are a conjugate pair when
+//! `(B² − 4AC) Π_i(a_i) < 0`, else both real. At
+//! `h0 = 0` the zeros are `±w_0`, one root `a_i + w_0²` on both branches, as for
+//! the pairs above; its first-order split `ρ = dt/dh0 = −2σ/P'(a_i)` orders the
+//! two members (the limit `h0 → 0⁺`).
 
 use num_complex::Complex64;
 
-use super::polish::{polish_root, Level, PolishedRoot};
+use super::polish::{offsets_at, polish_root, polish_root_at, Level, PolishedRoot};
 use crate::numeric::complex::sqrt_principal;
 
 type C = Complex64;
@@ -38,6 +63,16 @@ pub const PAIR_ROUTE_RTOL: f64 = 1e-3;
 /// this fraction of the distance from `r` to the nearest `a_i` (the
 /// expansion in `h0` converges within that distance).
 const PAIR_GAP_FRACTION: f64 = 0.1;
+
+/// A root `r` of `P` whose pair fails [`PAIR_GAP_FRACTION`] is taken at the
+/// branch point `a_i` nearest it when `|r − a_i|` is below this fraction of
+/// the distance from `a_i` to the other `a_m` (the expansion of `φ(w)` in the
+/// module docs converges within that distance).
+const BRANCH_POINT_FRACTION: f64 = 0.1;
+
+/// Newton steps on `φ(w)` (quadratic convergence from the quadratic's seed,
+/// whose relative error is `O(|w|²/gap)`).
+const W_NEWTON_STEPS: usize = 12;
 
 /// The two roots of `P(s) = h1 s² − h2 s + h3`, real for a real state (else
 /// `None`), each polished by two Newton steps on `P` summed from the state
@@ -79,6 +114,9 @@ pub(super) type PairRoute = ([PolishedRoot; 4], [bool; 4], [f64; 4]);
 struct PairRoot {
     root: PolishedRoot,
     r: f64,
+    /// The offset from `r` that orders the members: `h0 ρ` (first order) for a
+    /// pair of the expansion, the exact `t = s − a_i` at a branch point.
+    off: C,
     rho: C,
     /// `±1` for the upper/lower member of a conjugate pair, else 0: the side of
     /// the real axis it approaches as `h0 → 0` (branches on cuts follow it).
@@ -107,21 +145,26 @@ pub(super) fn pair_roots(lv: &Level, p_at_a: &[f64; 4]) -> Option<PairRoute> {
         let (_, dp) = lv.p_dp(C::new(rk, 0.0), &xs);
         let g = xs.iter().product::<C>();
         let sg = sqrt_principal(g);
-        if dp.re == 0.0 || sg.norm() == 0.0 {
-            return None;
-        }
         // G(r) < 0: √G imaginary, the pair is a conjugate pair (partner by
         // conjugation); G(r) > 0: two real roots, each polished.
         let conj_pair = g.re < 0.0;
         // The expansion needs the split small against the distance from r to
         // the nearest a_i, where √G has its branch point: near r = a_i the two
-        // members meet on the real axis (a root of F at a_i, a separatrix of
-        // the real motion), which is not a pair of this kind.
+        // members meet near a_i and are found in the local parameter there
+        // (module docs; r may even round to a_i).
         let gap =
             lv.a.iter()
                 .fold(f64::INFINITY, |m, &ai| m.min((rk - ai).abs()));
-        if (2.0 * h0 * sg / dp.re).norm() > PAIR_GAP_FRACTION * gap {
-            return None;
+        if dp.re == 0.0
+            || sg.norm() == 0.0
+            || (2.0 * h0 * sg / dp.re).norm() > PAIR_GAP_FRACTION * gap
+        {
+            let (ib, agap) = nearest_a(lv.a, rk);
+            if gap > BRANCH_POINT_FRACTION * agap {
+                return None;
+            }
+            out.extend(branch_point_pair(lv, p_at_a, ib)?);
+            continue;
         }
         for (k, b) in [1.0, -1.0].into_iter().enumerate() {
             let sigma = sg * b;
@@ -132,6 +175,7 @@ pub(super) fn pair_roots(lv: &Level, p_at_a: &[f64; 4]) -> Option<PairRoute> {
                 out.push(PairRoot {
                     root: first.root.conj(),
                     r: rk,
+                    off: first.off.conj(),
                     rho: first.rho.conj(),
                     side,
                 });
@@ -157,6 +201,7 @@ pub(super) fn pair_roots(lv: &Level, p_at_a: &[f64; 4]) -> Option<PairRoute> {
             out.push(PairRoot {
                 root,
                 r: rk,
+                off: rho * h0,
                 rho,
                 side,
             });
@@ -171,21 +216,32 @@ pub(super) fn pair_roots(lv: &Level, p_at_a: &[f64; 4]) -> Option<PairRoute> {
 /// is ordered by its limit.
 fn order_pairs(roots: Vec<PairRoot>, h0: f64) -> Option<PairRoute> {
     let kappa = if h0 == 0.0 { 1.0 } else { h0 };
-    let im = |p: &PairRoot| (p.rho * kappa).im;
+    // Im s: that of the offset (exact at a branch point, first order in a pair of
+    // the expansion), ties (h0 = 0) broken by the first-order split.
+    let im = |p: &PairRoot| p.off.im;
+    let im_cmp = |p: &PairRoot, q: &PairRoot| {
+        im(p)
+            .total_cmp(&im(q))
+            .then((p.rho * kappa).im.total_cmp(&(q.rho * kappa).im))
+    };
     let re_cmp = |p: &PairRoot, q: &PairRoot| {
         p.r.total_cmp(&q.r)
+            .then(p.off.re.total_cmp(&q.off.re))
             .then((p.rho * kappa).re.total_cmp(&(q.rho * kappa).re))
     };
-    let by_im_re = |p: &PairRoot, q: &PairRoot| im(p).total_cmp(&im(q)).then(re_cmp(p, q));
+    let by_im_re = |p: &PairRoot, q: &PairRoot| im_cmp(p, q).then(re_cmp(p, q));
     let mut rest: Vec<PairRoot> = roots;
     let mut order: Vec<PairRoot> = Vec::with_capacity(4);
     let mut partner = [false; 4];
-    if rest.iter().any(|p| im(p) != 0.0) {
+    if rest
+        .iter()
+        .any(|p| im(p) != 0.0 || (p.rho * kappa).im != 0.0)
+    {
         // s1: the non-real root of largest imaginary part; s2 its conjugate
         // (the other member of its pair); s3 the remaining one of larger
         // imaginary part (then real part); s4 the last.
         let i1 = (0..rest.len())
-            .filter(|&i| im(&rest[i]) != 0.0)
+            .filter(|&i| im(&rest[i]) != 0.0 || (rest[i].rho * kappa).im != 0.0)
             .max_by(|&i, &j| by_im_re(&rest[i], &rest[j]))?;
         let s1 = rest.remove(i1);
         let i2 = (0..rest.len()).find(|&i| rest[i].r == s1.r)?;
@@ -194,7 +250,8 @@ fn order_pairs(roots: Vec<PairRoot>, h0: f64) -> Option<PairRoute> {
         order.push(s2);
         partner[1] = true;
         rest.sort_by(|p, q| by_im_re(q, p));
-        let conj34 = rest[0].r == rest[1].r && im(&rest[0]) != 0.0;
+        let conj34 =
+            rest[0].r == rest[1].r && (im(&rest[0]) != 0.0 || (rest[0].rho * kappa).im != 0.0);
         order.extend(rest);
         partner[3] = conj34;
     } else {
@@ -205,4 +262,147 @@ fn order_pairs(roots: Vec<PairRoot>, h0: f64) -> Option<PairRoute> {
     let mut it = order.into_iter().map(|p| p.root);
     let roots = [it.next()?, it.next()?, it.next()?, it.next()?];
     Some((roots, partner, side))
+}
+
+/// The `a_i` nearest `r` and its distance to the other `a_m`.
+fn nearest_a(a: &[f64; 4], r: f64) -> (usize, f64) {
+    let ib = (0..4)
+        .min_by(|&i, &j| (r - a[i]).abs().total_cmp(&(r - a[j]).abs()))
+        .unwrap_or(0);
+    let agap = (0..4)
+        .filter(|&m| m != ib)
+        .fold(f64::INFINITY, |g, m| g.min((a[m] - a[ib]).abs()));
+    (ib, agap)
+}
+
+/// The two roots of `F` near the branch point `a_i` of `√G` (module docs): the
+/// zeros of `φ(w) = P(a_i + w²) + 2 h0 w √Π_i(a_i + w²)` near 0, seeded from the
+/// quadratic `P'(a_i) w² + 2 h0 √Π_i(a_i) w + P(a_i) = 0` and polished in `w`;
+/// each root is then carried by its offset `t = w²` from `a_i` and polished on
+/// `f` on its branch `σ = w √Π_i` in DD ([`polish_root_at`]). `None` when the
+/// pair does not lie near `a_i` (then the quartic takes over) or is exactly
+/// `a_i` (`P(a_i) = h0 = 0`: the state lies on the degenerate set).
+fn branch_point_pair(lv: &Level, p_at_a: &[f64; 4], i: usize) -> Option<[PairRoot; 2]> {
+    let a = lv.a;
+    let h0 = lv.h[0];
+    let ai = a[i];
+    let x0 = offsets_at(a, i, C::new(0.0, 0.0));
+    let pi0: C = (0..4).filter(|&m| m != i).map(|m| x0[m]).product();
+    let sqrt_pi0 = sqrt_principal(pi0);
+    let (_, dp0) = lv.p_dp(C::new(ai, 0.0), &x0);
+    let (qa, qb, qc) = (dp0, 2.0 * h0 * sqrt_pi0, C::new(p_at_a[i], 0.0));
+    if qa == C::new(0.0, 0.0) {
+        return None;
+    }
+    // stable roots of qa w² + qb w + qc = 0; B² − 4AC is real for a real state
+    let disc = qb * qb - 4.0 * qa * qc;
+    let sd = sqrt_principal(disc);
+    let q = if (qb + sd).norm() >= (qb - sd).norm() {
+        -0.5 * (qb + sd)
+    } else {
+        -0.5 * (qb - sd)
+    };
+    if q == C::new(0.0, 0.0) {
+        return None;
+    }
+    let agap = nearest_a(a, ai).1;
+    let seeds = [q / qa, qc / q];
+    // t = w²: with w = (−B ± √disc)/(2A), t1 and t2 are conjugate (and not
+    // real) when disc Π_i(a_i) < 0 (Π_i > 0: complex w, conjugate; Π_i < 0: B is
+    // imaginary, w = i v with v complex conjugate); else both are real.
+    let conj_pair = disc.re * pi0.re < 0.0;
+    let kappa = if h0 == 0.0 { 1.0 } else { h0 };
+    let mut out: Vec<PairRoot> = Vec::with_capacity(2);
+    for (k, &w0) in seeds.iter().enumerate() {
+        if conj_pair && k == 1 {
+            let first: &PairRoot = out.last()?;
+            let side = -first.side;
+            out.push(PairRoot {
+                root: first.root.conj(),
+                r: ai,
+                off: first.off.conj(),
+                rho: first.rho.conj(),
+                side,
+            });
+            continue;
+        }
+        let (w, sp) = polish_w(lv, i, w0, sqrt_pi0)?;
+        let t = w * w;
+        if !(t.norm() < BRANCH_POINT_FRACTION * agap) {
+            return None;
+        }
+        let sigma = w * sp;
+        let root = polish_root_at(lv, p_at_a, i, t, Some(sigma));
+        // the DD polish must keep the root at its offset
+        let off = root.x[i].to_c();
+        if !((off - t).norm() <= 1e-6 * t.norm()) {
+            return None;
+        }
+        let rho = -2.0 * sigma / dp0;
+        let side = if conj_pair {
+            let sgn = if off.im != 0.0 {
+                off.im
+            } else {
+                (rho * kappa).im
+            };
+            sgn.signum()
+        } else {
+            0.0
+        };
+        out.push(PairRoot {
+            root,
+            r: ai,
+            off,
+            rho,
+            side,
+        });
+    }
+    let mut it = out.into_iter();
+    Some([it.next()?, it.next()?])
+}
+
+/// Newton's method on `φ(w) = P(a_i + w²) + 2 h0 w √Π_i(a_i + w²)` from `w0`,
+/// `φ'(w) = 2w P'(s) + 2 h0 √Π_i(s) (1 + w² Σ_{m≠i} 1/(s − a_m))`, with `P`, `P'`
+/// summed from the state at the offsets `s − a_m` (exact from `w²`) and
+/// `√Π_i` continued from `√Π_i(a_i)`. Returns `w` and `√Π_i(a_i + w²)`, or
+/// `None` if the iteration does not settle near its seed.
+fn polish_w(lv: &Level, i: usize, w0: C, sqrt_pi0: C) -> Option<(C, C)> {
+    let a = lv.a;
+    let h0 = lv.h[0];
+    let mut w = w0;
+    let mut sp = sqrt_pi0;
+    for _ in 0..W_NEWTON_STEPS {
+        let t = w * w;
+        let x = offsets_at(a, i, t);
+        let pi: C = (0..4).filter(|&m| m != i).map(|m| x[m]).product();
+        let r = sqrt_principal(pi);
+        sp = if (r - sp).norm() <= (r + sp).norm() {
+            r
+        } else {
+            -r
+        };
+        let (p, dp) = lv.p_dp(C::new(a[i], 0.0) + t, &x);
+        let phi = p + 2.0 * h0 * w * sp;
+        let suminv: C = (0..4).filter(|&m| m != i).map(|m| 1.0 / x[m]).sum();
+        let dphi = 2.0 * w * dp + 2.0 * h0 * sp * (1.0 + t * suminv);
+        let step = phi / dphi;
+        if !(step.re.is_finite() && step.im.is_finite()) {
+            break;
+        }
+        w -= step;
+        if step.norm() <= 2.0 * f64::EPSILON * w.norm() {
+            break;
+        }
+    }
+    let t = w * w;
+    let x = offsets_at(a, i, t);
+    let pi: C = (0..4).filter(|&m| m != i).map(|m| x[m]).product();
+    let r = sqrt_principal(pi);
+    sp = if (r - sp).norm() <= (r + sp).norm() {
+        r
+    } else {
+        -r
+    };
+    // it must stay with its seed (not run to the other zero or off the pair)
+    ((w - w0).norm() <= 0.5 * w0.norm() && w.re.is_finite() && w.im.is_finite()).then_some((w, sp))
 }

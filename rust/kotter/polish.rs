@@ -127,7 +127,7 @@ impl Level<'_> {
 
 /// The offsets `x_m = s − a_m` with `s = a_i + t` (`i` the nearest `a`):
 /// `x_i = t`, `x_m = (a_i − a_m) + t`, to full relative accuracy when `t` is.
-fn offsets_at(a: &[f64; 4], i: usize, t: C) -> [C; 4] {
+pub(super) fn offsets_at(a: &[f64; 4], i: usize, t: C) -> [C; 4] {
     std::array::from_fn(|m| if m == i { t } else { (a[i] - a[m]) + t })
 }
 
@@ -193,19 +193,33 @@ impl PolishedRoot {
 /// apart, and `|f|` at the start does not tell them apart (at `h0 = 0` not at all).
 pub(super) fn polish_root(lv: &Level, p_at_a: &[f64; 4], s0: C, branch: Option<C>) -> PolishedRoot {
     let a = lv.a;
-    let [h0, h1, h2, _] = *lv.h;
     let mut best = 0;
     for i in 1..4 {
         if (s0 - a[i]).norm() < (s0 - a[best]).norm() {
             best = i;
         }
     }
+    polish_root_at(lv, p_at_a, best, s0 - a[best], branch)
+}
+
+/// [`polish_root`] from the offset `t0 = s0 − a_best` itself (a root within
+/// rounding of `a_best` — the pairs at a branch point of `√G`, [`super::pairs`] —
+/// keeps its offset, which `s0` alone would lose).
+pub(super) fn polish_root_at(
+    lv: &Level,
+    p_at_a: &[f64; 4],
+    best: usize,
+    t0: C,
+    branch: Option<C>,
+) -> PolishedRoot {
+    let a = lv.a;
+    let [h0, h1, h2, _] = *lv.h;
     let ai = a[best];
     let gap = (0..4)
         .filter(|&m| m != best)
         .map(|m| (a[m] - ai).abs())
         .fold(f64::INFINITY, f64::min);
-    let mut t = s0 - ai;
+    let mut t = t0;
     if branch.is_none() && t.norm() < 0.1 * gap {
         let pa = p_at_a[best];
         let dpa = 2.0 * h1 * ai - h2;

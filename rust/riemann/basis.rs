@@ -6,15 +6,27 @@
 
 use num_complex::Complex64;
 
-use super::quad::log_rho;
+use super::quad::focal_half_sum;
 use crate::error::{Error, Result};
 
 type C = Complex64;
 
 /// Edges whose segment passes within this ellipse parameter (`ln ρ`) of
 /// another branch point are not used: the branch point is on the segment up
-/// to rounding (`ln ρ ≈ √(2δ)` for a point at relative distance `δ`).
-const MIN_EDGE_LOG_RHO: f64 = 1e-7;
+/// to rounding (`ln ρ ≈ √(2δ)` for a point at relative distance `δ` from the
+/// segment's interior). A point near an *end* of the segment (a cluster of
+/// branch points, or one far from the rest) is not on it: its quality is
+/// computed from its offset to that end to full relative accuracy
+/// ([`edge_quality`]), and the composite quadrature from that end resolves it
+/// (docs/riemann.md, "Clusters"). So only an exact zero is refused here.
+const MIN_EDGE_LOG_RHO: f64 = 0.0;
+
+/// Below this `ρ`-excess `s − 1` (`s` the focal half sum) the quality is
+/// recomputed from the offset of the point to the nearer end of the segment:
+/// the plain `(|z − 1| + |z + 1|)/2 − 1` keeps only `u/(s − 1)` of its digits,
+/// and at `s − 1 ≲ u` (a point `1e-16` of the segment's length from its end)
+/// it is 0. Above, the plain form is used as it always was (same bits).
+const ACCURATE_EXCESS_BELOW: f64 = 1e-3;
 
 /// Quality `ln ρ` of the segment `[p, q]`: the smallest ellipse parameter of
 /// the other branch points in the coordinate `t`, `x = (p+q)/2 + t (q−p)/2`.
@@ -24,10 +36,36 @@ pub fn edge_quality(e: &[C], p: usize, q: usize) -> f64 {
     e.iter()
         .enumerate()
         .filter(|&(m, _)| m != p && m != q)
-        .map(|(_, &em)| log_rho((em - mid) / half))
+        .map(|(_, &em)| {
+            let fhs = focal_half_sum((em - mid) / half);
+            if fhs - 1.0 < ACCURATE_EXCESS_BELOW {
+                log_rho_near_end(e[p], e[q], em)
+            } else {
+                fhs.acosh()
+            }
+        })
         .fold(f64::INFINITY, f64::min)
 }
 
+/// `ln ρ` of the point `em` for the segment `[ep, eq]` from the offsets to
+/// the nearer end. With `s = (|em − ep| + |em − eq|)/|ep − eq|` the focal
+/// half sum, `x = s − 1` is, for `em` nearer `ep` (`w = em − ep`,
+/// `v = ep − eq`), `(|w| + (|w + v| − |v|))/|v|` with
+/// `|w + v| − |v| = (|w|² + 2 Re(w v̄))/(|w + v| + |v|)` — no difference of
+/// nearly equal numbers — and `ln ρ = acosh(1 + x) = log1p(x + √(x(x + 2)))`.
+fn log_rho_near_end(ep: C, eq: C, em: C) -> f64 {
+    let (near, far) = if (em - ep).norm() <= (em - eq).norm() {
+        (ep, eq)
+    } else {
+        (eq, ep)
+    };
+    let w = em - near;
+    let v = near - far;
+    let (aw, av, awv) = (w.norm(), v.norm(), (w + v).norm());
+    let x = (aw + (aw * aw + 2.0 * (w * v.conj()).re) / (awv + av)) / av;
+    let x = x.max(0.0);
+    (x + (x * (x + 2.0)).sqrt()).ln_1p()
+}
 fn orient(a: C, b: C, c: C) -> f64 {
     ((b - a).conj() * (c - a)).im
 }

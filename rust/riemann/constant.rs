@@ -1,17 +1,96 @@
 //! What needs theta functions on the curve (built on first use): the theta
-//! plan of `τ`, the vector of Riemann constants `K` (the even characteristic
-//! whose theta vanishes on the Abel images of `g − 1` points) and, for
-//! genus 2, the calibration of the inversion's theta quotients.
+//! plan of `τ`, the vector of Riemann constants `K` and, for genus 2, the
+//! calibration of the inversion's theta quotients.
+//!
+//! # The vector of Riemann constants in closed form
+//!
+//! With the base point `P0` a Weierstrass point (`∞` for odd `n`, `e_1` for
+//! even `n`), `K` is a half period, and its characteristic is fixed by the
+//! characteristics `η(w)` of the other `2g + 1` Weierstrass points `w` alone,
+//! in any canonical basis:
+//!
+//! * Riemann's vanishing theorem (in this crate's convention
+//!   `θ(u(D) + K) = 0` for every effective `D` of degree `g − 1`) and
+//!   Riemann's singularity theorem: the order of vanishing of `θ` at
+//!   `u(D) + K` is `h⁰(D)` (Mumford, *Tata Lectures on Theta I*, Thm. II.3.1
+//!   and §II.3; Griffiths–Harris, *Principles*, p. 348).
+//! * For `D = w_1 + … + w_m + (g − 1 − m) P0` with distinct Weierstrass points
+//!   `w_i ≠ P0`, `u(D) = η(w_1) + … + η(w_m)` is a half period and
+//!   `h⁰(D) = 1 + ⌊(g − 1 − m)/2⌋` (`2 P0` is the `g¹₂`; an effective divisor of
+//!   degree `≤ g` on a hyperelliptic curve is `r g¹₂ + F` with `F` free of
+//!   conjugate pairs and `h⁰ = r + 1`; Mumford, *Tata Lectures on Theta II*,
+//!   IIIa, §2).
+//! * `θ(z + (b + τa)/2)` is a nonzero multiple of `θ[a;b](z)`, and
+//!   `θ[a;b](−z) = (−1)^{a·b} θ[a;b](z)`: the order of vanishing at 0 of
+//!   `θ[χ]`, `χ = K + η(w_1) + … + η(w_m)`, has the parity `a·b` of `χ`.
+//!
+//! Hence `e(K) ≡ 1 + ⌊(g − 1)/2⌋` and, for `g ≥ 2`, `e(K + η(w)) ≡ 1 + ⌊(g − 2)/2⌋`
+//! (mod 2) for each of the `2g + 1` points `w ≠ P0`, `e([a;b]) = a·b`. These
+//! conditions have exactly one solution: two solutions `K`, `K + δ` give
+//! `e(δ) + B(δ, K) = 0` and `B(δ, η(w)) = 0` for all `w` (`e(χ + δ) = e(χ) +
+//! e(δ) + B(χ, δ)` with the symplectic form `B`), and the `η(w)` span the
+//! half periods, so `δ = 0`; in genus 1, `K` is the one odd characteristic.
+//! (In genus 2: `K` is odd and so is each `K + η(w)`: these are the six odd
+//! characteristics.) So `K` needs no theta function and no threshold; the
+//! `η(w)` are read off the lattice coordinates of `u(w)` (integral to
+//! ~1e-14). A numerical search — keep the characteristics whose theta is
+//! rounding-sized on the Abel image of the curve — cannot tell vanishing from
+//! small when the curve is nearly pinched (`Im τ_ii` of 10 and more makes a
+//! theta with `a_i = 1` smaller than `exp(−π Im τ_ii / 4)` everywhere); the
+//! closed form is checked against the theta function at one divisor, relative
+//! to the thetas with the same `a` (which share that scale).
 
 use super::*;
 
-/// A characteristic `[a; b]` is taken as the Riemann constant when
-/// `|θ[a;b](z)| ≤ K_SEARCH_RTOL · max_χ |θ[χ](z)|` at every test divisor: the
-/// vanishing values are rounding-sized (~1e-15), the others O(1e-2) or larger.
+/// The closed-form `K` is accepted when
+/// `|θ[K](z)| ≤ K_CHECK_RTOL · max_b |θ[a_K; b](z)|` at the Abel image `z` of a
+/// fixed divisor of degree `g − 1`: the thetas with the same `a` share the
+/// scale `exp(iπ (n + a/2)ᵀτ(n + a/2))` of their dominant terms, so the vanishing
+/// one is rounding-sized against them (~1e-15) while a wrong characteristic is
+/// O(1) against them, however small all of them are.
+const K_CHECK_RTOL: f64 = 1e-8;
+
+/// Relative tolerance of the numerical calibration of the even-degree inversion
+/// (constant quotients over four divisors).
 const K_SEARCH_RTOL: f64 = 1e-8;
 
 /// Absolute tolerance of the theta sums used here (see `crate::theta`).
 const THETA_TOL: f64 = 1e-15;
+
+/// `e([a;b]) = a·b mod 2` for the FLINT index of a characteristic in genus `g`.
+fn parity_bit(g: usize, idx: usize) -> u32 {
+    let mask = (1usize << g) - 1;
+    ((idx >> g) & mask & idx).count_ones() % 2
+}
+
+/// The characteristic (FLINT index) of the vector of Riemann constants from
+/// those of the Weierstrass points other than the base point (module docs):
+/// the unique `χ` with `e(χ) = 1 + ⌊(g − 1)/2⌋` and, for `g ≥ 2`,
+/// `e(χ + η) = 1 + ⌊(g − 2)/2⌋` mod 2 for every `η` of `etas`. `None` unless
+/// exactly one characteristic qualifies (the `η` are then not those of a
+/// hyperelliptic curve's Weierstrass points).
+pub(super) fn riemann_char_from_etas(g: usize, etas: &[usize]) -> Option<usize> {
+    let e0 = ((1 + (g - 1) / 2) % 2) as u32;
+    let e1 = if g >= 2 {
+        ((1 + (g - 2) / 2) % 2) as u32
+    } else {
+        0
+    };
+    let mut found = None;
+    for chi in 0..(1usize << (2 * g)) {
+        if parity_bit(g, chi) != e0 {
+            continue;
+        }
+        if g >= 2 && etas.iter().any(|&eta| parity_bit(g, chi ^ eta) != e1) {
+            continue;
+        }
+        if found.is_some() {
+            return None;
+        }
+        found = Some(chi);
+    }
+    found
+}
 
 impl HyperellipticCurve {
     pub(super) fn derived(&self) -> Result<&Derived> {
@@ -21,7 +100,7 @@ impl HyperellipticCurve {
             .map_err(|e| e.clone())
     }
 
-    fn test_point(&self, j: usize, l: usize) -> (C, C) {
+    pub(super) fn test_point(&self, j: usize, l: usize) -> (C, C) {
         // Fixed, generic points at the scale of the branch points.
         let w = C::new(
             0.31 + 0.23 * j as f64 - 0.17 * l as f64,
@@ -34,34 +113,46 @@ impl HyperellipticCurve {
     fn build_derived(&self) -> Result<Derived> {
         let g = self.g;
         let plan = ThetaPlan::new(&self.tau_flat, g, THETA_TOL, 0)?;
-        let nchar = 1usize << (2 * g);
-        let mut alive = vec![true; nchar];
-        for j in 0..3 {
-            let mut z = vec![C::new(0.0, 0.0); g];
-            for l in 0..g.saturating_sub(1) {
-                let (x, y) = self.test_point(j, l);
-                let u = self.normalise(&self.abel_unnormalised(x, y)?);
-                for i in 0..g {
-                    z[i] += u[i];
-                }
-            }
-            let (vals, _) = plan.theta_all(&z)?;
-            let big = vals.iter().map(|v| v.norm()).fold(0.0, f64::max);
-            for (c, v) in vals.iter().enumerate() {
-                if v.norm() > K_SEARCH_RTOL * big {
-                    alive[c] = false;
-                }
+        // η(w) of the Weierstrass points other than the base point (∞ for odd
+        // n, e_1 for even n).
+        let first = if self.e.len() % 2 == 1 { 0 } else { 1 };
+        let mut etas = Vec::with_capacity(self.e.len());
+        for k in first..self.e.len() {
+            let (a, b) = self.branch_char(k)?;
+            etas.push(crate::theta::char_index(&a, &b)?);
+        }
+        let kidx = riemann_char_from_etas(g, &etas).ok_or_else(|| Error::NoConvergence {
+            what: "Riemann constant (the characteristics of the branch points fix none)",
+            tol: CHAR_TOL,
+            reached: f64::NAN,
+            iterations: 1,
+        })?;
+        // Check: θ[K] vanishes at the Abel image of a divisor of degree g − 1,
+        // relative to the thetas with the same a (module docs).
+        let mut z = vec![C::new(0.0, 0.0); g];
+        for l in 0..g.saturating_sub(1) {
+            let (x, y) = self.test_point(0, l);
+            let u = self.normalise(&self.abel_unnormalised(x, y)?);
+            for i in 0..g {
+                z[i] += u[i];
             }
         }
-        let found: Vec<usize> = (0..nchar).filter(|&c| alive[c]).collect();
-        if found.len() != 1 {
+        let (vals, _) = plan.theta_all(&z)?;
+        let a_mask = ((1usize << g) - 1) << g;
+        let same_a = (0..vals.len())
+            .filter(|&c| c & a_mask == kidx & a_mask)
+            .map(|c| vals[c].norm())
+            .fold(0.0, f64::max);
+        let rel = vals[kidx].norm() / same_a;
+        if !(rel <= K_CHECK_RTOL) {
             return Err(Error::NoConvergence {
-                what: "Riemann constant (characteristics vanishing on the theta divisor)",
-                tol: K_SEARCH_RTOL,
-                reached: found.len() as f64,
-                iterations: 3,
+                what: "Riemann constant (theta[K] does not vanish on the Abel image of the curve)",
+                tol: K_CHECK_RTOL,
+                reached: rel,
+                iterations: 1,
             });
         }
+        let found = [kidx];
         let k_char = crate::theta::char_from_index(g, found[0]);
         let k = self.half_period(&k_char.0, &k_char.1);
         let mut calib = Vec::new();
@@ -148,11 +239,13 @@ impl HyperellipticCurve {
 
     /// The vector of Riemann constants `K` for the base point `P0`: the half
     /// period `(b + τa)/2` with `θ(u(P_1) + … + u(P_{g−1}) + K) = 0` for all
-    /// points (g = 2: `θ(u(P) + K) = 0` for every `P`), found among the `4^g`
-    /// half periods by evaluating theta at three fixed divisors (built on
-    /// first use).
+    /// points (g = 2: `θ(u(P) + K) = 0` for every `P`). Its characteristic is
+    /// the closed form in the characteristics `η(w)` of the Weierstrass points
+    /// (module docs: Riemann's vanishing and singularity theorems), checked at
+    /// one divisor (built on first use).
     ///
-    /// Errors: those of the search (no half period qualifies, the theta plan).
+    /// Errors: no characteristic or one that fails the check (inaccurate
+    /// periods), the theta plan.
     pub fn riemann_constant(&self) -> Result<&[C]> {
         Ok(&self.derived()?.k)
     }

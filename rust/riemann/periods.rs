@@ -10,6 +10,11 @@ use super::*;
 /// (the curve is singular to double precision).
 const REPEATED_RTOL: f64 = 8.0 * f64::EPSILON;
 
+/// A branch point nearer than this fraction of a tree segment's length to one
+/// of its ends is "near the end": the segment's factors then take exact
+/// offsets at the ends ([`HyperellipticCurve::edge_period`]).
+const NEAR_END_FRACTION: f64 = 1e-8;
+
 impl HyperellipticCurve {
     /// The curve with finite branch points `e_1 … e_n`, `n = 2g+1` or `2g+2`,
     /// `1 ≤ g ≤` [`MAX_GENUS`].
@@ -220,9 +225,28 @@ impl HyperellipticCurve {
         let mid = 0.5 * (self.e[p] + self.e[q]);
         let h = 0.5 * (self.e[q] - self.e[p]);
         let others: Vec<usize> = (0..self.e.len()).filter(|&k| k != p && k != q).collect();
+        // A branch point within a tiny fraction of the segment's length of one
+        // of its ends (a cluster, or a point far from the rest seen from it):
+        // `mid − e_k ± h` rounds that offset away (to 0 at 1e-16 of the
+        // length), which put the end directions below at 0 and the
+        // intersection numbers wrong. Then the factors take the exact offsets
+        // `e_p − e_k`, `e_q − e_k` at the ends (elsewhere, as before, the same bits).
+        let near_end = others.iter().any(|&k| {
+            (self.e[p] - self.e[k])
+                .norm()
+                .min((self.e[q] - self.e[k]).norm())
+                < NEAR_END_FRACTION * (2.0 * h).norm()
+        });
+        let start = |k: usize| {
+            if near_end {
+                self.e[p] - self.e[k]
+            } else {
+                mid - self.e[k] - h
+            }
+        };
         let segs: Vec<SegmentSqrt> = others
             .iter()
-            .map(|&k| SegmentSqrt::new(mid - self.e[k] - h, 2.0 * h))
+            .map(|&k| SegmentSqrt::new(start(k), 2.0 * h))
             .collect();
         let unrot: C = segs.iter().map(|s| s.unrot()).product();
         let prod_at = |t: f64| -> C {
@@ -232,9 +256,20 @@ impl HyperellipticCurve {
                 .map(|(&k, s)| s.rotated(mid - self.e[k] + h * t))
                 .product::<C>()
         };
+        let prod_at_end = |end: usize, t: f64| -> C {
+            if near_end {
+                others
+                    .iter()
+                    .zip(&segs)
+                    .map(|(&k, s)| s.rotated(self.e[end] - self.e[k]))
+                    .product::<C>()
+            } else {
+                prod_at(t)
+            }
+        };
         let i_unit = C::new(0.0, 1.0);
-        let dp = i_unit * h * unrot * prod_at(-1.0);
-        let dq = -i_unit * h * unrot * prod_at(1.0);
+        let dp = i_unit * h * unrot * prod_at_end(p, -1.0);
+        let dq = -i_unit * h * unrot * prod_at_end(q, 1.0);
         let lr = basis::edge_quality(&self.e, p, q);
         let nc = nodes_for(lr);
         let mut per = vec![C::new(0.0, 0.0); g];

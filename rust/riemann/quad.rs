@@ -45,6 +45,14 @@ pub const CHEB_MAX: usize = 192;
 /// pieces cover `δ` far below double precision; beyond, the path is refused.
 const MAX_PIECES: usize = 400;
 
+/// A piece is not split below this width relative to its position,
+/// `half ≤ PIECE_MIN_RATIO · mid`: its nodes would no longer be distinct in
+/// double precision (a singularity on the path to rounding). Pieces at the
+/// start of the path (`[0, h]`) can be graded down to any width: a
+/// singularity at a tiny `|v|` off the path (a cluster of branch points at
+/// the start, seen from the far end of a long segment) is resolved.
+const PIECE_MIN_RATIO: f64 = 1e-13;
+
 /// A quadrature rule on `[0, 1]` (Gauss–Legendre) or `[-1, 1]` (Chebyshev).
 #[derive(Debug)]
 pub struct Rule {
@@ -444,7 +452,7 @@ pub fn plan_pieces(sing: &[C], out: &mut Vec<Piece>) -> Result<()> {
                 b,
                 n: (n as usize).max(4),
             });
-        } else if out.len() + stack.len() >= MAX_PIECES || half < 1e-17 {
+        } else if out.len() + stack.len() >= MAX_PIECES || half <= PIECE_MIN_RATIO * mid {
             return Err(Error::InvalidArgument {
                 what: "path",
                 reason: "an integration path passes within rounding distance of a branch point"

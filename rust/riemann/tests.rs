@@ -296,3 +296,113 @@ fn batches_follow_the_point_by_point_maps() {
         Err(Error::Interrupted)
     );
 }
+
+/// The characteristics whose theta vanishes at the Abel images of three fixed
+/// divisors of degree `g − 1`, each judged against the thetas with the same
+/// `a` (which share its scale; module docs of `constant`): an independent
+/// numerical search for the Riemann constant.
+fn riemann_chars_by_search(h: &HyperellipticCurve) -> Vec<usize> {
+    let g = h.genus();
+    let plan = h.theta_plan().unwrap();
+    let n = 1usize << (2 * g);
+    let a_mask = ((1usize << g) - 1) << g;
+    let mut alive = vec![true; n];
+    for j in 0..3 {
+        let mut z = vec![C::new(0.0, 0.0); g];
+        for l in 0..g.saturating_sub(1) {
+            let (x, y) = h.test_point(j, l);
+            let u = h.abel(x, y).unwrap();
+            for i in 0..g {
+                z[i] += u[i];
+            }
+        }
+        let (vals, _) = plan.theta_all(&z).unwrap();
+        for c in 0..n {
+            let same_a = (0..n)
+                .filter(|&d| d & a_mask == c & a_mask)
+                .map(|d| vals[d].norm())
+                .fold(0.0, f64::max);
+            if vals[c].norm() > 1e-8 * same_a {
+                alive[c] = false;
+            }
+        }
+    }
+    (0..n).filter(|&c| alive[c]).collect()
+}
+
+#[test]
+fn riemann_constant_closed_form_equals_the_search() {
+    // Random curves of every degree: the closed form (parities of K + η(w))
+    // and the numerical search agree, and the search finds exactly one.
+    let mut rng = Rng(0x5eed_0bad_cafe);
+    for n in 3..=10 {
+        for _ in 0..10 {
+            let e: Vec<C> = (0..n).map(|_| rng.c(2.0)).collect();
+            let h = HyperellipticCurve::new(&e).unwrap();
+            let (a, b) = h.riemann_constant_char().unwrap();
+            let idx = crate::theta::char_index(&a, &b).unwrap();
+            assert_eq!(riemann_chars_by_search(&h), vec![idx], "n = {n}, e = {e:?}");
+        }
+    }
+}
+
+#[test]
+fn riemann_constant_of_pinched_curves() {
+    // Curves (8) near the degenerate level sets of the top (docs/degenerate.md,
+    // "Near the pinched sets"): a pair of branch points 1e-12 apart relative to
+    // the others (Im τ_11 ≈ 17), a branch point 1e15 times farther out than the
+    // others (Im τ_22 ≈ 11), both at once. Thetas with a_i = 1 are then smaller
+    // than exp(−π Im τ_ii / 4) everywhere; the search over all 16 at one scale
+    // found none or several (the old code refused the first). Thetas with the
+    // same a and b_i differing where a_i = 0 differ only by terms
+    // exp(−π Im τ_ii) smaller, so no search at a few points can tell the
+    // vanishing one from them: the closed form is among those the search per
+    // scale keeps, and θ(u(P) + K) vanishes at points of the curve.
+    let cases: Vec<Vec<C>> = vec![
+        vec![
+            c(0.0, 0.0),
+            c(0.0, 1e-12),
+            c(0.0, -1.5),
+            c(0.0, -8.3),
+            c(0.0, 0.7),
+        ],
+        vec![
+            c(0.0, 0.0),
+            c(2.4, 0.0),
+            c(-1.5, 0.0),
+            c(-13.4, 0.0),
+            c(4.8e16, 0.0),
+        ],
+        vec![
+            c(0.0, 0.0),
+            c(0.0, 3e-9),
+            c(0.0, 1.2),
+            c(0.0, -0.8),
+            c(0.0, 2.9e15),
+        ],
+    ];
+    for e in cases {
+        let h = HyperellipticCurve::new(&e).unwrap();
+        let im = h.tau()[(0, 0)].im.max(h.tau()[(1, 1)].im);
+        assert!(im > 5.0, "not pinched: Im tau = {im}");
+        let (a, b) = h.riemann_constant_char().unwrap();
+        let idx = crate::theta::char_index(&a, &b).unwrap();
+        assert_eq!(crate::theta::parity(2, idx), -1);
+        assert!(riemann_chars_by_search(&h).contains(&idx), "e = {e:?}");
+        // θ(u(P) + K) = 0 at points of the curve, relative to the thetas with
+        // the characteristic's a
+        let plan = h.theta_plan().unwrap();
+        let kv = h.riemann_constant().unwrap().to_vec();
+        for x in [c(0.3, 0.1), c(-2.0, 1.0), c(1e3, -2e3)] {
+            let u = h.abel(x, h.y(x, 1)).unwrap();
+            let z: Vec<C> = (0..2).map(|i| u[i] + kv[i]).collect();
+            let (vals, _) = plan.theta_all(&z).unwrap();
+            let same_a = (0..4).map(|bb| vals[bb].norm()).fold(0.0, f64::max);
+            assert!(
+                vals[0].norm() < 1e-12 * same_a,
+                "theta {:e}",
+                vals[0].norm() / same_a
+            );
+        }
+    }
+}
