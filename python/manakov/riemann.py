@@ -74,13 +74,22 @@ class HyperellipticCurve:
     Raises
     ------
     ValueError
-        Wrong shape or count, NaN or infinity, ``|e_k| > 1e20``, two branch
-        points coinciding (to rounding), or a configuration the quadrature
-        cannot resolve (a branch point within rounding of a segment between
-        two others). The message says which.
+        Wrong shape or count, NaN or infinity, ``|e_k|`` so large that
+        ``y ~ x**(n/2)`` leaves the double range (``2**(2000/n)``, about
+        ``1e120`` for ``n = 5``), two branch points coinciding (to rounding),
+        or a configuration the quadrature cannot resolve (a branch point
+        within rounding of a segment between two others). The message says
+        which.
 
     Notes
     -----
+    Branch points larger than ``1e20`` are handled in the coordinate
+    ``x / 2**k`` (exactly; the periods, the Abel map and the points are
+    converted), so ``tau`` and the Abel map do not depend on the scale of
+    ``x``. Clusters of branch points (pairs ``1e-30`` apart relative to the
+    others, a branch point ``1e30`` times farther out than the rest, as near
+    the pinched level sets of the top) are resolved.
+
     The homology basis is built from a spanning tree of straight segments
     between branch points, chosen to keep the other branch points far from
     each segment; it does not depend on the branch points being real or

@@ -28,7 +28,7 @@ impl HyperellipticCurve {
                 .map(|v| (v - self.e[r]).norm())
                 .fold(0.0, f64::max);
         let xr = self.e[r] + d * len;
-        let yr = self.y(xr, 1);
+        let yr = self.y_int(xr, 1);
         let part1 = self.path_from_branch(r, xr, yr, None)?;
         let (part2, lam) = self.to_infinity(self.e[r], xr, yr, None)?;
         let ray: Vec<C> = (0..g).map(|i| part1[i] + part2[i]).collect(); // ∫_{e_r}^{∞} ω
@@ -273,6 +273,11 @@ impl HyperellipticCurve {
     /// `q = y / Π_k √(x − e_k)` (factor by factor, so nothing overflows before
     /// `y` itself does).
     pub fn check_point(&self, x: C, y: C) -> Result<()> {
+        self.check_point_int(self.x_in(x), self.y_in(y))
+    }
+
+    /// [`Self::check_point`] in the internal coordinate.
+    fn check_point_int(&self, x: C, y: C) -> Result<()> {
         if !is_finite_c(x) || !is_finite_c(y) {
             return Err(Error::InvalidArgument {
                 what: "point",
@@ -453,7 +458,8 @@ impl HyperellipticCurve {
     /// through `∞` or the branch point `k` (`route = Some(k)`), for tests of
     /// path independence.
     pub fn abel_via(&self, x: C, y: C, route: Option<usize>) -> Result<Vec<C>> {
-        self.check_point(x, y)?;
+        let (x, y) = (self.x_in(x), self.y_in(y));
+        self.check_point_int(x, y)?;
         let raw: Row = match route {
             Some(k) if k < self.e.len() => {
                 let v = self.path_from_branch(k, x, y, None)?;
@@ -510,7 +516,7 @@ impl HyperellipticCurve {
     /// Errors: `(x, y)` not on the curve to [`ON_CURVE_RTOL`], non-finite input.
     pub fn abel(&self, x: C, y: C) -> Result<Vec<C>> {
         let mut out = ZERO_ROW;
-        self.abel_into(x, y, &mut out[..self.g])?;
+        self.abel_into(self.x_in(x), self.y_in(y), &mut out[..self.g])?;
         Ok(out[..self.g].to_vec())
     }
 
@@ -529,8 +535,9 @@ impl HyperellipticCurve {
                 reason: format!("{k} is out of range (0..{})", self.e.len()),
             });
         }
+        let (dx, y) = (self.x_in(dx), self.y_in(y));
         let x = self.e[k] + dx;
-        self.check_point(x, y)?;
+        self.check_point_int(x, y)?;
         let v = self.path_from_branch_dx(k, dx, y, None)?;
         let raw: Row = std::array::from_fn(|i| {
             if i < self.g {
@@ -557,13 +564,13 @@ impl HyperellipticCurve {
         Ok(u)
     }
 
-    /// [`Self::abel`] into `out` (length `g`), without allocating: the
-    /// distances `|x − e_m|` serve the point check, the route choice and the
-    /// node count.
+    /// [`Self::abel`] into `out` (length `g`), without allocating, of the point
+    /// `(x, y)` in the internal coordinate: the distances `|x − e_m|` serve the
+    /// point check, the route choice and the node count.
     fn abel_into(&self, x: C, y: C, out: &mut [C]) -> Result<()> {
         let n = self.e.len();
         if !is_finite_c(x) || !is_finite_c(y) {
-            return self.check_point(x, y);
+            return self.check_point_int(x, y);
         }
         let mut dist = [0.0; MAX_N];
         for (d, &em) in dist.iter_mut().zip(&self.e) {
@@ -586,7 +593,9 @@ impl HyperellipticCurve {
                 got: format!("{}, {}, {}", x.len(), y.len(), out.len()),
             });
         }
-        let one = |(i, row): (usize, &mut [C])| -> Result<()> { self.abel_into(x[i], y[i], row) };
+        let one = |(i, row): (usize, &mut [C])| -> Result<()> {
+            self.abel_into(self.x_in(x[i]), self.y_in(y[i]), row)
+        };
         if x.len() >= PARALLEL_MIN_POINTS {
             use rayon::prelude::*;
             out.par_chunks_mut(g).enumerate().try_for_each(one)

@@ -28,6 +28,11 @@ const MIN_EDGE_LOG_RHO: f64 = 0.0;
 /// it is 0. Above, the plain form is used as it always was (same bits).
 const ACCURATE_EXCESS_BELOW: f64 = 1e-3;
 
+/// The `ρ`-excess `x` of [`log_rho_near_end`] is rounding noise below this many
+/// ulps of `|w|/|v|` (a point on the segment's line inside it, where the two
+/// terms of `x` cancel): the point is then on the segment.
+const ON_SEGMENT_ULPS: f64 = 16.0;
+
 /// Quality `ln ρ` of the segment `[p, q]`: the smallest ellipse parameter of
 /// the other branch points in the coordinate `t`, `x = (p+q)/2 + t (q−p)/2`.
 pub fn edge_quality(e: &[C], p: usize, q: usize) -> f64 {
@@ -63,7 +68,11 @@ fn log_rho_near_end(ep: C, eq: C, em: C) -> f64 {
     let v = near - far;
     let (aw, av, awv) = (w.norm(), v.norm(), (w + v).norm());
     let x = (aw + (aw * aw + 2.0 * (w * v.conj()).re) / (awv + av)) / av;
-    let x = x.max(0.0);
+    // Its rounding error is a few u |w|/|v|: below that the point lies on the
+    // segment to rounding (x = 0, as the plain form has it), whatever its offset.
+    if !(x > ON_SEGMENT_ULPS * f64::EPSILON * aw / av) {
+        return 0.0;
+    }
     (x + (x * (x + 2.0)).sqrt()).ln_1p()
 }
 fn orient(a: C, b: C, c: C) -> f64 {

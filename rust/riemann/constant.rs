@@ -107,7 +107,7 @@ impl HyperellipticCurve {
             0.57 - 0.19 * j as f64 + 0.29 * l as f64,
         );
         let x = self.center + w * (1.3 * self.radius);
-        (x, self.y(x, if (j + l) % 2 == 0 { 1 } else { -1 }))
+        (x, self.y_int(x, if (j + l) % 2 == 0 { 1 } else { -1 }))
     }
 
     fn build_derived(&self) -> Result<Derived> {

@@ -57,12 +57,12 @@ impl HyperellipticCurve {
                 iterations: 0,
             });
         }
-        let (mut y1, mut y2) = (self.y(x1, 1), self.y(x2, 1));
+        let (mut y1, mut y2) = (self.y_int(x1, 1), self.y_int(x2, 1));
         let (s1, s2) = self.start_sheets(&u, (x1, y1), (x2, y2))?;
         y1 *= s1;
         y2 *= s2;
         self.newton(u.as_slice(), &mut x1, &mut y1, &mut x2, &mut y2)?;
-        Ok([(x1, y1), (x2, y2)])
+        Ok([self.point_out(x1, y1), self.point_out(x2, y2)])
     }
 
     /// Genus 2, two finite entries of `u`.
@@ -176,7 +176,7 @@ impl HyperellipticCurve {
             let d2 = -(-c1[1] * r[0] + c1[0] * r[1]) / det;
             for (x, y, dx) in [(&mut *x1, &mut *y1, d1), (&mut *x2, &mut *y2, d2)] {
                 let xn = *x + dx;
-                let yn = self.y(xn, 1);
+                let yn = self.y_int(xn, 1);
                 // Continue the sheet: y' = R'(x)/(2y) = (y/2) Σ 1/(x − e_k).
                 let dy = 0.5
                     * *y

@@ -34,6 +34,21 @@
 //! from infinity (`x = c + (x − c)/τ²`), with composite Gauss–Legendre
 //! quadrature ([`quad`]).
 
+//!
+//! # Scale
+//!
+//! The curve has no preferred scale: `x = λ ξ`, `y = λ^{n/2} η` maps it to
+//! `η² = Π (ξ − e_k/λ)`, the differentials `x^{i−1} dx/y = λ^{i − n/2} ξ^{i−1} dξ/η`
+//! scale row by row, so `τ = A^{-1}B` and the normalised Abel map are the same.
+//! A curve with some `|e_k| > MAX_ABS_BRANCH_POINT` (`R(x)` would leave the
+//! double range; near a pinched level set of the top the branch points spread
+//! over 30 and more orders of magnitude) is built with `λ = 2^k`, `k` even and
+//! `max |e_k| / λ` of order 1: a power of two scales every operation exactly,
+//! so the internal computation is that of the scaled curve to the bit, and
+//! points and periods are converted at the public methods (`x`, `dx` by `λ`,
+//! `y` by `λ^{n/2}`, period rows by `λ^{i − n/2}`). Curves within the bound are
+//! built as given (`k = 0`).
+
 // Index loops over g ≤ 6 coordinates mirror the formulas.
 #![allow(clippy::needless_range_loop)]
 
@@ -77,9 +92,16 @@ type Row = [C; MAX_GENUS];
 
 const ZERO_ROW: Row = [C::new(0.0, 0.0); MAX_GENUS];
 
-/// Largest `|e_k|` accepted: `R(x)` for `|x|` of that size and `n ≤ 14` stays
-/// far below the double range (`(1e20)^14 = 1e280`).
+/// Largest `|e_k|` handled in the coordinate `x` as given: `R(x)` for `|x|` of
+/// that size and `n ≤ 14` stays far below the double range
+/// (`(1e20)^14 = 1e280`). Curves with larger branch points are built in the
+/// coordinate `x / 2^k` (module docs, "Scale").
 pub const MAX_ABS_BRANCH_POINT: f64 = 1e20;
+
+/// The exponent `k n / 2` of the factor `2^{k n/2}` that carries `y` between
+/// the user's coordinate and the curve's internal one must stay in the double
+/// range: `|e_k|` up to `2^(2 MAX_Y_SCALE_EXP / n)` (`≈ 1e120` for `n = 5`).
+const MAX_Y_SCALE_EXP: i32 = 1000;
 
 /// Relative tolerance of "the point is on the curve": `|y² − R(x)| ≤
 /// ON_CURVE_RTOL · Π_k (|x| + |e_k|)`, the right-hand scale being that of the
@@ -103,7 +125,18 @@ pub const THETA_DIVISOR_RTOL: f64 = 1e-8;
 /// periods and Abel map (module docs for the conventions).
 #[derive(Debug, Clone)]
 pub struct HyperellipticCurve {
+    /// The branch points in the internal coordinate `x / 2^k` (module docs,
+    /// "Scale"); everything below is in that coordinate unless named `_user`.
     e: Vec<C>,
+    /// The branch points as given.
+    e_user: Vec<C>,
+    /// `k` of the internal coordinate `x / 2^k` (even; 0 unless some
+    /// `|e_k| > MAX_ABS_BRANCH_POINT`).
+    scale_exp: i32,
+    /// `(A, B)` of the user's coordinate: row `i` of the internal periods times
+    /// `2^{k(i + 1 − n/2)}` (`x^i dx/y` scales by `λ^{i + 1 − n/2}`, `λ = 2^k`).
+    a_user: DMatrix<C>,
+    b_user: DMatrix<C>,
     g: usize,
     center: C,
     radius: f64,
@@ -163,7 +196,50 @@ impl HyperellipticCurve {
 
     /// The finite branch points `e_1 … e_n` as given.
     pub fn branch_points(&self) -> &[C] {
-        &self.e
+        &self.e_user
+    }
+
+    /// `x` (or an offset `dx`) in the internal coordinate `x / 2^k`.
+    #[inline]
+    fn x_in(&self, x: C) -> C {
+        if self.scale_exp == 0 {
+            x
+        } else {
+            x * 2f64.powi(-self.scale_exp)
+        }
+    }
+
+    /// `y` in the internal coordinate `y / 2^{k n/2}`.
+    #[inline]
+    fn y_in(&self, y: C) -> C {
+        if self.scale_exp == 0 {
+            y
+        } else {
+            y * 2f64.powi(-self.scale_exp * self.e.len() as i32 / 2)
+        }
+    }
+
+    /// An internal point `(x, y)` in the user's coordinate.
+    #[inline]
+    fn point_out(&self, x: C, y: C) -> (C, C) {
+        if self.scale_exp == 0 {
+            (x, y)
+        } else {
+            (
+                x * 2f64.powi(self.scale_exp),
+                y * 2f64.powi(self.scale_exp * self.e.len() as i32 / 2),
+            )
+        }
+    }
+
+    /// The factor `λ^{i + 1 − n/2}` of row `i` of the periods (user over internal).
+    fn period_row_scale(&self, i: usize) -> f64 {
+        if self.scale_exp == 0 {
+            1.0
+        } else {
+            let twice = self.scale_exp * (2 * (i as i32 + 1) - self.e.len() as i32);
+            2f64.powi(twice / 2)
+        }
     }
 
     /// Whether `∞` is a branch point (odd `n`); then `P0 = ∞`, else `P0 = e_1`.
@@ -173,13 +249,27 @@ impl HyperellipticCurve {
 
     /// `R(x) = Π (x − e_k)`.
     pub fn r(&self, x: C) -> C {
-        self.e.iter().map(|&ek| x - ek).product()
+        self.e_user.iter().map(|&ek| x - ek).product()
     }
 
     /// `y` on sheet `sheet = ±1`: `sheet · Π_k √(x − e_k)` with principal
     /// roots (`sheet = +1` is the canonical sheet of `crate::curve`). Any
     /// `sheet ≤ 0` means `−1`.
     pub fn y(&self, x: C, sheet: i8) -> C {
+        let y: C = self
+            .e_user
+            .iter()
+            .map(|&ek| sqrt_principal(x - ek))
+            .product();
+        if sheet > 0 {
+            y
+        } else {
+            -y
+        }
+    }
+
+    /// [`Self::y`] in the internal coordinate.
+    fn y_int(&self, x: C, sheet: i8) -> C {
         let y: C = self.e.iter().map(|&ek| sqrt_principal(x - ek)).product();
         if sheet > 0 {
             y
@@ -190,7 +280,7 @@ impl HyperellipticCurve {
 
     /// `(A, B)`: `A_ij = ∮_{a_j} ω_i`, `B_ij = ∮_{b_j} ω_i`, `ω_i = x^{i−1} dx/y`.
     pub fn periods(&self) -> (&DMatrix<C>, &DMatrix<C>) {
-        (&self.a, &self.b)
+        (&self.a_user, &self.b_user)
     }
 
     /// `τ = A^{-1} B` (symmetrised; `Im τ` positive definite).
@@ -227,6 +317,8 @@ impl HyperellipticCurve {
     /// The periods `∮_{c_j} ω_i` of the tree loops (column `j`), `g × 2g`.
     pub fn cycle_periods(&self) -> DMatrix<C> {
         let g = self.g;
-        DMatrix::from_fn(g, 2 * g, |i, j| self.edge_periods[self.cycle_edges[j]][i])
+        DMatrix::from_fn(g, 2 * g, |i, j| {
+            self.edge_periods[self.cycle_edges[j]][i] * self.period_row_scale(i)
+        })
     }
 }

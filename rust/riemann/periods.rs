@@ -39,18 +39,27 @@ impl HyperellipticCurve {
                 index,
             });
         }
-        if let Some(k) = branch_points
-            .iter()
-            .position(|v| v.norm() > MAX_ABS_BRANCH_POINT)
-        {
-            return Err(Error::InvalidArgument {
-                what: "branch_points",
-                reason: format!(
-                    "|e[{k}]| = {:e} exceeds {MAX_ABS_BRANCH_POINT:e} (R(x) would overflow); rescale x",
-                    branch_points[k].norm()
-                ),
-            });
-        }
+        // The internal coordinate x / 2^k (module docs, "Scale").
+        let big = branch_points.iter().map(|v| v.norm()).fold(0.0, f64::max);
+        let scale_exp = if big > MAX_ABS_BRANCH_POINT {
+            let k = 2 * (big.log2() / 2.0).floor() as i32;
+            if k * n as i32 / 2 > MAX_Y_SCALE_EXP {
+                let kmax = branch_points
+                    .iter()
+                    .position(|v| v.norm() == big)
+                    .unwrap_or(0);
+                return Err(Error::InvalidArgument {
+                    what: "branch_points",
+                    reason: format!(
+                        "|e[{kmax}]| = {big:e} is too large: y ~ x^(n/2) at that scale leaves \
+                         the double range"
+                    ),
+                });
+            }
+            k
+        } else {
+            0
+        };
         for i in 0..n {
             for j in (i + 1)..n {
                 let scale = branch_points[i].norm().max(branch_points[j].norm());
@@ -63,7 +72,13 @@ impl HyperellipticCurve {
                 }
             }
         }
-        let e = branch_points.to_vec();
+        let e_user = branch_points.to_vec();
+        let e: Vec<C> = if scale_exp == 0 {
+            e_user.clone()
+        } else {
+            let down = 2f64.powi(-scale_exp);
+            e_user.iter().map(|&v| v * down).collect()
+        };
         let g = (n - 1) / 2;
         let center = e.iter().sum::<C>() / n as f64;
         let radius = e.iter().map(|v| (v - center).norm()).fold(0.0, f64::max);
@@ -74,6 +89,10 @@ impl HyperellipticCurve {
         let c_dist = e.iter().map(|&v| (v - center).norm()).collect();
         let mut this = HyperellipticCurve {
             e,
+            e_user,
+            scale_exp,
+            a_user: DMatrix::zeros(g, g),
+            b_user: DMatrix::zeros(g, g),
             g,
             center,
             radius,
@@ -145,6 +164,10 @@ impl HyperellipticCurve {
         self.cycle_edges = cycle_edges;
         self.intersection = c;
         self.symplectic = msym;
+        let rs: Vec<f64> = (0..g).map(|i| self.period_row_scale(i)).collect();
+        let row = |m: &DMatrix<C>| DMatrix::from_fn(g, g, |i, j| m[(i, j)] * rs[i]);
+        self.a_user = row(&a);
+        self.b_user = row(&b);
         self.a = a;
         self.b = b;
         self.a_inv = a_inv;

@@ -319,7 +319,7 @@ pub(super) fn aux_constants_squared(
     rc: &[C; 2],
     est0: Option<[C; 7]>,
 ) -> Result<[C; 7]> {
-    let (center, radius, geo) = aux_scales(kc);
+    let (center, radius, geo, median) = aux_scales(kc);
     // Fixed generic offsets (off the real axis, both sheets).
     const W: [(f64, f64, f64, f64); 4] = [
         (0.37, 0.61, -0.53, -0.29),
@@ -344,9 +344,16 @@ pub(super) fn aux_constants_squared(
             .map(|(i, (q, x))| (cands.iter().filter(|(_, y)| agree(x, y)).count(), *q, i))
             .max_by(|a, b| a.0.cmp(&b.0).then(a.1.total_cmp(&b.1)))
     };
-    // The geometric-mean scale first; the outer scale only when fewer than
-    // three estimates agree there (a clustered curve: the two scales coincide).
-    for (origin, scale) in [(C::new(0.0, 0.0), geo), (center, 1.3 * radius)] {
+    // The geometric-mean scale first; the median scale, then the outer scale,
+    // only when fewer than three estimates agree (a clustered curve: the scales
+    // coincide). Near a pinched level set one branch point lies far out (|d_4|
+    // 1e15 times the others and more): the geometric mean then sits in the thin
+    // neck of the pinched cycle, where the thetas at the divisor are sums of two
+    // comparable terms and the estimates scatter by 1e-11 … 1e-9, and the
+    // outer scale at the far pair itself; at the median of the |d_j| the points
+    // lie among the bulk of the branch points, where the estimates keep roundoff.
+    let scales = [(C::new(0.0, 0.0), geo), (C::new(0.0, 0.0), median), (center, 1.3 * radius)];
+    for (origin, scale) in scales {
         if best(&cands).is_some_and(|(votes, _, _)| votes >= 3) {
             break;
         }
@@ -367,6 +374,10 @@ pub(super) fn aux_constants_squared(
             }
         }
     }
+    if std::env::var("MANAKOV_DEBUG_CHECK").is_ok() {
+        if let Some(e) = est0 { eprintln!("AUX est0 {:?}", e); }
+        for c in &cands { eprintln!("AUX q={:e} {:?}", c.0, c.1); }
+    }
     best(&cands)
         .map(|(_, _, i)| cands[i].1)
         .ok_or(Error::InvalidArgument {
@@ -375,10 +386,10 @@ pub(super) fn aux_constants_squared(
         })
 }
 
-/// The centre and radius of the branch points of `kc`, and the geometric mean
-/// of the non-zero `|d_j|`: a point at that modulus is, in ratio, far from
-/// every branch point, whatever their spread.
-fn aux_scales(kc: &KotterCurve) -> (C, f64, f64) {
+/// The centre and radius of the branch points of `kc`, the geometric mean of
+/// the non-zero `|d_j|` (a point at that modulus is, in ratio, far from every
+/// branch point, whatever their spread) and the median of `|d_1| … |d_4|`.
+fn aux_scales(kc: &KotterCurve) -> (C, f64, f64, f64) {
     let bp = kc.branch_points();
     let center: C = bp.iter().sum::<C>() / 5.0;
     let radius = bp
@@ -394,7 +405,15 @@ fn aux_scales(kc: &KotterCurve) -> (C, f64, f64) {
     } else {
         radius
     };
-    (center, radius, geo)
+    // the median of |d_1| … |d_4| (the mean of the middle two)
+    let mut mods: Vec<f64> = bp[1..].iter().map(|d| d.norm()).collect();
+    mods.sort_by(f64::total_cmp);
+    let median = if mods.len() == 4 {
+        0.5 * (mods[1] + mods[2])
+    } else {
+        geo
+    };
+    (center, radius, geo, median)
 }
 
 /// The estimate of the `C_L²` at one auxiliary divisor.
