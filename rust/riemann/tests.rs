@@ -414,7 +414,13 @@ fn curves_beyond_the_double_range_of_r_are_built_at_scale() {
     // makes the computation that of the unscaled curve to the bit, and the
     // public methods convert (x by 2^100, y by 2^250, period rows by
     // 2^{100 (i + 1 − 5/2)}).
-    let e = [c(0.0, 0.0), c(0.9, 0.7), c(-1.3, 0.4), c(0.5, -1.1), c(2.1, 0.3)];
+    let e = [
+        c(0.0, 0.0),
+        c(0.9, 0.7),
+        c(-1.3, 0.4),
+        c(0.5, -1.1),
+        c(2.1, 0.3),
+    ];
     let lam = 2f64.powi(100);
     let big: Vec<C> = e.iter().map(|&v| v * lam).collect();
     let h = HyperellipticCurve::new(&e).unwrap();
@@ -463,7 +469,13 @@ fn curves_beyond_the_double_range_of_r_are_built_at_scale() {
 #[test]
 #[ignore]
 fn debug_neck() {
-    let e = vec![c(0.0, 0.0), c(0.0, 68073800.11712147), c(0.0, 59042400.04807433), c(0.0, -32174740.64930172), c(0.0, 1.2931802195938597e+23)];
+    let e = vec![
+        c(0.0, 0.0),
+        c(0.0, 68073800.11712147),
+        c(0.0, 59042400.04807433),
+        c(0.0, -32174740.64930172),
+        c(0.0, 1.2931802195938597e+23),
+    ];
     let h = HyperellipticCurve::new(&e).unwrap();
     eprintln!("tau {:?} tree {:?}", h.tau(), h.cycle_edges());
     for s in [1e7, 1e9, 3.6e11, 1e15, 1e20, 1.7e23, 1e25] {
