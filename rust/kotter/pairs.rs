@@ -46,6 +46,7 @@
 //! two members (the limit `h0 → 0⁺`).
 
 use num_complex::Complex64;
+use std::cmp::Ordering;
 
 use super::polish::{offsets_at, polish_root, polish_root_at, Level, PolishedRoot};
 use crate::numeric::complex::sqrt_principal;
@@ -328,14 +329,17 @@ fn branch_point_pair(lv: &Level, p_at_a: &[f64; 4], i: usize) -> Option<[PairRoo
         }
         let (w, sp) = polish_w(lv, i, w0, sqrt_pi0)?;
         let t = w * w;
-        if !(t.norm() < BRANCH_POINT_FRACTION * agap) {
+        if t.norm().partial_cmp(&(BRANCH_POINT_FRACTION * agap)) != Some(Ordering::Less) {
             return None;
         }
         let sigma = w * sp;
         let root = polish_root_at(lv, p_at_a, i, t, Some(sigma));
         // the DD polish must keep the root at its offset
         let off = root.x[i].to_c();
-        if !((off - t).norm() <= 1e-6 * t.norm()) {
+        if !matches!(
+            (off - t).norm().partial_cmp(&(1e-6 * t.norm())),
+            Some(Ordering::Less | Ordering::Equal)
+        ) {
             return None;
         }
         let rho = -2.0 * sigma / dp0;

@@ -5,6 +5,7 @@
 //! docs/riemann.md).
 
 use num_complex::Complex64;
+use std::cmp::Ordering;
 
 use super::quad::focal_half_sum;
 use crate::error::{Error, Result};
@@ -70,7 +71,7 @@ fn log_rho_near_end(ep: C, eq: C, em: C) -> f64 {
     let x = (aw + (aw * aw + 2.0 * (w * v.conj()).re) / (awv + av)) / av;
     // Its rounding error is a few u |w|/|v|: below that the point lies on the
     // segment to rounding (x = 0, as the plain form has it), whatever its offset.
-    if !(x > ON_SEGMENT_ULPS * f64::EPSILON * aw / av) {
+    if x.partial_cmp(&(ON_SEGMENT_ULPS * f64::EPSILON * aw / av)) != Some(Ordering::Greater) {
         return 0.0;
     }
     (x + (x * (x + 2.0)).sqrt()).ln_1p()

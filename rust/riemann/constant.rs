@@ -41,6 +41,7 @@
 //! to the thetas with the same `a` (which share that scale).
 
 use super::*;
+use std::cmp::Ordering;
 
 /// The closed-form `K` is accepted when
 /// `|θ[K](z)| ≤ K_CHECK_RTOL · max_b |θ[a_K; b](z)|` at the Abel image `z` of a
@@ -121,7 +122,7 @@ impl HyperellipticCurve {
             let (a, b) = self.branch_char(k)?;
             etas.push(crate::theta::char_index(&a, &b)?);
         }
-        let kidx = riemann_char_from_etas(g, &etas).ok_or_else(|| Error::NoConvergence {
+        let kidx = riemann_char_from_etas(g, &etas).ok_or(Error::NoConvergence {
             what: "Riemann constant (the characteristics of the branch points fix none)",
             tol: CHAR_TOL,
             reached: f64::NAN,
@@ -144,7 +145,10 @@ impl HyperellipticCurve {
             .map(|c| vals[c].norm())
             .fold(0.0, f64::max);
         let rel = vals[kidx].norm() / same_a;
-        if !(rel <= K_CHECK_RTOL) {
+        if !matches!(
+            rel.partial_cmp(&K_CHECK_RTOL),
+            Some(Ordering::Less | Ordering::Equal)
+        ) {
             return Err(Error::NoConvergence {
                 what: "Riemann constant (theta[K] does not vanish on the Abel image of the curve)",
                 tol: K_CHECK_RTOL,

@@ -4,6 +4,7 @@
 //! the velocity `U` from Frahm's equations (1) at `v0` by least squares.
 
 use super::*;
+use std::cmp::Ordering;
 
 /// The estimate of the `C_L²` at `v0` takes part in the consensus of
 /// [`aux_constants_squared`] when every needed `|θ[χ](v0)|` is at least this
@@ -59,16 +60,16 @@ fn normal_residual(a: &DMatrix<C>, x: &DVector<C>, r: &DVector<C>) -> f64 {
 /// columns multiplied by `colscale` (undone on `x`); `None` if `R` is singular.
 fn qr_least_squares(a: &DMatrix<C>, r: &DVector<C>, colscale: &[f64; 2]) -> Option<DVector<C>> {
     let mut scaled = a.clone();
-    for k in 0..2 {
-        if colscale[k] != 1.0 {
-            scaled.column_mut(k).scale_mut(colscale[k]);
+    for (k, &s) in colscale.iter().enumerate() {
+        if s != 1.0 {
+            scaled.column_mut(k).scale_mut(s);
         }
     }
     let qr = scaled.qr();
     let qtb = qr.q().adjoint() * r;
     let mut x = qr.r().solve_upper_triangular(&qtb)?;
-    for k in 0..2 {
-        x[k] *= colscale[k];
+    for (xk, &s) in x.iter_mut().zip(colscale) {
+        *xk *= s;
     }
     x.iter()
         .all(|v| v.re.is_finite() && v.im.is_finite())
@@ -138,9 +139,9 @@ impl VelocitySystem {
             [1.0, 1.0]
         };
         let mut scaled = amat.clone();
-        for k in 0..2 {
-            if colscale[k] != 1.0 {
-                scaled.column_mut(k).scale_mut(colscale[k]);
+        for (k, &s) in colscale.iter().enumerate() {
+            if s != 1.0 {
+                scaled.column_mut(k).scale_mut(s);
             }
         }
         let svd = scaled.svd(true, true);
@@ -193,7 +194,10 @@ impl VelocitySystem {
         if std::env::var("MANAKOV_DEBUG_CHECK").is_ok() {
             eprintln!("NE {ne:e}");
         }
-        if !(ne <= NORMAL_RESIDUAL_RTOL) {
+        if !matches!(
+            ne.partial_cmp(&NORMAL_RESIDUAL_RTOL),
+            Some(Ordering::Less | Ordering::Equal)
+        ) {
             if let Some(xq) = qr_least_squares(&self.amat, &rhs, &self.colscale) {
                 x = xq;
             }
