@@ -8,6 +8,8 @@ small step (good to ~1e-13 relative on [0, 100] for these tops).
 from __future__ import annotations
 
 import itertools
+import sys
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -101,3 +103,50 @@ def test_kotter_fields_stay_finite_at_subnormal_h0() -> None:
     assert bool(np.all(k.ok))
     for name in ("xi", "eta", "Delta", "alpha", "K", "g", "sqrt_fprime"):
         assert np.all(np.isfinite(np.asarray(getattr(k, name)))), name
+
+
+#: A state of the harsh random draw (tests/data/every_state_harsh.py, seed 1,
+#: draw 85) whose solution passed its self-check (defect 6.7e-11) and was wrong
+#: by 1.8e-8 |l0| over its window (~23 fast periods): the phase drifts.
+DRIFTING_STATE = (
+    [-0.7124535627701329, -0.5163715580709776, 85.58535386103978, 97.80619195719756],
+    [0.32704667620171946, 12.589647087582449, 12.714745186577423, -747.9937080647329],
+    [
+        178.48795802528048,
+        1.2196941680054887e-06,
+        616061.8945794657,
+        0.005249496313195362,
+        788.1758058080827,
+        -131592.64731334345,
+    ],
+)
+#: The bound of every_state_harsh.py where gauss16 is good (max(1e-10, 10 x its
+#: error); gauss16 is good to ~1e-15 here).
+HARSH_BOUND = 1e-10
+
+
+def test_a_drifting_phase_is_refused_not_returned() -> None:
+    """Each time of the window: l(t) within HARSH_BOUND of the long-double
+    reference, or refused (ClosedFormError); never silently wrong."""
+    pytest.importorskip("heyoka")
+    data = str(Path(__file__).resolve().parent / "data")
+    if data not in sys.path:
+        sys.path.insert(0, data)
+    import longdouble_ref
+
+    a, b, l0 = (np.array(v) for v in DRIFTING_STATE)
+    top = manakov.ManakovTop(a, b)
+    t = np.linspace(0.0, 1.27e-5, 51)
+    ref = longdouble_ref.reference(a, b, l0, t)
+    sol = top.solve(l0)
+    norm = float(np.linalg.norm(l0))
+    refused = 0
+    for tk, rk in zip(t, ref):
+        try:
+            lk = sol.l(tk)
+        except manakov.ClosedFormError:
+            refused += 1
+            continue
+        err = float(np.max(np.abs(np.asarray(lk, dtype=np.longdouble) - rk)) / norm)
+        assert err <= HARSH_BOUND, (tk, err)
+    assert 0 < refused < len(t)

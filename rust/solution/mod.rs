@@ -60,7 +60,7 @@ mod setup;
 pub mod transverse;
 pub mod velocity;
 
-pub use check::SELF_CHECK_RTOL;
+pub use check::{DRIFT_DEFECT_FLOOR, DRIFT_RTOL, SELF_CHECK_RTOL};
 pub use level_set::{a_periods_of, level_set_curve, LevelSetCurve};
 pub use setup::{INCONSISTENT, QUOTIENT_RESIDUAL_RTOL};
 
@@ -130,6 +130,8 @@ pub struct Solution {
     calibration: [f64; 7],
     /// The largest relative defect of the self-check ([`check::SelfCheck`]).
     self_check: f64,
+    /// `|l0|` (`Σ l_ij²` is a Casimir of (1): `|l(t)| = |l0|`).
+    size: f64,
 }
 
 fn singular(kind: SingularKind, reason: String) -> Error {
@@ -307,6 +309,7 @@ impl Solution {
             den,
             calibration,
             self_check,
+            size: l0.iter().map(|x| x * x).sum::<f64>().sqrt(),
         })
     }
 
@@ -616,7 +619,37 @@ impl Solution {
             |first, m, lanes| self.lattice_lanes(&t[first..first + m], lanes),
             &self.idx,
             |first, blk| self.combine(blk, &mut out[6 * first..6 * (first + blk.len)]),
-        )
+        )?;
+        self.check_drift(t, out)
+    }
+
+    /// Refuses `l(t)` where the relative defect `δ` the self-check leaves may
+    /// have moved it by more than [`DRIFT_RTOL`] `|l0|`: the first-order drift
+    /// `δ |t| |l̇(t)|`, `l̇` Frahm's (1) at the computed `l(t)`; not where `δ`
+    /// is at rounding level ([`DRIFT_DEFECT_FLOOR`]).
+    fn check_drift(&self, t: &[f64], out: &[f64]) -> Result<()> {
+        if self.self_check <= DRIFT_DEFECT_FLOOR {
+            return Ok(());
+        }
+        for (&tk, lk) in t.iter().zip(out.chunks_exact(6)) {
+            let l: &[f64; 6] = lk.try_into().expect("rows of 6");
+            let f = so4::vector_field4(&self.c4, l);
+            let speed = f.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+            let drift = self.self_check * tk.abs() * speed / self.size;
+            // NaN (a non-finite l) passes here: the quotient's own checks own it
+            if drift > DRIFT_RTOL {
+                return Err(Error::Unverified {
+                    what: "l(t)",
+                    reason: format!(
+                        "at t = {tk:e} the relative defect {:e} left by the self-check may \
+                         move l(t) by {drift:e} |l0| > {DRIFT_RTOL:e} (the drift \
+                         delta |t| |dl/dt| of the phase); evaluate nearer t = 0",
+                        self.self_check
+                    ),
+                });
+            }
+        }
+        Ok(())
     }
 
     /// `l(t_k)` into `out` (row-major `(N, 6)`); rayon for large batches,
