@@ -273,6 +273,11 @@ class Solution:
         ------
         ValueError
             Non-finite ``t``.
+        ClosedFormError
+            A genus-2 solution whose self-check defect ``δ`` (``self_check``)
+            is above rounding (1e-12), at a ``t`` where the drift
+            ``δ |t| |dl/dt| / |l0|`` of its phase exceeds 1e-10: the closed form
+            cannot vouch for ``l(t)`` there (integrate instead).
         """
         tt = _float_array(t, "t")
         out = self._motion.l(np.ascontiguousarray(tt.reshape(-1)))
