@@ -37,6 +37,9 @@ CYC = ((0, 1, 2), (1, 2, 0), (2, 0, 1))
 CLOSED_FORM_RTOL = 1e-11
 #: Must-show on random states (tests/data/clebsch_random_stats.py runs 1000).
 RANDOM_RTOL = 1e-10
+#: Of those 100, draws whose l(t) the drift check refuses (docs/degenerate.md,
+#: "Near the pinched sets"): draw 1, self-check defect 2.1e-12, at t = 48.
+RANDOM_REFUSED_MAX = 1
 #: The conjugate top's own check (manakov.Solution.self_check) on the four bodies:
 #: they leave ≤ 1.3e-14; the Solution refuses only above 1e-10, so this bound sees
 #: a loss of conditioning of the conjugacy long before a refusal would.
@@ -202,8 +205,14 @@ def test_closed_form_on_random_states():
     """100 of the 1000 draws of tests/data/clebsch_random_stats.py (its own run:
     999 of 1000 within 1e-10 on [0, 100], all on [0, 20])."""
     rng = np.random.default_rng(random_stats.SEED)
-    errs = [random_stats.error(*random_stats.draw(rng), 100.0) for _ in range(100)]
+    errs, refused = [], 0
+    for _ in range(100):
+        try:
+            errs.append(random_stats.error(*random_stats.draw(rng), 100.0))
+        except manakov.ClosedFormError:
+            refused += 1
     assert max(errs) <= RANDOM_RTOL, max(errs)
+    assert refused <= RANDOM_REFUSED_MAX, refused
 
 
 class _BodyAsTop:
@@ -411,11 +420,14 @@ def test_solve_refuses_other_bodies_and_singular_states():
     with pytest.raises(ValueError, match="Clebsch case only"):
         _ = gen.body.conjugate_top
     body = manakov.fluid_problem("clebsch_generic").body
-    # 1e-13 off M·p = 0 beside two axes: a genus-2 state of the conjugate top that
-    # its reduction refuses (a repeated root of F); the message translates h0 and
-    # gives the top's.
-    with pytest.raises(ValueError, match=r"M0·p0 = 0 is the conjugate top's h0 = 0.*repeated root"):
-        body.solve([1.0, 1e-13, 0.0], [0.0, 1.0, 0.0])
+    # 1e-13 off M·p = 0 beside two axes: a genus-2 state of the conjugate top
+    # whose roots of F meet at a branch point of sqrt(G); found in the local
+    # parameter there (docs/degenerate.md, "Near the pinched sets"), it is solved.
+    M0, p0 = np.array([1.0, 1e-13, 0.0]), np.array([0.0, 1.0, 0.0])
+    t = np.linspace(0.0, 20.0, 41)
+    M, p = body.solve(M0, p0).state(t)
+    tr = body.integrate(M0, p0, 20.0, t_eval=t, dt=body.default_dt(M0, p0) / 4)
+    assert max(np.max(np.abs(M - tr.M)), np.max(np.abs(p - tr.p))) <= RANDOM_RTOL
     with pytest.raises(ValueError, match="finite"):
         body.solve([np.nan, 0, 0], [0, 1, 0])
     with pytest.raises(ValueError, match=r"shape \(3,\)"):

@@ -276,7 +276,7 @@ class Solution:
         ClosedFormError
             A genus-2 solution whose self-check defect ``δ`` (``self_check``)
             is above rounding (1e-12), at a ``t`` where the drift
-            ``δ |t| |dl/dt| / |l0|`` of its phase exceeds 1e-10: the closed form
+            ``δ |t| |dl/dt| / |l0|`` of its phase exceeds 5e-11: the closed form
             cannot vouch for ``l(t)`` there (integrate instead).
         """
         tt = _float_array(t, "t")

@@ -465,35 +465,3 @@ fn curves_beyond_the_double_range_of_r_are_built_at_scale() {
     let d = (hs.tau() - h.tau()).norm() / h.tau().norm();
     assert!(d < 1e-13, "{d:e}");
 }
-
-#[test]
-#[ignore]
-fn debug_neck() {
-    let e = vec![
-        c(0.0, 0.0),
-        c(0.0, 68073800.11712147),
-        c(0.0, 59042400.04807433),
-        c(0.0, -32174740.64930172),
-        c(0.0, 1.2931802195938597e+23),
-    ];
-    let h = HyperellipticCurve::new(&e).unwrap();
-    eprintln!("tau {:?} tree {:?}", h.tau(), h.cycle_edges());
-    for s in [1e7, 1e9, 3.6e11, 1e15, 1e20, 1.7e23, 1e25] {
-        let x = c(0.37, 0.61) * s;
-        let y = h.y(x, 1);
-        let u0 = h.abel(x, y).unwrap();
-        let mut worst = 0.0f64;
-        for route in [None, Some(0), Some(1), Some(2), Some(3), Some(4)] {
-            match h.abel_via(x, y, route) {
-                Ok(u1) => {
-                    let d: Vec<C> = (0..2).map(|i| u1[i] - u0[i]).collect();
-                    let r = h.reduce(&d);
-                    worst = worst.max(r[0].norm().max(r[1].norm()));
-                    eprintln!("   s={s:e} route {route:?} diff {:?}", r);
-                }
-                Err(err) => eprintln!("   s={s:e} route {route:?} {err:?}"),
-            }
-        }
-        eprintln!("s={s:e} worst {worst:e} u {u0:?}");
-    }
-}
