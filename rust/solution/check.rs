@@ -62,6 +62,19 @@ pub const DRIFT_RTOL: f64 = SELF_CHECK_RTOL / 2.0;
 /// 1.03e-10): the price of refusing the wrong ones.
 pub const DRIFT_DEFECT_FLOOR: f64 = 1e-12;
 
+/// The relative rounding of the velocity `U` and of the phase `U t` (a few
+/// ulp: U is accurate to ~1e-16 relative against long-double fits,
+/// docs/theorem.md), the smallest drift rate the phase horizon assumes.
+pub const PHASE_ROUNDING_RTOL: f64 = 4.0 * f64::EPSILON;
+
+/// Beyond the time where `max(δ, PHASE_ROUNDING_RTOL) |t| |l̇|` exceeds this
+/// fraction of `|l0|`, `l(t)` is refused whatever the self-check left: the
+/// phase is not determined there (any integrator of (1) in double precision
+/// has lost as much by then). Far beyond every use the tests make
+/// (`t = 1e4 … 1e6` on O(1) tops leaves ≤ 1e-9), well before `|U t| ~ 1e16`
+/// where the phase has no digit left.
+pub const HORIZON_RTOL: f64 = 1e-6;
+
 /// Fractions of the shortest lattice period of the phase at which the
 /// self-check evaluates the solution (besides `t = 0`): points spread over
 /// the torus, none a simple fraction of a period.

@@ -60,7 +60,9 @@ mod setup;
 pub mod transverse;
 pub mod velocity;
 
-pub use check::{DRIFT_DEFECT_FLOOR, DRIFT_RTOL, SELF_CHECK_RTOL};
+pub use check::{
+    DRIFT_DEFECT_FLOOR, DRIFT_RTOL, HORIZON_RTOL, PHASE_ROUNDING_RTOL, SELF_CHECK_RTOL,
+};
 pub use level_set::{a_periods_of, level_set_curve, LevelSetCurve};
 pub use setup::{INCONSISTENT, QUOTIENT_RESIDUAL_RTOL};
 
@@ -132,6 +134,9 @@ pub struct Solution {
     self_check: f64,
     /// `|l0|` (`Σ l_ij²` is a Casimir of (1): `|l(t)| = |l0|`).
     size: f64,
+    /// `4 max|c_ij| |l0|²`, a bound of `|l̇|` by (1) for the phase horizon
+    /// (`‖[L, Ω]‖_F ≤ 2 ‖L‖_F ‖Ω‖_F`, `‖Ω‖_F ≤ max|c_ij| ‖L‖_F`, `‖L‖_F² = 2|l|²`).
+    speed_bound: f64,
 }
 
 fn singular(kind: SingularKind, reason: String) -> Error {
@@ -310,6 +315,9 @@ impl Solution {
             calibration,
             self_check,
             size: l0.iter().map(|x| x * x).sum::<f64>().sqrt(),
+            speed_bound: 4.0
+                * c4.iter().fold(0.0f64, |m, v| m.max(v.abs()))
+                * l0.iter().map(|x| x * x).sum::<f64>(),
         })
     }
 
@@ -626,26 +634,48 @@ impl Solution {
     /// Refuses `l(t)` where the relative defect `δ` the self-check leaves may
     /// have moved it by more than [`DRIFT_RTOL`] `|l0|`: the first-order drift
     /// `δ |t| |l̇(t)|`, `l̇` Frahm's (1) at the computed `l(t)`; not where `δ`
-    /// is at rounding level ([`DRIFT_DEFECT_FLOOR`]).
+    /// is at rounding level ([`DRIFT_DEFECT_FLOOR`]). Beyond the phase horizon
+    /// every solution refuses: where even a rounding-level `δ`
+    /// (`max(δ, PHASE_ROUNDING_RTOL)`) drifts `l(t)` by more than
+    /// [`HORIZON_RTOL`] `|l0|`, the phase `U t` is no longer determined by the
+    /// double `U` (at `|U t| ~ 1e16` not even its integer part is), and the
+    /// value would be arbitrary.
     fn check_drift(&self, t: &[f64], out: &[f64]) -> Result<()> {
-        if self.self_check <= DRIFT_DEFECT_FLOOR {
-            return Ok(());
+        let gated = self.self_check > DRIFT_DEFECT_FLOOR;
+        let delta = self.self_check.max(PHASE_ROUNDING_RTOL);
+        if !gated {
+            // One comparison per block on the generic path, with the bound
+            // `speed_bound` of |l̇| (|l| = |l0|: Σ l² is conserved).
+            let t_max = t.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+            if delta * t_max * self.speed_bound / self.size <= HORIZON_RTOL {
+                return Ok(());
+            }
         }
         for (&tk, lk) in t.iter().zip(out.chunks_exact(6)) {
             let l: &[f64; 6] = lk.try_into().expect("rows of 6");
             let f = so4::vector_field4(&self.c4, l);
             let speed = f.iter().fold(0.0f64, |m, v| m.max(v.abs()));
-            let drift = self.self_check * tk.abs() * speed / self.size;
+            let drift = delta * tk.abs() * speed / self.size;
             // NaN (a non-finite l) passes here: the quotient's own checks own it
-            if drift > DRIFT_RTOL {
-                return Err(Error::Unverified {
-                    what: "l(t)",
-                    reason: format!(
+            let bound = if gated { DRIFT_RTOL } else { HORIZON_RTOL };
+            if drift > bound {
+                let reason = if gated {
+                    format!(
                         "at t = {tk:e} the relative defect {:e} left by the self-check may \
                          move l(t) by {drift:e} |l0| > {DRIFT_RTOL:e} (the drift \
                          delta |t| |dl/dt| of the phase); evaluate nearer t = 0",
                         self.self_check
-                    ),
+                    )
+                } else {
+                    format!(
+                        "t = {tk:e} is beyond the phase horizon: the rounding of the \
+                         velocity U alone may move l(t) by {drift:e} |l0| > \
+                         {HORIZON_RTOL:e}; integrate from a state nearer that time instead"
+                    )
+                };
+                return Err(Error::Unverified {
+                    what: "l(t)",
+                    reason,
                 });
             }
         }
