@@ -211,3 +211,20 @@ def test_times_beyond_the_phase_horizon_are_refused(scale: float) -> None:
             sol.l(t)
         with pytest.raises(manakov.ClosedFormError, match="phase horizon"):
             sol.l(np.array([0.0, t]))
+
+
+@pytest.mark.parametrize(
+    "l0",
+    [[1.0, 0.5, 0.3, 0.3, -0.5, 1.0], [0.6, -0.4, 0.0, 0.8, 0.0, 0.0]],
+    ids=["self-dual", "block"],
+)
+def test_euler_kinds_refuse_beyond_the_phase_horizon(l0: list) -> None:
+    """The Euler top's l(t) has the genus-2 kind's horizon: at t = 1e17 its
+    phase has no digit left (an arbitrary state was returned before)."""
+    p = manakov.problem("generic")
+    sol = manakov.ManakovTop(p.a, p.b).solve(np.array(l0))
+    assert sol.kind == "euler"
+    assert np.all(np.isfinite(sol.l(1e4)))
+    for t in (1e12, 1e17, -1e300):
+        with pytest.raises(manakov.ClosedFormError, match="phase horizon"):
+            sol.l(t)

@@ -277,7 +277,11 @@ class Solution:
             A genus-2 solution whose self-check defect ``δ`` (``self_check``)
             is above rounding (1e-12), at a ``t`` where the drift
             ``δ |t| |dl/dt| / |l0|`` of its phase exceeds 5e-11: the closed form
-            cannot vouch for ``l(t)`` there (integrate instead).
+            cannot vouch for ``l(t)`` there (integrate instead). Any kind
+            with a moving phase, beyond its phase horizon: where the rounding
+            of the velocity alone (4 ulp) moves ``l(t)`` by more than 1e-6
+            ``|l0|`` (e.g. ``|t| ~ 1e12`` on a top and state of unit size),
+            the phase is no longer determined by double precision.
         """
         tt = _float_array(t, "t")
         out = self._motion.l(np.ascontiguousarray(tt.reshape(-1)))

@@ -27,7 +27,7 @@ use rayon::prelude::*;
 use super::constant::is_equilibrium;
 use super::euler::{Embedding, EulerRegime, EulerTop};
 use super::normalize::{state_scale, TopFrame};
-use super::Solution;
+use super::{Solution, HORIZON_RTOL, PHASE_ROUNDING_RTOL};
 use crate::error::{Error, Result};
 use crate::numeric::cancel::Cancel;
 
@@ -222,6 +222,24 @@ impl Motion {
                 Ok(())
             }
             Body::Euler { emb, top } => {
+                // The phase horizon of the genus-2 kind ([`HORIZON_RTOL`]),
+                // with the Euler top's own rate: a rounding of its frequency
+                // by PHASE_ROUNDING_RTOL moves M(t) by ~that times 2π ν |t|
+                // of its size. (ν = 0: at rest or on the separatrix, where
+                // M(t) tends to its limit and every t is determined.)
+                let nu = top.frequency() * self.time_scale;
+                let t_max = t.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+                let drift = PHASE_ROUNDING_RTOL * std::f64::consts::TAU * nu * t_max;
+                if drift > HORIZON_RTOL {
+                    return Err(Error::Unverified {
+                        what: "l(t)",
+                        reason: format!(
+                            "t = {t_max:e} is beyond the phase horizon: the rounding of the \
+                             frequency alone may move l(t) by {drift:e} |l0| > \
+                             {HORIZON_RTOL:e}; integrate from a state nearer that time instead"
+                        ),
+                    });
+                }
                 for (o, &tk) in out.chunks_exact_mut(6).zip(t) {
                     let l = emb.state(&top.m(self.time_scale * tk));
                     for q in 0..6 {
