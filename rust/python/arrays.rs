@@ -14,7 +14,8 @@ use pyo3::PyErr;
 
 use super::errors::py_cancel;
 use crate::error::Error;
-use crate::numeric::alloc::{check_size, items_per_check, try_collect, try_map_rows};
+use crate::numeric::alloc::{check_size, items_per_check, try_collect, try_map_rows, try_vec};
+use crate::numeric::cancel::Cancel;
 
 /// Checks, before any copy or work, that `count` items (states, points,
 /// samples) of a call fit the allocation budget when each needs `bytes_each`
@@ -52,6 +53,28 @@ pub(super) fn out_shape_err(e: ShapeError) -> PyErr {
         reason: e.to_string(),
     }
     .into()
+}
+
+/// `l(t_k)`, `(N, 6)`, of a flat array of times by a core batch `eval`
+/// (`Solution::l_batch`, `Motion::l_batch`), with the GIL released and Ctrl-C
+/// polled; the times and the six components at each are checked against the
+/// allocation budget before anything is copied.
+pub(super) fn l_of_times<'py>(
+    py: Python<'py>,
+    t: PyReadonlyArray1<'_, f64>,
+    eval: impl Fn(&[f64], &mut [f64], &Cancel) -> crate::error::Result<()> + Send + Sync,
+) -> PyResult<Bound<'py, PyArray2<f64>>> {
+    check_call("t", t.as_array().len(), 7 * std::mem::size_of::<f64>())?;
+    let t = vec1(&t, "t", None)?;
+    let n = t.len();
+    let out = py.detach(|| -> crate::error::Result<Vec<f64>> {
+        let mut out = try_vec("l(t)", 6 * n, 0.0)?;
+        eval(&t, &mut out, &py_cancel())?;
+        Ok(out)
+    })?;
+    Ok(Array2::from_shape_vec((n, 6), out)
+        .map_err(out_shape_err)?
+        .into_pyarray(py))
 }
 
 /// A 1-d array as a `Vec`; with `len`, its length must be `len`.

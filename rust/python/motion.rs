@@ -1,15 +1,15 @@
 //! Bindings for `crate::solution::motion` (the dispatcher over every kind of
 //! state), its closed forms, and the Jacobi elliptic functions behind them.
 
-use numpy::ndarray::{Array1, Array2};
+use numpy::ndarray::Array1;
 use numpy::{Complex64, IntoPyArray, PyArray1, PyArray2, PyReadonlyArray1};
 use pyo3::prelude::*;
 
-use super::arrays::{array1, check_call, out_shape_err, stack, vec1};
+use super::arrays::{array1, check_call, l_of_times, stack, vec1};
 use super::errors::py_cancel;
 use super::solution::SolutionCore;
 use crate::error::Error;
-use crate::numeric::alloc::{try_vec, try_with_capacity};
+use crate::numeric::alloc::try_with_capacity;
 use crate::solution::jacobi::Jacobi;
 use crate::solution::motion::{Kind, Motion};
 use crate::solution::transverse::euler_frequencies_with;
@@ -59,18 +59,7 @@ impl MotionCore {
         py: Python<'py>,
         t: PyReadonlyArray1<'_, f64>,
     ) -> PyResult<Bound<'py, PyArray2<f64>>> {
-        // The times and the six components at each, before anything is copied.
-        check_call("t", t.as_array().len(), 7 * std::mem::size_of::<f64>())?;
-        let t = vec1(&t, "t", None)?;
-        let n = t.len();
-        let out = py.detach(|| -> crate::error::Result<Vec<f64>> {
-            let mut out = try_vec("l(t)", 6 * n, 0.0)?;
-            self.motion.l_batch(&t, &mut out, &py_cancel())?;
-            Ok(out)
-        })?;
-        Ok(Array2::from_shape_vec((n, 6), out)
-            .map_err(out_shape_err)?
-            .into_pyarray(py))
+        l_of_times(py, t, |t, out, cancel| self.motion.l_batch(t, out, cancel))
     }
 
     /// `s` of `l0' = l0/s`.

@@ -7,9 +7,7 @@ use pyo3::prelude::*;
 
 use std::sync::Arc;
 
-use super::arrays::{array1, check_call, out_shape_err, vec1};
-use super::errors::py_cancel;
-use crate::numeric::alloc::try_vec;
+use super::arrays::{array1, l_of_times, out_shape_err};
 use crate::solution::Solution;
 
 type C = Complex64;
@@ -56,18 +54,7 @@ impl SolutionCore {
         py: Python<'py>,
         t: PyReadonlyArray1<'_, f64>,
     ) -> PyResult<Bound<'py, PyArray2<f64>>> {
-        // The times and the six components at each, before anything is copied.
-        check_call("t", t.as_array().len(), 7 * std::mem::size_of::<f64>())?;
-        let t = vec1(&t, "t", None)?;
-        let n = t.len();
-        let out = py.detach(|| -> crate::error::Result<Vec<f64>> {
-            let mut out = try_vec("l(t)", 6 * n, 0.0)?;
-            self.sol.l_batch(&t, &mut out, &py_cancel())?;
-            Ok(out)
-        })?;
-        Ok(Array2::from_shape_vec((n, 6), out)
-            .map_err(out_shape_err)?
-            .into_pyarray(py))
+        l_of_times(py, t, |t, out, cancel| self.sol.l_batch(t, out, cancel))
     }
 
     /// The Abel image `u(P1) + u(P2)` of a state on the same level set.
