@@ -130,16 +130,9 @@ impl EulerTop {
         crate::error::check_finite("M0", &m0)?;
         let wv = w.map(|x| x.to_f64());
         crate::error::check_finite("W", &wv)?;
-        let rest = |regime| EulerTop {
-            m0,
-            w,
-            motion: Motion::Rest,
-            regime,
-            params: [f64::NAN; 3],
-        };
         let nonzero = m0.iter().filter(|v| **v != 0.0).count();
         if nonzero <= 1 {
-            return Ok(rest(EulerRegime::Rest));
+            return Ok(Self::rest(w, m0));
         }
         let diff = |i: usize, j: usize| w[i].sub(w[j]);
         let eq = |i: usize, j: usize| signum0(diff(i, j)) == 0.0;
@@ -148,32 +141,57 @@ impl EulerTop {
             .filter(|&&(i, j)| eq(i, j))
             .count();
         if n_equal == 3 {
-            return Ok(rest(EulerRegime::Rest));
+            return Ok(Self::rest(w, m0));
         }
         if n_equal == 1 {
-            // Axisymmetric: z the distinct axis.
-            let z = (0..3).find(|&z| eq((z + 1) % 3, (z + 2) % 3)).unwrap_or(0);
-            let (p, q) = ((z + 1) % 3, (z + 2) % 3);
-            let omega = diff(z, p).to_f64() * m0[z];
-            let nu = omega / (2.0 * std::f64::consts::PI);
-            if nu == 0.0 || (m0[p] == 0.0 && m0[q] == 0.0) {
-                return Ok(rest(EulerRegime::Rest));
-            }
-            return Ok(EulerTop {
-                m0,
-                w,
-                motion: Motion::Rotation {
-                    p,
-                    q,
-                    nu,
-                    mp: m0[p],
-                    mq: m0[q],
-                },
-                regime: EulerRegime::Axisymmetric,
-                params: [0.0, 1.0, omega.abs()],
-            });
+            return Ok(Self::axisymmetric(w, m0));
         }
-        // Triaxial: b the middle axis.
+        Self::triaxial(w, m0)
+    }
+
+    /// At rest: `M(t) = M0` (at most one non-zero component, or a spherical top).
+    fn rest(w: [Dd; 3], m0: [f64; 3]) -> Self {
+        EulerTop {
+            m0,
+            w,
+            motion: Motion::Rest,
+            regime: EulerRegime::Rest,
+            params: [f64::NAN; 3],
+        }
+    }
+
+    /// Two equal `W`: a uniform rotation about the distinct axis.
+    fn axisymmetric(w: [Dd; 3], m0: [f64; 3]) -> Self {
+        let diff = |i: usize, j: usize| w[i].sub(w[j]);
+        let eq = |i: usize, j: usize| signum0(diff(i, j)) == 0.0;
+        // z the distinct axis.
+        let z = (0..3).find(|&z| eq((z + 1) % 3, (z + 2) % 3)).unwrap_or(0);
+        let (p, q) = ((z + 1) % 3, (z + 2) % 3);
+        let omega = diff(z, p).to_f64() * m0[z];
+        let nu = omega / (2.0 * std::f64::consts::PI);
+        if nu == 0.0 || (m0[p] == 0.0 && m0[q] == 0.0) {
+            return Self::rest(w, m0);
+        }
+        EulerTop {
+            m0,
+            w,
+            motion: Motion::Rotation {
+                p,
+                q,
+                nu,
+                mp: m0[p],
+                mq: m0[q],
+            },
+            regime: EulerRegime::Axisymmetric,
+            params: [0.0, 1.0, omega.abs()],
+        }
+    }
+
+    /// Three distinct `W`: Jacobi's elliptic functions, or the separatrix.
+    fn triaxial(w: [Dd; 3], m0: [f64; 3]) -> Result<Self> {
+        let wv = w.map(|x| x.to_f64());
+        let diff = |i: usize, j: usize| w[i].sub(w[j]);
+        // b the middle axis.
         let mut order = [0usize, 1, 2];
         // The exact order of the double-double W (their sums may round alike).
         order.sort_by(|&i, &j| signum0(diff(i, j)).total_cmp(&0.0));
