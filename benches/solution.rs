@@ -5,6 +5,8 @@
 
 use criterion::{black_box, criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
 use manakov::numeric::cancel::Cancel;
+use manakov::solution::motion::classify;
+use manakov::solution::normalize::TopFrame;
 use manakov::solution::Solution;
 
 const A: [f64; 4] = [0.3, 1.1, 2.0, 3.7];
@@ -30,5 +32,19 @@ fn bench_solution(c: &mut Criterion) {
     g.finish();
 }
 
-criterion_group!(benches, bench_solution);
+/// What the dispatcher adds before a genus-2 set-up: the top's frame (once
+/// per top) and the classification of the state (once per state).
+fn bench_dispatch(c: &mut Criterion) {
+    let mut g = c.benchmark_group("dispatch");
+    g.bench_function("top_frame", |b| {
+        b.iter(|| TopFrame::new(black_box(&A), black_box(&B)).unwrap())
+    });
+    let frame = TopFrame::new(&A, &B).unwrap();
+    g.bench_function("classify", |b| {
+        b.iter(|| classify(black_box(&frame), black_box(&L0)))
+    });
+    g.finish();
+}
+
+criterion_group!(benches, bench_solution, bench_dispatch);
 criterion_main!(benches);

@@ -75,6 +75,20 @@ pub const PHASE_ROUNDING_RTOL: f64 = 4.0 * f64::EPSILON;
 /// where the phase has no digit left.
 pub const HORIZON_RTOL: f64 = 1e-6;
 
+/// The refusal of `l(t)` at a time `t` beyond the phase horizon, where the
+/// rounding of the phase rate (`rate`: "the velocity U", "the frequency")
+/// alone may move it by `drift |l0|` > [`HORIZON_RTOL`].
+pub(super) fn beyond_horizon(t: f64, drift: f64, rate: &str) -> crate::error::Error {
+    crate::error::Error::Unverified {
+        what: "l(t)",
+        reason: format!(
+            "t = {t:e} is beyond the phase horizon: the rounding of {rate} alone may move \
+             l(t) by {drift:e} |l0| > {HORIZON_RTOL:e}; integrate from a state nearer \
+             that time instead"
+        ),
+    }
+}
+
 /// Fractions of the shortest lattice period of the phase at which the
 /// self-check evaluates the solution (besides `t = 0`): points spread over
 /// the torus, none a simple fraction of a period.

@@ -657,25 +657,18 @@ impl Solution {
             let speed = f.iter().fold(0.0f64, |m, v| m.max(v.abs()));
             let drift = delta * tk.abs() * speed / self.size;
             // NaN (a non-finite l) passes here: the quotient's own checks own it
-            let bound = if gated { DRIFT_RTOL } else { HORIZON_RTOL };
-            if drift > bound {
-                let reason = if gated {
-                    format!(
+            if !gated && drift > HORIZON_RTOL {
+                return Err(check::beyond_horizon(tk, drift, "the velocity U"));
+            }
+            if gated && drift > DRIFT_RTOL {
+                return Err(Error::Unverified {
+                    what: "l(t)",
+                    reason: format!(
                         "at t = {tk:e} the relative defect {:e} left by the self-check may \
                          move l(t) by {drift:e} |l0| > {DRIFT_RTOL:e} (the drift \
                          delta |t| |dl/dt| of the phase); evaluate nearer t = 0",
                         self.self_check
-                    )
-                } else {
-                    format!(
-                        "t = {tk:e} is beyond the phase horizon: the rounding of the \
-                         velocity U alone may move l(t) by {drift:e} |l0| > \
-                         {HORIZON_RTOL:e}; integrate from a state nearer that time instead"
-                    )
-                };
-                return Err(Error::Unverified {
-                    what: "l(t)",
-                    reason,
+                    ),
                 });
             }
         }

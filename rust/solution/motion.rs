@@ -231,14 +231,7 @@ impl Motion {
                 let t_max = t.iter().fold(0.0f64, |m, v| m.max(v.abs()));
                 let drift = PHASE_ROUNDING_RTOL * std::f64::consts::TAU * nu * t_max;
                 if drift > HORIZON_RTOL {
-                    return Err(Error::Unverified {
-                        what: "l(t)",
-                        reason: format!(
-                            "t = {t_max:e} is beyond the phase horizon: the rounding of the \
-                             frequency alone may move l(t) by {drift:e} |l0| > \
-                             {HORIZON_RTOL:e}; integrate from a state nearer that time instead"
-                        ),
-                    });
+                    return Err(super::check::beyond_horizon(t_max, drift, "the frequency"));
                 }
                 for (o, &tk) in out.chunks_exact_mut(6).zip(t) {
                     let l = emb.state(&top.m(self.time_scale * tk));

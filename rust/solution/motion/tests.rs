@@ -1,5 +1,4 @@
 use super::*;
-use crate::solution::normalize::TopFrame;
 use crate::solution::tests::TOPS;
 
 /// Two solutions of the same motion, one through normalized data: their
@@ -122,30 +121,5 @@ fn shifted_a_gives_the_same_motion() {
             let err = max_rel(&o1, &traj.y, norm(&l0));
             assert!(err < SAME_MOTION, "shift {shift:e}, a = {a:?}: {err:e}");
         }
-    }
-}
-
-/// The set-up cost the dispatcher adds to a genus-2 state: the top's frame
-/// (once per top) and the classification (once per state). A timing, not an
-/// assertion: `cargo test --release -- --ignored --nocapture classification_cost`.
-#[test]
-#[ignore]
-fn classification_cost() {
-    use std::hint::black_box;
-    use std::time::Instant;
-    let n = 2_000_000u32;
-    for (a, b, l0) in TOPS {
-        let t = Instant::now();
-        for _ in 0..n {
-            black_box(TopFrame::new(black_box(&a), black_box(&b)).unwrap());
-        }
-        let frame_ns = t.elapsed().as_nanos() as f64 / f64::from(n);
-        let frame = TopFrame::new(&a, &b).unwrap();
-        let t = Instant::now();
-        for _ in 0..n {
-            black_box(classify(black_box(&frame), black_box(&l0)));
-        }
-        let class_ns = t.elapsed().as_nanos() as f64 / f64::from(n);
-        eprintln!("a = {a:?}: frame {frame_ns:.1} ns, classify {class_ns:.1} ns");
     }
 }
