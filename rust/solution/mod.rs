@@ -89,6 +89,35 @@ const CHUNK: usize = 8192;
 /// Smallest piece handed to one thread.
 const PAR_PIECE: usize = 512;
 
+/// Rows `l(t_k)` of `out` (row-major `(N, 6)`) by `eval` on blocks of times:
+/// `chunk` times per thread between Ctrl-C checks, split over rayon's threads
+/// in pieces of at least `min_piece` times (fewer stay on the calling thread,
+/// where a fork would cost more than it saves). Shared by the genus-2
+/// solution and the dispatcher, whose evaluations differ in cost.
+pub(crate) fn rows_in_parallel(
+    t: &[f64],
+    out: &mut [f64],
+    cancel: &Cancel,
+    chunk: usize,
+    min_piece: usize,
+    eval: impl Fn(&[f64], &mut [f64]) -> Result<()> + Sync,
+) -> Result<()> {
+    let threads = rayon::current_num_threads();
+    let unit = chunk * threads.max(1);
+    for (tc, oc) in t.chunks(unit).zip(out.chunks_mut(6 * unit)) {
+        cancel.check()?;
+        if threads > 1 && tc.len() >= 2 * min_piece {
+            let piece = tc.len().div_ceil(4 * threads).max(min_piece);
+            tc.par_chunks(piece)
+                .zip(oc.par_chunks_mut(6 * piece))
+                .try_for_each(|(tp, op)| eval(tp, op))?;
+        } else {
+            eval(tc, oc)?;
+        }
+    }
+    Ok(())
+}
+
 /// Labels of the Wurzelfunktionen that enter (37) and (42), in the order of
 /// [`Solution::constants`]: `P_0`, `P_kl` for `j = 1, 2, 3` (`kl = 23, 31, 12`),
 /// `P_j4` for `j = 1, 2, 3`.
@@ -688,20 +717,9 @@ impl Solution {
             });
         }
         crate::error::check_finite("t", t)?;
-        let threads = rayon::current_num_threads();
-        let unit = CHUNK * threads.max(1);
-        for (tc, oc) in t.chunks(unit).zip(out.chunks_mut(6 * unit)) {
-            cancel.check()?;
-            if threads > 1 && tc.len() >= 2 * PAR_PIECE {
-                let piece = tc.len().div_ceil(4 * threads).max(PAR_PIECE);
-                tc.par_chunks(piece)
-                    .zip(oc.par_chunks_mut(6 * piece))
-                    .try_for_each(|(tp, op)| self.eval_serial(tp, op))?;
-            } else {
-                self.eval_serial(tc, oc)?;
-            }
-        }
-        Ok(())
+        rows_in_parallel(t, out, cancel, CHUNK, PAR_PIECE, |tp, op| {
+            self.eval_serial(tp, op)
+        })
     }
 
     /// [`Solution::l_batch`] on the calling thread only (for benchmarks and

@@ -22,12 +22,10 @@
 
 use std::sync::Arc;
 
-use rayon::prelude::*;
-
 use super::constant::is_equilibrium;
 use super::euler::{Embedding, EulerRegime, EulerTop};
 use super::normalize::{state_scale, TopFrame};
-use super::{Solution, HORIZON_RTOL, PHASE_ROUNDING_RTOL};
+use super::{rows_in_parallel, Solution, HORIZON_RTOL, PHASE_ROUNDING_RTOL};
 use crate::error::{Error, Result};
 use crate::numeric::cancel::Cancel;
 
@@ -275,20 +273,9 @@ impl Motion {
                 return sol.l_batch(t, out, cancel);
             }
         }
-        let threads = rayon::current_num_threads();
-        let unit = CHUNK * threads.max(1);
-        for (tc, oc) in t.chunks(unit).zip(out.chunks_mut(6 * unit)) {
-            cancel.check()?;
-            if threads > 1 && tc.len() >= 2 * PAR_PIECE {
-                let piece = tc.len().div_ceil(4 * threads).max(PAR_PIECE);
-                tc.par_chunks(piece)
-                    .zip(oc.par_chunks_mut(6 * piece))
-                    .try_for_each(|(tp, op)| self.eval_serial(tp, op))?;
-            } else {
-                self.eval_serial(tc, oc)?;
-            }
-        }
-        Ok(())
+        rows_in_parallel(t, out, cancel, CHUNK, PAR_PIECE, |tp, op| {
+            self.eval_serial(tp, op)
+        })
     }
 
     /// `l(t)` at one time.
