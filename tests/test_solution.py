@@ -158,11 +158,14 @@ def test_states_the_theorem_does_not_cover_get_their_kind(l0: np.ndarray, kind: 
 
 def test_singular_genus2_states_name_the_reason() -> None:
     # n = (1 + 2^-30) m: within 1e-13 of h1^2 = 4 h0^2 but not exactly self-dual,
-    # so a genus-2 state on the Theorem's singular set: refused, saying why.
+    # so a genus-2 state on the Theorem's singular set: a valid state refused
+    # (ClosedFormError, not ValueError), saying why, with h1^2 - 4 h0^2 from its
+    # exact factors h1 - 2 h0 = 0.83 * 2^-60 and h1 + 2 h0 = 3.32 (not the 0 that
+    # the difference h1^2 - 4 h0^2 cancels to).
     p = manakov.problem("generic")
     e = 1 + 2**-30
     l0 = np.array([0.7, -0.5, 0.3 * e, 0.3, 0.5 * e, 0.7 * e])
-    with pytest.raises(ValueError, match=r"h1\^2 - 4 h0\^2"):
+    with pytest.raises(manakov.ClosedFormError, match=r"h1\^2 - 4 h0\^2 = 2\.39\d*e-18 vanishes"):
         manakov.ManakovTop(p.a, p.b).solve(l0)
 
 

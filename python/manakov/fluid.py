@@ -42,6 +42,7 @@ import numpy as np
 
 from . import _core
 from ._checks import _finite_result, _float_array
+from ._core import ClosedFormError
 from .solution import Solution
 from .top import DEFAULT_MAX_STEPS, DEFAULT_RTOL, MAX_SAMPLES, METHODS, ManakovTop
 from .tori import FrequencyMap
@@ -924,14 +925,15 @@ class KirchhoffBody:
         Raises
         ------
         ValueError
-            Not a Clebsch body, or a singular level set (the message names the
-            reason, as :meth:`manakov.ManakovTop.solve`). ``M0·p0 = 0`` (the
+            Not a Clebsch body, or invalid ``M0``, ``p0``. ``M0·p0 = 0`` (the
             conjugate top's ``h0 = 0``) is not singular by itself, and the states
             on the conjugate top's exact degenerate sets (``p0 = 0``; ``M0``,
             ``p0`` on two axes) are solved in its closed form.
         ClosedFormError
-            The conjugate top's solution did not pass its own check
-            (:attr:`manakov.Solution.self_check`); no solution is returned.
+            A valid state whose conjugate top's closed form could not be built
+            (the message names the step, as :meth:`manakov.ManakovTop.solve`) or
+            did not pass its own check (:attr:`manakov.Solution.self_check`); no
+            solution is returned.
         """
         self._require_clebsch("solve")
         y, lead = _states(M0, p0, ("M0", "p0"))
@@ -1013,7 +1015,7 @@ class ClebschSolution:
         l0 = body.to_so4(self._M0, self._p0)
         try:
             self._solution = Solution(top.a, top.b, l0)
-        except ValueError as err:
+        except (ValueError, ClosedFormError) as err:
             # p0 = 0 (Euler's top) never gets here: its conjugate state lies in an
             # so(3) block, which Solution solves in closed form.
             M0a, p0a = self._M0, self._p0
@@ -1022,7 +1024,9 @@ class ClebschSolution:
                 # h0 = 0 alone is a regular level set of the top (its reduction takes
                 # the limit there); this only translates the top's wording.
                 hint = "M0·p0 = 0 is the conjugate top's h0 = 0; "
-            raise ValueError(
+            # A valid body state the top cannot solve stays a ClosedFormError.
+            kind = ClosedFormError if isinstance(err, ClosedFormError) else ValueError
+            raise kind(
                 f"no genus-2 solution through M0 = {M0a.tolist()}, p0 = {p0a.tolist()}: "
                 f"{hint}the conjugate Manakov top says: {err}"
             ) from None

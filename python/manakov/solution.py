@@ -129,13 +129,15 @@ class Solution:
     ------
     ValueError
         Invalid ``a``, ``b``, ``l0`` (shapes, non-finite values, repeated
-        ``a_i``); and, for a genus-2 state, a singular level set of the
-        Theorem (the message names it: ``h1² = 4h0²`` off the exact sets
-        above, coinciding branch points, the divisor of ``l0`` at infinity).
+        ``a_i``): only invalid input.
     manakov.ClosedFormError
-        A genus-2 solution that fails its self-check (:attr:`self_check`
-        above 1e-10): the state is valid, the closed form could not be
-        verified; integrate it instead.
+        A valid state whose closed form could not be built — a level set on
+        which the Theorem's coordinates are singular to working precision
+        (``h1² = 4h0²`` off the exact sets above, coinciding branch points, a
+        repeated root of F (19), the divisor of ``l0`` at infinity), an
+        iteration of the reduction that did not converge — or that fails its
+        self-check (:attr:`self_check` above 1e-10). The message names the
+        step; integrate the state instead.
 
     Notes
     -----

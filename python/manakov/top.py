@@ -859,11 +859,13 @@ class ManakovTop(FrahmTop):
         Raises
         ------
         ValueError
-            Not an so(4) top, or a singular genus-2 state (the message names the
-            reason).
+            Not an so(4) top, or invalid ``l0`` (shape, non-finite values).
         manakov.ClosedFormError
-            A genus-2 solution that fails its self-check (``Solution.self_check``
-            above 1e-10; docs/degenerate.md).
+            A valid state whose closed form could not be built (a level set on
+            which the Theorem's coordinates are singular to working precision;
+            the message names the step) or that fails its self-check
+            (``Solution.self_check`` above 1e-10; docs/degenerate.md): integrate
+            it instead.
         """
         self._require_so4("solve")
         return Solution(self.a, self.b, l0)

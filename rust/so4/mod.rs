@@ -409,6 +409,30 @@ pub fn poisson_tensor(n: usize, l: &[f64], out: &mut [f64]) {
     }
 }
 
+/// `[H1 + 2 H0, H1 − 2 H0]` as the sums of squares they are,
+/// `H1 ± 2H0 = (l12 ± l34)² + (l14 ± l23)² + (l13 ∓ l24)²`, i.e. `2|m|²` and
+/// `2|n|²` of the self-dual and anti-self-dual parts of `l`: each to full
+/// relative accuracy (a difference of nearby components is exact), where
+/// `H1² − 4H0²`, their product, formed from `H0` and `H1` cancels to rounding
+/// near the self-dual states `m = ±n` (a one-factor rotation, `n = 0` or `m = 0`).
+pub fn casimir_factors(l: &[f64; 6]) -> [f64; 2] {
+    let [l12, l13, l14, l23, l24, l34] = *l;
+    let sq = |x: f64, y: f64, z: f64| x * x + y * y + z * z;
+    [
+        sq(l12 + l34, l14 + l23, l13 - l24),
+        sq(l12 - l34, l14 - l23, l13 + l24),
+    ]
+}
+
+/// `|h1² − 4h0²| ≤ SINGULAR_SET_RTOL (h1² + 4h0²)` in terms of the factors
+/// `h1 ± 2h0` of [`casimir_factors`] (`h1² + 4h0² = (hp² + hm²)/2`),
+/// as a ratio so that no square overflows.
+pub fn near_self_dual(hp: f64, hm: f64) -> bool {
+    let (lo, hi) = (hp.min(hm), hp.max(hm));
+    let r = lo / hi;
+    r <= crate::numeric::tol::SINGULAR_SET_RTOL * 0.5 * (1.0 + r * r)
+}
+
 /// The so(4) integrals, corrected where (7) is misprinted (see the module docs):
 /// `[H0, H1, H2, H3]` with
 /// `H0 = l12 l34 + l23 l14 + l31 l24` (6),
@@ -516,6 +540,22 @@ mod tests {
 
     const GENERIC_A: [f64; 4] = [0.3, 1.1, 2.0, 3.7];
     const GENERIC_B: [f64; 4] = [0.5, -0.2, 1.4, 0.9];
+
+    #[test]
+    fn casimir_factors_are_h1_plus_minus_2h0_and_exact_on_the_self_dual_sets() {
+        let l = [0.7, -0.5, 0.3, 0.3, 0.5, 0.7];
+        let [p, m] = casimir_factors(&l);
+        let h = integrals4(&GENERIC_A, &l);
+        assert_relative_eq!(p, h[1] + 2.0 * h[0], max_relative = 1e-15);
+        assert_eq!(m, 0.0);
+        // 2^-30 off the set: H1 - 2 H0 = 0.83 · 2^-60 exactly, which H1 - 2 H0
+        // formed from the integrals loses entirely.
+        let e = 1.0 + 2f64.powi(-30);
+        let l = [0.7, -0.5, 0.3 * e, 0.3, 0.5 * e, 0.7 * e];
+        let [_, m] = casimir_factors(&l);
+        let exact = (0.49 + 0.25 + 0.09) * 2f64.powi(-60);
+        assert_relative_eq!(m, exact, max_relative = 1e-14);
+    }
 
     /// Independent (1): build the matrices and form l ω - ω l.
     fn vf_matrix(n: usize, c: &[f64], l: &[f64]) -> Vec<f64> {

@@ -90,7 +90,7 @@ pub struct LevelSetCurve {
 
 /// The checks of `l0` that precede the reduction, and the reduction's
 /// level-set objects: refuses `l0 = 0`, `h1² = 4h0²` (relative to
-/// [`SINGULAR_SET_RTOL`]) and coinciding branch points with a
+/// [`crate::numeric::tol::SINGULAR_SET_RTOL`], [`so4::near_self_dual`]) and coinciding branch points with a
 /// [`Error::Singular`] that names the reason. `h0 = 0` (rank-2 states) is a
 /// regular level set: the reduction takes its limit there (docs/degenerate.md).
 pub fn level_set_curve(a: &[f64; 4], l0: &[f64; 6]) -> Result<LevelSetCurve> {
@@ -102,9 +102,11 @@ pub fn level_set_curve(a: &[f64; 4], l0: &[f64; 6]) -> Result<LevelSetCurve> {
             "l0 = 0: the rest state; the solution is l(t) = 0, there is no curve (8)".into(),
         ));
     }
-    let h = so4::integrals4(a, l0);
-    let disc = h[1] * h[1] - 4.0 * h[0] * h[0];
-    if disc.abs() <= SINGULAR_SET_RTOL * (h[1] * h[1] + 4.0 * h[0] * h[0]) {
+    let [hp, hm] = so4::casimir_factors(l0);
+    // h1² − 4h0² = (h1 + 2h0)(h1 − 2h0) from the exact sums of squares: the
+    // value named in the message is right even where h1² − 4h0² cancels.
+    let disc = hp * hm;
+    if so4::near_self_dual(hp, hm) {
         return Err(singular(
             SingularKind::SelfDual,
             format!(

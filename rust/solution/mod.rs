@@ -43,7 +43,6 @@ use crate::error::{Error, Result, SingularKind};
 use crate::kotter::{kotter_constants, kotter_with, KotterConstants, KotterState};
 use crate::numeric::cancel::Cancel;
 use crate::numeric::complex::sqrt_principal;
-use crate::numeric::tol::SINGULAR_SET_RTOL;
 use crate::riemann::HyperellipticCurve;
 use crate::so4;
 use crate::theta::{char_index, LatticeLanes, SelectedBlock, ThetaJet, ThetaPlan, BLOCK};

@@ -95,6 +95,29 @@ pub struct Motion {
     body: Body,
 }
 
+/// A closed form that could not be built for a state already checked to be
+/// valid (finite, on a valid top, with a representable time scale): a refusal
+/// of this state ([`Error::Unverified`], Python's `ClosedFormError`), not
+/// invalid input — whatever the step that failed reported (a singular
+/// coordinate of the reduction, an iteration that did not converge). The step
+/// and its numbers stay in the message; cancellation and size errors pass.
+fn refusal(e: Error) -> Error {
+    let step = match &e {
+        Error::Unverified { .. }
+        | Error::Interrupted
+        | Error::TooLarge { .. }
+        | Error::OutOfMemory { .. } => return e,
+        Error::Singular { what, reason, .. } | Error::InvalidArgument { what, reason } => {
+            format!("{what}: {reason}")
+        }
+        other => other.to_string(),
+    };
+    Error::Unverified {
+        what: "closed form for this l0",
+        reason: format!("{step}; the state is valid: integrate it instead"),
+    }
+}
+
 /// Times per cancellation check in the closed forms (~1 ms).
 const CHUNK: usize = 16384;
 
@@ -104,8 +127,10 @@ const PAR_PIECE: usize = 4096;
 impl Motion {
     /// Normalizes, classifies and solves the state `l0` of the top `(a, b)`.
     ///
-    /// Errors: invalid `a`, `b` or `l0` (non-finite, repeated `a_i`); for the
-    /// genus-2 kind, those of [`Solution::with_c4`].
+    /// Errors: invalid `a`, `b` or `l0` (non-finite, repeated `a_i`), the
+    /// only ones on the input; a valid state whose closed form cannot be built
+    /// or fails its self-check gets [`Error::Unverified`] naming the step (for
+    /// the genus-2 kind the errors of [`Solution::with_c4`], re-worded).
     pub fn new(a: &[f64; 4], b: &[f64; 4], l0: &[f64; 6]) -> Result<Self> {
         crate::error::check_finite("l0", l0)?;
         let frame = TopFrame::new(a, b)?;
@@ -133,11 +158,17 @@ impl Motion {
                 let emb = Embedding::of_state(&ln).ok_or(Error::InvalidArgument {
                     what: "l0",
                     reason: "classified as an Euler top but in no invariant subspace".into(),
-                })?;
-                let top = Box::new(EulerTop::new(emb.w_of(&frame.c4), emb.m_of(&ln))?);
-                Body::Euler { emb, top }
+                });
+                let emb = emb.map_err(refusal)?;
+                let top = EulerTop::new(emb.w_of(&frame.c4), emb.m_of(&ln)).map_err(refusal)?;
+                Body::Euler {
+                    emb,
+                    top: Box::new(top),
+                }
             }
-            Kind::Genus2 => Body::Genus2(Arc::new(Solution::with_c4(&frame.a, &frame.c4, &ln)?)),
+            Kind::Genus2 => Body::Genus2(Arc::new(
+                Solution::with_c4(&frame.a, &frame.c4, &ln).map_err(refusal)?,
+            )),
         };
         Ok(Motion {
             kind,

@@ -42,7 +42,7 @@ use rayon::prelude::*;
 
 use crate::error::{Error, Result};
 use crate::numeric::cancel::Cancel;
-use crate::numeric::tol::SINGULAR_SET_RTOL;
+use crate::so4;
 
 /// A point of `C²`.
 pub type C2 = [Complex64; 2];
@@ -683,13 +683,10 @@ where
     if l0.iter().all(|&v| v == 0.0) {
         return MapEntry::failed(Status::ZeroState);
     }
-    let [l12, l13, l14, l23, l24, l34] = *l0;
-    let h0 = l12 * l34 - l13 * l24 + l14 * l23;
-    let h1: f64 = l0.iter().map(|v| v * v).sum();
-    let disc = h1 * h1 - 4.0 * h0 * h0;
+    let [hp, hm] = so4::casimir_factors(l0);
     // The solution's own test (it would refuse the state): this pre-check only
     // saves its set-up and reports the status of the singular level set.
-    if disc.abs() <= SINGULAR_SET_RTOL * (h1 * h1 + 4.0 * h0 * h0) {
+    if so4::near_self_dual(hp, hm) {
         return MapEntry::failed(Status::SingularCasimirs);
     }
     let d = match solve(l0) {

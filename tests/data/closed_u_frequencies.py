@@ -58,7 +58,7 @@ def main() -> None:
         for l0, nu, st in zip(states, fm.nu, fm.status):
             try:
                 ref = top.solve(l0).frequencies
-            except ValueError:
+            except (ValueError, manakov.ClosedFormError):
                 ref = None
             if st != 0 or ref is None:
                 if st != 0 and ref is None:

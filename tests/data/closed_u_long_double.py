@@ -19,7 +19,8 @@ once) gives l(t) on a grid of S times in [0, T]. Then:
    precision (``real128``, tolerance 1e-32) at t = 100, which shows the long-double
    reference's own error.
 
-Run: ``python tests/data/closed_u_long_double.py [--n 100] [--seed 2211] [--f128]``
+Run: ``python tests/data/closed_u_long_double.py [--n 100] [--seed 2211] [--f128]
+[--cache DIR]``
 (about an hour for 100 states on one core: the stiff states take 1-3 min of long
 double each). Output committed as ``tests/data/closed_u_long_double.txt``.
 """
@@ -27,6 +28,7 @@ double each). Output committed as ``tests/data/closed_u_long_double.txt``.
 from __future__ import annotations
 
 import argparse
+import hashlib
 import os
 import platform
 import time
@@ -104,6 +106,30 @@ def propagate(a, b, l0, ts, fp):
     return np.array([[float(v) for v in row] for row in out])
 
 
+def propagate_cached(a, b, l0, ts, cache):
+    """``propagate`` in long double, kept in ``cache`` (a directory) when one is given.
+
+    The key hashes the exact bytes of a, b, l0 and the grid, so a cached trajectory
+    is the same long-double computation, only not repeated when the Theorem side of
+    this script is re-run.
+    """
+    if not cache:
+        return propagate(a, b, l0, ts, LD)
+    h = hashlib.sha256()
+    for v in (a, b, l0, ts):
+        h.update(np.ascontiguousarray(v, float).tobytes())
+    path = os.path.join(cache, h.hexdigest()[:32] + ".npy")
+    if os.path.exists(path):
+        return np.load(path)
+    out = propagate(a, b, l0, ts, LD)
+    os.makedirs(cache, exist_ok=True)
+    # written whole, then renamed: another run sharing the cache never reads half a file
+    tmp = f"{path}.{os.getpid()}.tmp.npy"
+    np.save(tmp, out)
+    os.replace(tmp, path)
+    return out
+
+
 def random_states(n, seed):
     rng = np.random.default_rng(seed)
     out = []
@@ -120,7 +146,7 @@ def random_states(n, seed):
         l0 = rng.normal(size=6)
         try:
             manakov.ManakovTop(a, b).solve(l0)
-        except ValueError:
+        except (ValueError, manakov.ClosedFormError):
             continue
         out.append((a, b, l0))
     return out
@@ -156,6 +182,7 @@ def main() -> None:
     ap.add_argument("--t-end", type=float, default=1e4)
     ap.add_argument("--samples", type=int, default=4001)
     ap.add_argument("--f128", action="store_true", help="also quad precision at t = 100")
+    ap.add_argument("--cache", default="", help="directory keeping the long-double trajectories")
     args = ap.parse_args()
     print(
         f"machine: {platform.machine()} {os.cpu_count()} cpus; heyoka {hy.__version__}; "
@@ -180,7 +207,7 @@ def main() -> None:
         top = manakov.ManakovTop(a, b)
         sol = top.solve(l0)
         t0 = time.time()
-        ref = propagate(a, b, l0, ts, LD)
+        ref = propagate_cached(a, b, l0, ts, args.cache)
         t_ld = time.time() - t0
         ls = ref.astype(float)
         u_fit, resid = abel_fit(sol, ts, ls)
@@ -227,7 +254,7 @@ def main() -> None:
             f"{np.max(r[:, 9]):.1e}; Theorem > gauss16 on {len(worse)} of {len(r)}"
             + (f": {', '.join(names[i] for i in worse)}" if len(worse) else "")
         )
-    print(f"long-double integration: {np.sum(r[:, 6]):.0f} s in all")
+    print(f"long-double integration (or loading it from --cache): {np.sum(r[:, 6]):.0f} s in all")
 
 
 if __name__ == "__main__":
