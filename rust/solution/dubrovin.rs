@@ -278,8 +278,8 @@ impl Level<Cdd> {
 /// about that (far inside [`HALF_PERIOD_AGREE_RTOL`]), not to DD. A least-squares
 /// `b` does not help: on a top with one small spacing it moves that `c_ij` by
 /// the others' rounding over the spacing (1e-10 at `a_2 − a_1 = 1e-6`).
-fn c_dd(c4: &[f64; 6]) -> [Cdd; 6] {
-    c4.map(|x| Cdd::real(Dd::new(x)))
+fn c_dd(c4: &[f64; 6], lo: &[f64; 6]) -> [Cdd; 6] {
+    std::array::from_fn(|q| Cdd::real(Dd::sum(c4[q], lo[q])))
 }
 
 /// Frahm's field (1) `l̇_ij = Σ_k l_ik l_kj (c_kj − c_ik)` for a complex state.
@@ -425,6 +425,29 @@ pub fn half_period_velocities(
     cs: &[[f64; 6]],
     dd: bool,
 ) -> Result<HalfPeriodVelocities> {
+    half_period_velocities_lo(k, l0, cs, &[], dd)
+}
+
+/// [`half_period_velocities`] for coefficients `cs[k] + cs_lo[k]` in
+/// double-double (`cs_lo` their rounding errors; empty for none): the DD
+/// result is that of the unrounded `c`, the double paths take `cs`.
+///
+/// Errors: those of [`half_period_velocities`]; `cs_lo` neither empty nor of
+/// the length of `cs`.
+pub fn half_period_velocities_lo(
+    k: &KotterConstants,
+    l0: &[f64; 6],
+    cs: &[[f64; 6]],
+    cs_lo: &[[f64; 6]],
+    dd: bool,
+) -> Result<HalfPeriodVelocities> {
+    if !cs_lo.is_empty() && cs_lo.len() != cs.len() {
+        return Err(Error::Shape {
+            what: "c_lo",
+            expected: format!("({},) like c", cs.len()),
+            got: format!("({},)", cs_lo.len()),
+        });
+    }
     if cs.is_empty() {
         return Err(Error::InvalidArgument {
             what: CLOSED_FORM,
@@ -459,8 +482,8 @@ pub fn half_period_velocities(
     let mut v = Vec::with_capacity(cs.len());
     let mut v_dd = Vec::with_capacity(cs.len());
     let mut agreement = 0.0f64;
-    for c4 in cs {
-        let c = c_dd(c4);
+    for (q, c4) in cs.iter().enumerate() {
+        let c = c_dd(c4, cs_lo.get(q).unwrap_or(&[0.0; 6]));
         let cc = c.map(|x| x.to_c());
         // The result in the precision asked, the check in double; where they
         // miss (double loses digits on widely spread d_j, ~1e-11 at |d_4| ~

@@ -199,7 +199,7 @@ impl Solution {
         let c = so4::manakov_c(a, b)?;
         // State order (12, 13, 14, 23, 24, 34) from the row-major 4 × 4 matrix.
         let c4 = [c[1], c[2], c[3], c[6], c[7], c[11]];
-        Self::with_c4(a, &c4, l0)
+        Self::with_c4_lo(a, &c4, &normalize::c_rounding(a, b, &c4), l0)
     }
 
     /// [`Solution::new`] for the top with parameters `a` and Manakov
@@ -207,8 +207,22 @@ impl Solution {
     /// `c' = (c − μ)/λ` of [`normalize::TopFrame`], which no `b` represents
     /// exactly in doubles.
     pub fn with_c4(a: &[f64; 4], c4: &[f64; 6], l0: &[f64; 6]) -> Result<Self> {
+        Self::with_c4_lo(a, c4, &[0.0; 6], l0)
+    }
+
+    /// [`Solution::with_c4`] for the coefficients `c4 + c4_lo` in double-double
+    /// (`c4_lo` the rounding errors of `c4`, [`normalize::c_rounding`]): the
+    /// closed form of `U`, hence the phase, is that of the unrounded top; the
+    /// rest takes `c4`.
+    pub fn with_c4_lo(
+        a: &[f64; 4],
+        c4: &[f64; 6],
+        c4_lo: &[f64; 6],
+        l0: &[f64; 6],
+    ) -> Result<Self> {
         crate::error::check_finite("l0", l0)?;
         crate::error::check_finite("c", c4)?;
+        crate::error::check_finite("c_lo", c4_lo)?;
         let c4 = *c4;
         let LevelSetCurve {
             kotter,
@@ -245,7 +259,21 @@ impl Solution {
         // [`dubrovin`]), with its lattice coordinates in DD and the real
         // structure imposed: one for every sign pattern of the C_L below. Where
         // it refuses (none known), U is the theta quotients' fit at v0.
-        let closed = dubrovin::half_period_velocities(&kotter, l0, &[c4], true).and_then(|hp| {
+        //
+        // With rounding errors `c4_lo`, two flows: `c4` as rounded, which the
+        // theta quotients, their velocity fit and the self-check below are
+        // consistent with (they evaluate (1) with `c4`), and `c4 + c4_lo`, the
+        // unrounded top, whose lattice rates give the phase of l(t) and `U`:
+        // the two differ by the rounding of c (relative ε times the condition
+        // of the differences c_kj − c_ik, ~1e-10 where two a_i nearly meet).
+        let exact_flow = c4_lo.iter().any(|v| *v != 0.0);
+        let (flows, flows_lo): (&[[f64; 6]], &[[f64; 6]]) = if exact_flow {
+            (&[c4, c4], &[[0.0; 6], *c4_lo])
+        } else {
+            (&[c4], &[])
+        };
+        let closed = dubrovin::half_period_velocities_lo(&kotter, l0, flows, flows_lo, true);
+        let closed = closed.and_then(|hp| {
             let e_lo = hp.branch_point_errors(&curve);
             let lat = dubrovin::lattice_rates_dd(&curve, e_lo.as_ref().map(|e| &e[..]), &hp.v_dd)?;
             Ok((hp.v[0], lat))
@@ -303,7 +331,7 @@ impl Solution {
             });
         }
         let (x0, y0) = curve.lattice_coordinates(&v0);
-        let (lat_rate, lat_rate_lo, v_sign) = match &closed {
+        let (rate, lat_rate, lat_rate_lo, v_sign) = match &closed {
             Ok((_, lat)) => {
                 let u = lat.u[0];
                 let s = if (u[0].conj() * rate[0] + u[1].conj() * rate[1]).re >= 0.0 {
@@ -311,11 +339,18 @@ impl Solution {
                 } else {
                     -1.0
                 };
-                (lat.w[0].map(|x| s * x), lat.w_lo[0].map(|x| s * x), s)
+                // the unrounded top's flow (the last) for U and the phase
+                let k = lat.u.len() - 1;
+                (
+                    lat.u[k].map(|z| s * z),
+                    lat.w[k].map(|x| s * x),
+                    lat.w_lo[k].map(|x| s * x),
+                    s,
+                )
             }
             Err(_) => {
                 let (xr, yr) = curve.lattice_coordinates(&rate);
-                ([xr[0], xr[1], yr[0], yr[1]], [0.0; 4], 1.0)
+                (rate, [xr[0], xr[1], yr[0], yr[1]], [0.0; 4], 1.0)
             }
         };
         Ok(Solution {

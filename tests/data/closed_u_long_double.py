@@ -106,28 +106,30 @@ def propagate(a, b, l0, ts, fp):
     return np.array([[float(v) for v in row] for row in out])
 
 
-def propagate_cached(a, b, l0, ts, cache):
-    """``propagate`` in long double, kept in ``cache`` (a directory) when one is given.
-
-    The key hashes the exact bytes of a, b, l0 and the grid, so a cached trajectory
-    is the same long-double computation, only not repeated when the Theorem side of
-    this script is re-run.
-    """
+def cached(cache, key, compute, *arrays):
+    """``compute()``, kept in ``cache`` (a directory) under ``key`` and a hash of the
+    exact bytes of ``arrays`` when a cache is given: the same computation, only not
+    repeated when the Theorem side of this script is re-run."""
     if not cache:
-        return propagate(a, b, l0, ts, LD)
+        return compute()
     h = hashlib.sha256()
-    for v in (a, b, l0, ts):
+    for v in arrays:
         h.update(np.ascontiguousarray(v, float).tobytes())
-    path = os.path.join(cache, h.hexdigest()[:32] + ".npy")
+    path = os.path.join(cache, h.hexdigest()[:32] + key + ".npy")
     if os.path.exists(path):
         return np.load(path)
-    out = propagate(a, b, l0, ts, LD)
+    out = compute()
     os.makedirs(cache, exist_ok=True)
     # written whole, then renamed: another run sharing the cache never reads half a file
     tmp = f"{path}.{os.getpid()}.tmp.npy"
     np.save(tmp, out)
     os.replace(tmp, path)
     return out
+
+
+def propagate_cached(a, b, l0, ts, cache):
+    """``propagate`` in long double, through :func:`cached`."""
+    return cached(cache, "", lambda: propagate(a, b, l0, ts, LD), a, b, l0, ts)
 
 
 def random_states(n, seed):
@@ -182,7 +184,12 @@ def main() -> None:
     ap.add_argument("--t-end", type=float, default=1e4)
     ap.add_argument("--samples", type=int, default=4001)
     ap.add_argument("--f128", action="store_true", help="also quad precision at t = 100")
-    ap.add_argument("--cache", default="", help="directory keeping the long-double trajectories")
+    ap.add_argument(
+        "--cache",
+        default="",
+        help="directory keeping the long-double trajectories and the gauss16 results "
+        "(clear it when the integrators change)",
+    )
     args = ap.parse_args()
     print(
         f"machine: {platform.machine()} {os.cpu_count()} cpus; heyoka {hy.__version__}; "
@@ -213,7 +220,15 @@ def main() -> None:
         u_fit, resid = abel_fit(sol, ts, ls)
         u_err = float(np.max(np.abs(sol.U - u_fit)) / np.max(np.abs(u_fit)))
         tq = np.array([100.0, args.t_end])
-        g16 = top.integrate(l0, args.t_end, t_eval=tq, dt=top.default_dt(l0) / 4).l
+        g16 = cached(
+            args.cache,
+            "_g16",
+            lambda: top.integrate(l0, args.t_end, t_eval=tq, dt=top.default_dt(l0) / 4).l,
+            a,
+            b,
+            l0,
+            tq,
+        )
         th = sol.l(tq)
         n0 = np.linalg.norm(l0)
         rq = np.vstack([ls[i100], ls[-1]])
