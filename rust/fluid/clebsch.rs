@@ -102,6 +102,160 @@ fn best_offset(g1: f64, g2: f64) -> f64 {
     (0.5 * (lo + hi)).exp()
 }
 
+/// The cyclic orders `(i, j, k)` of the body's three axes.
+const CYC: [(usize, usize, usize); 3] = [(0, 1, 2), (1, 2, 0), (2, 0, 1)];
+
+/// The differences `d_i = a_j − a_k = (C_k − C_j)/A_i` and Clebsch's condition
+/// relative to its terms (`|Σ d_i| / Σ |d_i|`): the body's data checked before
+/// any of the conjugacy is built on them ([`ClebschConjugacy::new`]'s errors).
+fn clebsch_differences(a_diag: &[f64; 3], c_diag: &[f64; 3]) -> Result<([f64; 3], f64)> {
+    check_finite("A", a_diag)?;
+    check_finite("C", c_diag)?;
+    if let Some(i) = a_diag.iter().position(|&x| x == 0.0) {
+        return Err(Error::InvalidArgument {
+            what: "A",
+            reason: format!("A_{} = 0: Clebsch's condition divides by A_i", i + 1),
+        });
+    }
+    // d_i = a_j − a_k = (C_k − C_j)/A_i.
+    let d: [f64; 3] = CYC.map(|(i, j, k)| (c_diag[k] - c_diag[j]) / a_diag[i]);
+    let scale: f64 = d.iter().map(|x| x.abs()).sum();
+    if !scale.is_finite() {
+        return Err(Error::InvalidArgument {
+            what: "A, C",
+            reason: "(C_k - C_j)/A_i overflows; rescale A and C".into(),
+        });
+    }
+    if scale == 0.0 {
+        return Err(Error::InvalidArgument {
+            what: "C",
+            reason: "C1 = C2 = C3: the body rotates freely (Euler's top with the \
+                     impulse carried along); its motion is elliptic, not genus 2"
+                .into(),
+        });
+    }
+    let r = d[0] + d[1] + d[2];
+    let violation = r.abs() / scale;
+    if violation > CLEBSCH_RTOL {
+        return Err(Error::InvalidArgument {
+            what: "A, C",
+            reason: format!(
+                "Clebsch's condition (C2 - C3)/A1 + (C3 - C1)/A2 + (C1 - C2)/A3 = 0 \
+                 fails: it is {r:e}, {violation:e} of the sum of its terms' moduli \
+                 (at most {CLEBSCH_RTOL:e} is accepted)"
+            ),
+        });
+    }
+    Ok((d, violation))
+}
+
+/// The body's `a_i` (not yet centred) and the cyclic triple `(k, p, q)` whose
+/// pair `(p, q)` keeps its difference `d_k` exactly.
+struct BodyAxes {
+    a: [f64; 3],
+    k: usize,
+    p: usize,
+    q: usize,
+}
+
+/// The body's `a_i` from the differences `d_i` (which sum to the rounding
+/// `r` of Clebsch's condition, not to 0), refusing an axisymmetric body.
+fn body_axes(d: &[f64; 3]) -> Result<BodyAxes> {
+    // The pair (p, q) with the smallest |a_p − a_q| = |d_k| keeps its
+    // difference exactly: A_k = (b_p − b_q)/(a_p − a_q) is a quotient of two
+    // small differences there, and the rounding of the violation r into
+    // a_p − a_q would move A_k by r/d_k (1e-10 on a body with
+    // C1 − C2 = 1.6e-6). The third axis takes r, split between its two
+    // (large) differences.
+    let k = (0..3)
+        .min_by(|&x, &y| d[x].abs().total_cmp(&d[y].abs()))
+        .unwrap_or(0);
+    let (_, p, q) = CYC[k];
+    let mut a = [0.0; 3];
+    a[q] = -d[k];
+    a[k] = 0.5 * ((a[q] - d[p]) + d[q]);
+    for (_, j, l) in CYC {
+        if a[j] == a[l] {
+            return Err(Error::InvalidArgument {
+                what: "C",
+                reason: format!(
+                    "C{} = C{} (so A{} = A{} by Clebsch's condition): the body is \
+                     axisymmetric (Kirchhoff's case); its motion is elliptic, the \
+                     genus-2 curve degenerates",
+                    j + 1,
+                    l + 1,
+                    j + 1,
+                    l + 1
+                ),
+            });
+        }
+    }
+    Ok(BodyAxes { a, k, p, q })
+}
+
+/// The Möbius map `s = σ + λ/t` of the spectral parameter (module docs,
+/// "Choices") and the images `α_i = λ/(a_i − σ)` of the body's `a_i`.
+struct MobiusMap {
+    /// The axes by ascending `a`: `sorted[0]` has the smallest.
+    sorted: [usize; 3],
+    /// `σ`, in the coordinates of the uncentred `a`.
+    sigma: f64,
+    lambda: f64,
+    /// `α_i` of the body's axis `i`.
+    al: [f64; 3],
+}
+
+/// [`MobiusMap`] of the body's `a_i`: `σ` spreads `α1, α2, α3, 0` as evenly as
+/// the body allows ([`best_offset`]), `λ = min a_i − σ`.
+fn mobius_map(a: &[f64; 3]) -> MobiusMap {
+    // Sort the axes by a: sorted[0] has the smallest a.
+    let mut sorted = [0usize, 1, 2];
+    sorted.sort_by(|&x, &y| a[x].total_cmp(&a[y]));
+    let (g1, g2) = (a[sorted[1]] - a[sorted[0]], a[sorted[2]] - a[sorted[1]]);
+    let x = best_offset(g1, g2);
+    let sigma = a[sorted[0]] - x;
+    let lambda = x;
+    // α_i = λ/(a_i − σ); the smallest a gets α = 1 exactly.
+    let al: [f64; 3] = std::array::from_fn(|i| {
+        if i == sorted[0] {
+            1.0
+        } else {
+            lambda / (x + (a[i] - a[sorted[0]]))
+        }
+    });
+    MobiusMap {
+        sorted,
+        sigma,
+        lambda,
+        al,
+    }
+}
+
+/// `β_i` of the axes and `β_∞` of the conjugate top, in the gauge
+/// `β_p = β_q = 0` of the exactly kept pair `(p, q)` ([`body_axes`]).
+fn beta_in_gauge(
+    a_diag: &[f64; 3],
+    al: &[f64; 3],
+    k: usize,
+    p: usize,
+    q: usize,
+) -> ([f64; 3], f64) {
+    // β_i = (ρ/λ) b_i α_i, ρ = √(α1 α2 α3), up to β → β + p0 + p1 α (no change
+    // of the flow). In the gauge β_p = β_q = 0 the top's c_pq = 0 and
+    // c_p∞ = ρ A_k/α_p exactly, instead of a difference of two nearly equal
+    // c's (docs/clebsch.md, "Conditioning"); the remaining two relations
+    // (α_j/ρ)(c_j∞ − c_{j,l}) = A_m give β_∞ = −ρ A_k and β_k, taken as the
+    // mean of its two expressions (equal by Clebsch's condition).
+    let rho = (al[0] * al[1] * al[2]).sqrt();
+    let mut be = [0.0; 3];
+    be[k] = 0.5
+        * rho
+        * ((a_diag[p] - a_diag[k]) * (al[q] - al[k]) / al[q]
+            + (a_diag[q] - a_diag[k]) * (al[p] - al[k]) / al[p]);
+    let be_inf = -rho * a_diag[k];
+    (be, be_inf)
+}
+
 impl ClebschConjugacy {
     /// The conjugacy of the Clebsch body `A = diag(A_i)`, `C = diag(C_i)`.
     ///
@@ -111,105 +265,19 @@ impl ClebschConjugacy {
     /// equal: an axisymmetric body or a free rotation, whose motion is
     /// elliptic — the genus-2 curve degenerates).
     pub fn new(a_diag: &[f64; 3], c_diag: &[f64; 3]) -> Result<Self> {
-        check_finite("A", a_diag)?;
-        check_finite("C", c_diag)?;
-        if let Some(i) = a_diag.iter().position(|&x| x == 0.0) {
-            return Err(Error::InvalidArgument {
-                what: "A",
-                reason: format!("A_{} = 0: Clebsch's condition divides by A_i", i + 1),
-            });
-        }
-        const CYC: [(usize, usize, usize); 3] = [(0, 1, 2), (1, 2, 0), (2, 0, 1)];
-        // d_i = a_j − a_k = (C_k − C_j)/A_i.
-        let d: [f64; 3] = CYC.map(|(i, j, k)| (c_diag[k] - c_diag[j]) / a_diag[i]);
-        let scale: f64 = d.iter().map(|x| x.abs()).sum();
-        if !scale.is_finite() {
-            return Err(Error::InvalidArgument {
-                what: "A, C",
-                reason: "(C_k - C_j)/A_i overflows; rescale A and C".into(),
-            });
-        }
-        if scale == 0.0 {
-            return Err(Error::InvalidArgument {
-                what: "C",
-                reason: "C1 = C2 = C3: the body rotates freely (Euler's top with the \
-                         impulse carried along); its motion is elliptic, not genus 2"
-                    .into(),
-            });
-        }
-        let r = d[0] + d[1] + d[2];
-        let violation = r.abs() / scale;
-        if violation > CLEBSCH_RTOL {
-            return Err(Error::InvalidArgument {
-                what: "A, C",
-                reason: format!(
-                    "Clebsch's condition (C2 - C3)/A1 + (C3 - C1)/A2 + (C1 - C2)/A3 = 0 \
-                     fails: it is {r:e}, {violation:e} of the sum of its terms' moduli \
-                     (at most {CLEBSCH_RTOL:e} is accepted)"
-                ),
-            });
-        }
-        // The pair (p, q) with the smallest |a_p − a_q| = |d_k| keeps its
-        // difference exactly: A_k = (b_p − b_q)/(a_p − a_q) is a quotient of two
-        // small differences there, and the rounding of the violation r into
-        // a_p − a_q would move A_k by r/d_k (1e-10 on a body with
-        // C1 − C2 = 1.6e-6). The third axis takes r, split between its two
-        // (large) differences.
-        let k = (0..3)
-            .min_by(|&x, &y| d[x].abs().total_cmp(&d[y].abs()))
-            .unwrap_or(0);
-        let (_, p, q) = CYC[k];
-        let mut a = [0.0; 3];
-        a[q] = -d[k];
-        a[k] = 0.5 * ((a[q] - d[p]) + d[q]);
-        for (_, j, l) in CYC {
-            if a[j] == a[l] {
-                return Err(Error::InvalidArgument {
-                    what: "C",
-                    reason: format!(
-                        "C{} = C{} (so A{} = A{} by Clebsch's condition): the body is \
-                         axisymmetric (Kirchhoff's case); its motion is elliptic, the \
-                         genus-2 curve degenerates",
-                        j + 1,
-                        l + 1,
-                        j + 1,
-                        l + 1
-                    ),
-                });
-            }
-        }
+        let (d, violation) = clebsch_differences(a_diag, c_diag)?;
+        let BodyAxes { a, k, p, q } = body_axes(&d)?;
         let mean_a = (a[0] + a[1] + a[2]) / 3.0;
         let a_centred = a.map(|x| x - mean_a);
         let mean_c = (c_diag[0] + c_diag[1] + c_diag[2]) / 3.0;
         let b = c_diag.map(|c| mean_c - c);
-        // Sort the axes by a: sorted[0] has the smallest a.
-        let mut sorted = [0usize, 1, 2];
-        sorted.sort_by(|&x, &y| a[x].total_cmp(&a[y]));
-        let (g1, g2) = (a[sorted[1]] - a[sorted[0]], a[sorted[2]] - a[sorted[1]]);
-        let x = best_offset(g1, g2);
-        let sigma = a[sorted[0]] - x;
-        let lambda = x;
-        // α_i = λ/(a_i − σ); the smallest a gets α = 1 exactly.
-        let al: [f64; 3] = std::array::from_fn(|i| {
-            if i == sorted[0] {
-                1.0
-            } else {
-                lambda / (x + (a[i] - a[sorted[0]]))
-            }
-        });
-        // β_i = (ρ/λ) b_i α_i, ρ = √(α1 α2 α3), up to β → β + p0 + p1 α (no change
-        // of the flow). In the gauge β_p = β_q = 0 the top's c_pq = 0 and
-        // c_p∞ = ρ A_k/α_p exactly, instead of a difference of two nearly equal
-        // c's (docs/clebsch.md, "Conditioning"); the remaining two relations
-        // (α_j/ρ)(c_j∞ − c_{j,l}) = A_m give β_∞ = −ρ A_k and β_k, taken as the
-        // mean of its two expressions (equal by Clebsch's condition).
-        let rho = (al[0] * al[1] * al[2]).sqrt();
-        let mut be = [0.0; 3];
-        be[k] = 0.5
-            * rho
-            * ((a_diag[p] - a_diag[k]) * (al[q] - al[k]) / al[q]
-                + (a_diag[q] - a_diag[k]) * (al[p] - al[k]) / al[p]);
-        let be_inf = -rho * a_diag[k];
+        let MobiusMap {
+            sorted,
+            sigma,
+            lambda,
+            al,
+        } = mobius_map(&a);
+        let (be, be_inf) = beta_in_gauge(a_diag, &al, k, p, q);
         // Ascending α: ∞ (α = 0) first, then the axes by decreasing a.
         let orig = [3, sorted[2], sorted[1], sorted[0]];
         let alpha = orig.map(|o| if o == 3 { 0.0 } else { al[o] });

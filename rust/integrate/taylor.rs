@@ -161,10 +161,12 @@ unsafe fn taylor_group_avx2(
 /// `X[n][k][w]`: coefficient `n` of component `k` of lane `w`, in scaled time.
 type Coeffs = [[V; M]; MAX_ORDER + 1];
 
-/// One long body on purpose (the SIMD kernel's exception to the ~100-line
-/// rule): split into inlined steps on a lane-state struct (record and
-/// refill, step sizes, dense output, time update), the same computation ran
-/// 30–40 % slower (256 states to t = 50, interleaved runs of both builds).
+/// Taylor's method on the lane group (see [`taylor_group`]): record the
+/// samples the lanes have reached and refill finished lanes, the series, the
+/// step of each lane, the samples inside the step (dense output), the update
+/// of the state and of the time. Every step is `#[inline(always)]`: the body
+/// is instantiated inside the AVX2 `#[target_feature]` copy, and its steps
+/// must be compiled with the same features.
 #[allow(clippy::too_many_arguments)]
 #[inline(always)]
 fn taylor_group_body<L: Lanes>(
@@ -177,100 +179,25 @@ fn taylor_group_body<L: Lanes>(
     progress: &mut Progress,
     cancel: &Cancel,
 ) -> Result<()> {
-    let rows = y0s.len() / M;
-    let ns = times.len();
     let Some(&t_last) = times.last() else {
         return Ok(());
     };
-    let per = ns * M;
-    let p = order(o.tol);
-    let sq = product_coefficients(c);
-    let s = sq.map(L::splat);
-    // Fresh lanes start from the time scale 1 / (‖x‖ max|s_q|), a bound on the
-    // Lipschitz constant of (1) up to a factor of order one.
-    let smax = sq.iter().fold(0.0f64, |m, v| m.max(v.abs()));
-    // Jorba & Zou's h = ρ e^{-2}, with heyoka's e^{-0.7/(p-1)} for the estimate
-    // of ρ from two coefficients. (A step ρ ε^{1/p}, whose last kept term is
-    // exactly ε, is 1.2x longer at ε = eps but measured no faster at equal
-    // error: the larger steps need the next tighter ε.)
-    let safety = (-2.0 - 0.7 / (p as f64 - 1.0)).exp();
-    let inv: [f64; MAX_ORDER + 1] =
-        std::array::from_fn(|n| if n == 0 { 0.0 } else { 1.0 / n as f64 });
-
+    let run = TaylorRun::<L>::new(c, y0s, t0, times, t_last, o);
+    let mut sink = Samples {
+        out,
+        per: times.len() * M,
+        progress,
+        cancel,
+    };
+    // The series stays out of the lane-state struct: with it inside (an array
+    // indexed by the order at run time) the kernel ran ~30 % slower (256
+    // states to t = 500, interleaved runs of both builds); outside, as fast as
+    // the former single body (~4 % faster).
     let mut x: Coeffs = [[[0.0; W]; M]; MAX_ORDER + 1];
-    // Time of each lane as an unevaluated sum t + t_lo (two-sum after every
-    // step): a plain t += h loses half an ulp of t per step, and over 700 steps
-    // to t = 100 that random walk in time alone put ~1e-12 into l.
-    let mut t = [t0; W];
-    let mut t_lo = [0.0f64; W];
-    // Compensation of the state update (the low bits lost in x + δ), as in
-    // the Gauss steppers (Kahan).
-    let mut comp = [[0.0f64; W]; M];
-    // Scaled-time unit of each lane: its previous (unclamped) step.
-    let mut hs = [1.0f64; W];
-    let mut idx = [0usize; W];
-    let mut taken = [0u64; W];
-    let mut traj: [Option<usize>; W] = [None; W];
-    let mut next = 0usize;
+    let mut lanes = TaylorLanes::new(t0);
     let mut since_check = 0u32;
     loop {
-        // Samples at the lanes' current times; refill finished lanes.
-        let mut any = false;
-        for w in 0..W {
-            loop {
-                let Some(j) = traj[w] else {
-                    if next == rows {
-                        break;
-                    }
-                    let y0 = &y0s[next * M..(next + 1) * M];
-                    let mut ymax = 0.0f64;
-                    for k in 0..M {
-                        x[0][k][w] = y0[k];
-                        ymax = ymax.max(y0[k].abs());
-                    }
-                    let scale = ymax * smax;
-                    hs[w] = if scale > 0.0 && scale.is_finite() {
-                        1.0 / scale
-                    } else {
-                        1.0
-                    };
-                    t[w] = t0;
-                    t_lo[w] = 0.0;
-                    for k in 0..M {
-                        comp[k][w] = 0.0;
-                    }
-                    idx[w] = 0;
-                    taken[w] = 0;
-                    traj[w] = Some(next);
-                    next += 1;
-                    continue;
-                };
-                if idx[w] < ns && (times[idx[w]] - t[w]) - t_lo[w] <= 0.0 {
-                    let s = idx[w];
-                    let dst = &mut out[j * per + s * M..j * per + (s + 1) * M];
-                    for k in 0..M {
-                        dst[k] = x[0][k][w] + comp[k][w];
-                    }
-                    idx[w] += 1;
-                    cancel.advance(1);
-                    if j == 0 {
-                        progress.samples0 = idx[w];
-                    }
-                    continue;
-                }
-                if idx[w] == ns {
-                    progress.steps += taken[w];
-                    traj[w] = None;
-                    for k in 0..M {
-                        x[0][k][w] = 0.0;
-                    }
-                    continue;
-                }
-                break;
-            }
-            any |= traj[w].is_some();
-        }
-        if !any {
+        if !lanes.record_and_refill(&mut x, &run, &mut sink) {
             return Ok(());
         }
         since_check += 1;
@@ -278,27 +205,255 @@ fn taylor_group_body<L: Lanes>(
             since_check = 0;
             cancel.check()?;
         }
+        lanes.series(&mut x, &run);
+        let step = lanes.step_sizes(&x, &run)?;
+        lanes.dense_output(&x, &run, &step, &mut sink);
+        compensated_update::<L>(&mut x, &mut lanes.comp, run.p, &step.sigma, &step.h, &run.s);
+        lanes.advance_time(&x, &run, &step)?;
+    }
+}
+
+/// What a run of the lane group does not change: the trajectories, the sample
+/// times, the tolerance's order and step factor, and the field's constants.
+struct TaylorRun<'a, L: Lanes> {
+    y0s: &'a [f64],
+    times: &'a [f64],
+    t0: f64,
+    t_last: f64,
+    o: TaylorOpts,
+    rows: usize,
+    ns: usize,
+    /// The order `p`.
+    p: usize,
+    /// The constants `s_q` of the products, on every lane.
+    s: [L; 12],
+    /// `max |s_q|`, for the time scale of a fresh lane.
+    smax: f64,
+    /// The step factor: `h = ρ · safety`.
+    safety: f64,
+    /// `1/n` (0 for `n = 0`).
+    inv: [f64; MAX_ORDER + 1],
+}
+
+impl<'a, L: Lanes> TaylorRun<'a, L> {
+    #[inline(always)]
+    fn new(
+        c: &[f64; 6],
+        y0s: &'a [f64],
+        t0: f64,
+        times: &'a [f64],
+        t_last: f64,
+        o: TaylorOpts,
+    ) -> Self {
+        let rows = y0s.len() / M;
+        let ns = times.len();
+        let p = order(o.tol);
+        let sq = product_coefficients(c);
+        let s = sq.map(L::splat);
+        // Fresh lanes start from the time scale 1 / (‖x‖ max|s_q|), a bound on the
+        // Lipschitz constant of (1) up to a factor of order one.
+        let smax = sq.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        // Jorba & Zou's h = ρ e^{-2}, with heyoka's e^{-0.7/(p-1)} for the estimate
+        // of ρ from two coefficients. (A step ρ ε^{1/p}, whose last kept term is
+        // exactly ε, is 1.2x longer at ε = eps but measured no faster at equal
+        // error: the larger steps need the next tighter ε.)
+        let safety = (-2.0 - 0.7 / (p as f64 - 1.0)).exp();
+        let inv: [f64; MAX_ORDER + 1] =
+            std::array::from_fn(|n| if n == 0 { 0.0 } else { 1.0 / n as f64 });
+        TaylorRun {
+            y0s,
+            times,
+            t0,
+            t_last,
+            o,
+            rows,
+            ns,
+            p,
+            s,
+            smax,
+            safety,
+            inv,
+        }
+    }
+}
+
+/// Where the samples go: `out` (`(rows, times.len(), 6)`, `per` values per
+/// trajectory), with the progress of the run and the cancellation token's count.
+struct Samples<'a> {
+    out: &'a mut [f64],
+    per: usize,
+    progress: &'a mut Progress,
+    cancel: &'a Cancel,
+}
+
+impl Samples<'_> {
+    /// The row of sample `s` of trajectory `j`.
+    #[inline(always)]
+    fn row(&mut self, j: usize, s: usize) -> &mut [f64] {
+        let per = self.per;
+        &mut self.out[j * per + s * M..j * per + (s + 1) * M]
+    }
+
+    /// Counts a sample written for trajectory `j`, whose next sample is `idx`.
+    #[inline(always)]
+    fn written(&mut self, j: usize, idx: usize) {
+        self.cancel.advance(1);
+        if j == 0 {
+            self.progress.samples0 = idx;
+        }
+    }
+}
+
+/// The state of the `W` lanes, each carrying one trajectory at a time.
+struct TaylorLanes {
+    // Time of each lane as an unevaluated sum t + t_lo (two-sum after every
+    // step): a plain t += h loses half an ulp of t per step, and over 700 steps
+    // to t = 100 that random walk in time alone put ~1e-12 into l.
+    t: [f64; W],
+    t_lo: [f64; W],
+    // Compensation of the state update (the low bits lost in x + δ), as in
+    // the Gauss steppers (Kahan).
+    comp: [[f64; W]; M],
+    // Scaled-time unit of each lane: its previous (unclamped) step.
+    hs: [f64; W],
+    /// The next sample of each lane.
+    idx: [usize; W],
+    /// Accepted steps of each lane's trajectory.
+    taken: [u64; W],
+    /// Each lane's trajectory (`None`: idle).
+    traj: [Option<usize>; W],
+    /// The next trajectory to load.
+    next: usize,
+}
+
+/// The step of each lane ([`TaylorLanes::step_sizes`]).
+struct LaneSteps {
+    /// The scaled-time unit the coefficients were computed in.
+    unit: V,
+    /// The step in scaled time.
+    sigma: V,
+    /// The step in time.
+    h: V,
+    /// The step ends on the last sample time.
+    last: [bool; W],
+}
+
+impl TaylorLanes {
+    #[inline(always)]
+    fn new(t0: f64) -> Self {
+        TaylorLanes {
+            t: [t0; W],
+            t_lo: [0.0f64; W],
+            comp: [[0.0f64; W]; M],
+            hs: [1.0f64; W],
+            idx: [0usize; W],
+            taken: [0u64; W],
+            traj: [None; W],
+            next: 0usize,
+        }
+    }
+
+    /// Samples at the lanes' current times; refill finished lanes. Returns
+    /// whether any lane still has a trajectory.
+    #[inline(always)]
+    fn record_and_refill<L: Lanes>(
+        &mut self,
+        x: &mut Coeffs,
+        run: &TaylorRun<L>,
+        sink: &mut Samples,
+    ) -> bool {
+        let mut any = false;
+        for w in 0..W {
+            loop {
+                let Some(j) = self.traj[w] else {
+                    if self.next == run.rows {
+                        break;
+                    }
+                    self.load(x, w, run);
+                    continue;
+                };
+                if self.idx[w] < run.ns
+                    && (run.times[self.idx[w]] - self.t[w]) - self.t_lo[w] <= 0.0
+                {
+                    let s = self.idx[w];
+                    let dst = sink.row(j, s);
+                    for k in 0..M {
+                        dst[k] = x[0][k][w] + self.comp[k][w];
+                    }
+                    self.idx[w] += 1;
+                    sink.written(j, self.idx[w]);
+                    continue;
+                }
+                if self.idx[w] == run.ns {
+                    sink.progress.steps += self.taken[w];
+                    self.traj[w] = None;
+                    for k in 0..M {
+                        x[0][k][w] = 0.0;
+                    }
+                    continue;
+                }
+                break;
+            }
+            any |= self.traj[w].is_some();
+        }
+        any
+    }
+
+    /// Loads the next trajectory into lane `w`, with the time scale of a
+    /// fresh lane.
+    #[inline(always)]
+    fn load<L: Lanes>(&mut self, x: &mut Coeffs, w: usize, run: &TaylorRun<L>) {
+        let next = self.next;
+        let y0 = &run.y0s[next * M..(next + 1) * M];
+        let mut ymax = 0.0f64;
+        for k in 0..M {
+            x[0][k][w] = y0[k];
+            ymax = ymax.max(y0[k].abs());
+        }
+        let scale = ymax * run.smax;
+        self.hs[w] = if scale > 0.0 && scale.is_finite() {
+            1.0 / scale
+        } else {
+            1.0
+        };
+        self.t[w] = run.t0;
+        self.t_lo[w] = 0.0;
+        for k in 0..M {
+            self.comp[k][w] = 0.0;
+        }
+        self.idx[w] = 0;
+        self.taken[w] = 0;
+        self.traj[w] = Some(next);
+        self.next += 1;
+    }
+
+    /// The coefficients `X_1 … X_p` of every lane in its scaled time.
+    #[inline(always)]
+    fn series<L: Lanes>(&self, x: &mut Coeffs, run: &TaylorRun<L>) {
+        let hs = &self.hs;
         let fac: [L; MAX_ORDER + 1] = std::array::from_fn(|n| {
-            let f: V = std::array::from_fn(|w| hs[w] * inv[n]);
+            let f: V = std::array::from_fn(|w| hs[w] * run.inv[n]);
             L::load(&f)
         });
+        let s = &run.s;
         // The orders of ε in [1e-16, 1e-13] with constant loop bounds, which
         // LLVM unrolls completely (the loop overhead of the short sums of the
         // low orders was a third of the step).
-        match p {
-            16 => coefficients_const::<L, 16>(&mut x, &s, &fac),
-            17 => coefficients_const::<L, 17>(&mut x, &s, &fac),
-            18 => coefficients_const::<L, 18>(&mut x, &s, &fac),
-            19 => coefficients_const::<L, 19>(&mut x, &s, &fac),
-            20 => coefficients_const::<L, 20>(&mut x, &s, &fac),
-            _ => coefficients::<L>(&mut x, p, &s, &fac),
+        match run.p {
+            16 => coefficients_const::<L, 16>(x, s, &fac),
+            17 => coefficients_const::<L, 17>(x, s, &fac),
+            18 => coefficients_const::<L, 18>(x, s, &fac),
+            19 => coefficients_const::<L, 19>(x, s, &fac),
+            20 => coefficients_const::<L, 20>(x, s, &fac),
+            _ => coefficients::<L>(x, run.p, s, &fac),
         }
-        // Step of each lane, in scaled time (σ) and in time (h); `unit` is the
-        // scale the coefficients were computed in.
-        let unit = hs;
-        let mut sigma = [0.0f64; W];
-        let mut h = [0.0f64; W];
-        let mut last = [false; W];
+    }
+
+    /// The radius of convergence of each lane's series in its scaled time,
+    /// from the last two coefficients: ρ̃ = 2^min(log2(xn/n1)/(p-1),
+    /// log2(xn/n2)/p) (max norms).
+    #[inline(always)]
+    fn radius(x: &Coeffs, p: usize) -> V {
         let (mut xn, mut n1, mut n2) = ([0.0f64; W], [0.0f64; W], [0.0f64; W]);
         for k in 0..M {
             for w in 0..W {
@@ -313,12 +468,26 @@ fn taylor_group_body<L: Lanes>(
         let (inv_p1, inv_p) = (1.0 / (p as f64 - 1.0), 1.0 / p as f64);
         let lg: V = std::array::from_fn(|w| log2_ratio(xn[w], n1[w]) * inv_p1);
         let lg2: V = std::array::from_fn(|w| log2_ratio(xn[w], n2[w]) * inv_p);
-        let rho: V = std::array::from_fn(|w| exp2_approx(lg[w].min(lg2[w])));
+        std::array::from_fn(|w| exp2_approx(lg[w].min(lg2[w])))
+    }
+
+    /// The step of each lane (Jorba & Zou, cut to the last sample time, at
+    /// most `h_max`) and the next step's scale; errors on a zero or NaN step.
+    #[inline(always)]
+    fn step_sizes<L: Lanes>(&mut self, x: &Coeffs, run: &TaylorRun<L>) -> Result<LaneSteps> {
+        let (o, safety) = (run.o, run.safety);
+        // Step of each lane, in scaled time (σ) and in time (h); `unit` is the
+        // scale the coefficients were computed in.
+        let unit = self.hs;
+        let mut sigma = [0.0f64; W];
+        let mut h = [0.0f64; W];
+        let mut last = [false; W];
+        let rho = Self::radius(x, run.p);
         for w in 0..W {
-            if traj[w].is_none() {
+            if self.traj[w].is_none() {
                 continue;
             }
-            let mut hw = hs[w] * (safety * rho[w]);
+            let mut hw = self.hs[w] * (safety * rho[w]);
             if o.h_max > 0.0 {
                 hw = hw.min(o.h_max);
             }
@@ -327,10 +496,10 @@ fn taylor_group_body<L: Lanes>(
                     what: "Taylor step (step size zero or NaN: the state overflowed; rescale l)",
                     tol: o.tol,
                     reached: hw,
-                    iterations: taken[w] as usize,
+                    iterations: self.taken[w] as usize,
                 });
             }
-            let remaining = (t_last - t[w]) - t_lo[w];
+            let remaining = (run.t_last - self.t[w]) - self.t_lo[w];
             if hw >= remaining {
                 last[w] = true;
                 h[w] = remaining;
@@ -341,19 +510,37 @@ fn taylor_group_body<L: Lanes>(
             // The next step's scale: this step before it was cut to the end,
             // growing at most 2^10-fold (a terminating series, ρ̃ = ∞, must not
             // make the next coefficients overflow).
-            hs[w] *= (safety * rho[w]).min(1024.0);
+            self.hs[w] *= (safety * rho[w]).min(1024.0);
         }
-        // Dense output: samples strictly inside the step.
+        Ok(LaneSteps {
+            unit,
+            sigma,
+            h,
+            last,
+        })
+    }
+
+    /// Dense output: samples strictly inside the step, from the step's
+    /// Taylor polynomial.
+    #[inline(always)]
+    fn dense_output<L: Lanes>(
+        &mut self,
+        x: &Coeffs,
+        run: &TaylorRun<L>,
+        step: &LaneSteps,
+        sink: &mut Samples,
+    ) {
+        let (comp, p) = (&self.comp, run.p);
         for w in 0..W {
-            let Some(j) = traj[w] else { continue };
-            while idx[w] < ns {
-                let s = idx[w];
-                let dt = (times[s] - t[w]) - t_lo[w];
-                if !(dt < h[w] || (last[w] && times[s] < t_last)) {
+            let Some(j) = self.traj[w] else { continue };
+            while self.idx[w] < run.ns {
+                let s = self.idx[w];
+                let dt = (run.times[s] - self.t[w]) - self.t_lo[w];
+                if !(dt < step.h[w] || (step.last[w] && run.times[s] < run.t_last)) {
                     break;
                 }
-                let tau = dt / unit[w];
-                let dst = &mut out[j * per + s * M..j * per + (s + 1) * M];
+                let tau = dt / step.unit[w];
+                let dst = sink.row(j, s);
                 for k in 0..M {
                     let mut acc = x[p][k][w];
                     for n in (1..p).rev() {
@@ -361,16 +548,24 @@ fn taylor_group_body<L: Lanes>(
                     }
                     dst[k] = x[0][k][w] + acc.mul_add(tau, comp[k][w]);
                 }
-                idx[w] += 1;
-                cancel.advance(1);
-                if j == 0 {
-                    progress.samples0 = idx[w];
-                }
+                self.idx[w] += 1;
+                sink.written(j, self.idx[w]);
             }
         }
-        compensated_update::<L>(&mut x, &mut comp, p, &sigma, &h, &s);
+    }
+
+    /// After the state update: checks each lane's state, moves its time to
+    /// the step's end (two-sum) and counts the step against the budget.
+    #[inline(always)]
+    fn advance_time<L: Lanes>(
+        &mut self,
+        x: &Coeffs,
+        run: &TaylorRun<L>,
+        step: &LaneSteps,
+    ) -> Result<()> {
+        let o = run.o;
         for w in 0..W {
-            if traj[w].is_none() {
+            if self.traj[w].is_none() {
                 continue;
             }
             if !(0..M).all(|k| x[0][k][w].is_finite()) {
@@ -378,22 +573,23 @@ fn taylor_group_body<L: Lanes>(
                     what: "Taylor step (state overflowed or became NaN; rescale l)",
                     tol: o.tol,
                     reached: f64::NAN,
-                    iterations: taken[w] as usize,
+                    iterations: self.taken[w] as usize,
                 });
             }
-            if last[w] {
-                t[w] = t_last;
-                t_lo[w] = 0.0;
+            if step.last[w] {
+                self.t[w] = run.t_last;
+                self.t_lo[w] = 0.0;
             } else {
-                let (s, e) = compensated::two_sum(t[w], h[w]);
-                t[w] = s;
-                t_lo[w] += e;
+                let (s, e) = compensated::two_sum(self.t[w], step.h[w]);
+                self.t[w] = s;
+                self.t_lo[w] += e;
             }
-            taken[w] += 1;
-            if taken[w] > o.max_steps {
+            self.taken[w] += 1;
+            if self.taken[w] > o.max_steps {
                 return Err(super::explicit::too_many_steps(o.max_steps));
             }
         }
+        Ok(())
     }
 }
 

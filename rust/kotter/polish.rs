@@ -213,7 +213,6 @@ pub(super) fn polish_root_at(
     branch: Option<C>,
 ) -> PolishedRoot {
     let a = lv.a;
-    let [h0, h1, h2, _] = *lv.h;
     let ai = a[best];
     let gap = (0..4)
         .filter(|&m| m != best)
@@ -221,34 +220,67 @@ pub(super) fn polish_root_at(
         .fold(f64::INFINITY, f64::min);
     let mut t = t0;
     if branch.is_none() && t.norm() < 0.1 * gap {
-        let pa = p_at_a[best];
-        let dpa = 2.0 * h1 * ai - h2;
-        for _ in 0..4 {
-            let pt = pa + (h1 * t + dpa) * t;
-            let dpt = dpa + 2.0 * h1 * t;
-            let mut prod = ONE;
-            let mut dprod = ZERO;
-            for m in (0..4).filter(|&m| m != best) {
-                let f = ai - a[m] + t;
-                dprod = dprod * f + prod;
-                prod *= f;
-            }
-            let val = pt * pt - 4.0 * h0 * h0 * t * prod;
-            let der = 2.0 * pt * dpt - 4.0 * h0 * h0 * (prod + t * dprod);
-            if der == ZERO || !(val / der).norm().is_finite() {
-                break;
-            }
-            let step = val / der;
-            t -= step;
-            if step.norm() <= f64::EPSILON * t.norm() {
-                break;
-            }
+        t = refine_on_squared_form(lv, p_at_a, best, t);
+    }
+    let (x0, sigma) = starting_branch(lv, best, t, branch);
+    let (t, x, sigma) = newton_on_branch(lv, best, t, x0, sigma);
+    let s = ai + t;
+    let df = lv.df(s, &x, sigma);
+    let fprime = df * (-4.0 * lv.h0_sign() * sigma) / lv.den;
+    let plain = PolishedRoot {
+        s,
+        x: x.map(Cdd::new),
+        sigma: Cdd::new(sigma),
+        fprime,
+        sqrt_fprime: Cdd::new(sqrt_principal(fprime)),
+    };
+    refine_dd(lv, best, t, sigma, df).unwrap_or(plain)
+}
+
+/// The offset `t` near `a_best` refined by four Newton steps on the numerator
+/// of (19) at `s = a_best + t`, `(P(a_i) + P'(a_i) t + h1 t²)² − 4h0² t
+/// Π_{m≠i}(a_i − a_m + t)`, smooth where `√G ~ √t` is not ([`polish_root`]).
+fn refine_on_squared_form(lv: &Level, p_at_a: &[f64; 4], best: usize, t0: C) -> C {
+    let a = lv.a;
+    let [h0, h1, h2, _] = *lv.h;
+    let ai = a[best];
+    let mut t = t0;
+    let pa = p_at_a[best];
+    let dpa = 2.0 * h1 * ai - h2;
+    for _ in 0..4 {
+        let pt = pa + (h1 * t + dpa) * t;
+        let dpt = dpa + 2.0 * h1 * t;
+        let mut prod = ONE;
+        let mut dprod = ZERO;
+        for m in (0..4).filter(|&m| m != best) {
+            let f = ai - a[m] + t;
+            dprod = dprod * f + prod;
+            prod *= f;
+        }
+        let val = pt * pt - 4.0 * h0 * h0 * t * prod;
+        let der = 2.0 * pt * dpt - 4.0 * h0 * h0 * (prod + t * dprod);
+        if der == ZERO || !(val / der).norm().is_finite() {
+            break;
+        }
+        let step = val / der;
+        t -= step;
+        if step.norm() <= f64::EPSILON * t.norm() {
+            break;
         }
     }
+    t
+}
+
+/// The offsets `s − a_m` at `s = a_best + t` and the branch `σ` of `√G` there:
+/// of `±√G(s)`, the one nearest `branch` if given, else the one on which `|f|`
+/// is the smaller.
+fn starting_branch(lv: &Level, best: usize, t: C, branch: Option<C>) -> ([C; 4], C) {
+    let a = lv.a;
+    let ai = a[best];
     // the branch: of ±√G(s0), the one given, else the one on which f is the smaller
     let x0 = offsets_at(a, best, t);
     let g0 = sqrt_principal(x0.iter().product());
-    let mut sigma = match branch {
+    let sigma = match branch {
         Some(b) => {
             if (g0 * b.conj()).re >= 0.0 {
                 g0
@@ -266,6 +298,15 @@ pub(super) fn polish_root_at(
             }
         }
     };
+    (x0, sigma)
+}
+
+/// Up to eight Newton steps on `f` (15) from `(t, x0, σ)`, following the
+/// branch of `√G` ([`sqrt_g_near`]): the state `(t, x, σ)` of the smallest
+/// relative residual `|f|/size` met.
+fn newton_on_branch(lv: &Level, best: usize, t: C, x0: [C; 4], mut sigma: C) -> (C, [C; 4], C) {
+    let a = lv.a;
+    let ai = a[best];
     let mut cur = (t, x0, sigma);
     let (f_cur, size) = lv.f(ai + t, &x0, sigma);
     let mut res_best = f_cur.norm() / size.max(f64::MIN_POSITIVE);
@@ -293,18 +334,7 @@ pub(super) fn polish_root_at(
             break;
         }
     }
-    let (t, x, sigma) = best_state;
-    let s = ai + t;
-    let df = lv.df(s, &x, sigma);
-    let fprime = df * (-4.0 * lv.h0_sign() * sigma) / lv.den;
-    let plain = PolishedRoot {
-        s,
-        x: x.map(Cdd::new),
-        sigma: Cdd::new(sigma),
-        fprime,
-        sqrt_fprime: Cdd::new(sqrt_principal(fprime)),
-    };
-    refine_dd(lv, best, t, sigma, df).unwrap_or(plain)
+    best_state
 }
 
 /// The root, `σ`, the offsets `s − a_m` and `√F'(s)` to double-double

@@ -119,6 +119,121 @@ pub fn phase_mod1(x0: f64, nu: f64, t: f64) -> f64 {
     x - x.round()
 }
 
+/// The axes of a triaxial Euler top through `m0` and the constants of its
+/// closed form (module docs).
+struct TriaxialAxes {
+    /// `b` the middle axis, `s` the axis the motion circulates around, `r` the third.
+    b: usize,
+    r: usize,
+    s: usize,
+    /// `χ`: `+1` if `(b, s, r)` is a cyclic order, else `−1`.
+    chi: f64,
+    /// `W_s − W_b`.
+    dsb: f64,
+    /// `A = |W_s − W_b|`, `B = |W_b − W_r|`, `C = |W_s − W_r|`.
+    a_: f64,
+    b_: f64,
+    c_: f64,
+    /// The power of two `μ` and `Δ' = Δ/μ²`.
+    mu: f64,
+    delta: Dd,
+    /// `|Δ'|` at or below [`SEPARATRIX_RTOL`] of its terms.
+    on_separatrix: bool,
+}
+
+impl TriaxialAxes {
+    /// The axes and `Δ` of the top `w` through `m0` (three distinct `W`).
+    fn of(w: [Dd; 3], m0: [f64; 3]) -> Self {
+        let diff = |i: usize, j: usize| w[i].sub(w[j]);
+        // b the middle axis.
+        let mut order = [0usize, 1, 2];
+        // The exact order of the double-double W (their sums may round alike).
+        order.sort_by(|&i, &j| signum0(diff(i, j)).total_cmp(&0.0));
+        let (lo, b, hi) = (order[0], order[1], order[2]);
+        // Δ with the two outer components scaled by a power of two μ (exact),
+        // so that their squares do not underflow when they are tiny beside
+        // M_b (a state within 1e-154 of the middle axis): Δ = μ² Δ'.
+        let big = m0[hi].abs().max(m0[lo].abs());
+        let mu = big.log2().floor().max(-1074.0).exp2();
+        let sq = |i: usize| {
+            let v = m0[i] / mu;
+            Dd::prod(v, v)
+        };
+        let t_hi = diff(hi, b).mul(sq(hi));
+        let t_lo = diff(lo, b).mul(sq(lo));
+        let delta = t_hi.add(t_lo);
+        let scale = t_hi.to_f64().abs() + t_lo.to_f64().abs();
+        let on_separatrix = delta.to_f64().abs() <= SEPARATRIX_RTOL * scale;
+        let (s, r) = if on_separatrix || signum0(delta) > 0.0 {
+            (hi, lo)
+        } else {
+            (lo, hi)
+        };
+        let chi = if s == (b + 1) % 3 { 1.0 } else { -1.0 };
+        let dsb = diff(s, b).to_f64();
+        let a_ = dsb.abs();
+        let b_ = diff(b, r).to_f64().abs();
+        let c_ = diff(s, r).to_f64().abs();
+        TriaxialAxes {
+            b,
+            r,
+            s,
+            chi,
+            dsb,
+            a_,
+            b_,
+            c_,
+            mu,
+            delta,
+            on_separatrix,
+        }
+    }
+
+    /// The amplitudes `X`, `R̃`, `S̃` and the rate `ω` of the closed form at `m0`.
+    fn amplitudes(&self, w: [Dd; 3], m0: [f64; 3]) -> Result<Amplitudes> {
+        let (a_, b_, c_) = (self.a_, self.b_, self.c_);
+        let (mb, mr, ms) = (m0[self.b], m0[self.r], m0[self.s]);
+        // Amplitudes as hypotenuses: no square underflows or overflows.
+        let x = mb.hypot((c_ / a_).sqrt() * mr);
+        let r_abs = mr.hypot((a_ / c_).sqrt() * mb);
+        let s_abs = ms.hypot((b_ / c_).sqrt() * mb);
+        let omega = a_.sqrt() * (b_.sqrt() * mb).hypot(c_.sqrt() * ms);
+        let s_amp = if ms < 0.0 { -s_abs } else { s_abs };
+        let r_amp = -self.chi * self.dsb.signum() * s_amp.signum() * r_abs;
+        if !(omega > 0.0 && x > 0.0 && r_abs > 0.0 && s_abs > 0.0) {
+            let wv = w.map(|x| x.to_f64());
+            // Unreachable for finite M off the axes: each amplitude is at
+            // least one non-zero |M_i| (off the axes two are non-zero).
+            return Err(Error::InvalidArgument {
+                what: "Euler top",
+                reason: format!(
+                    "degenerate amplitudes (omega = {omega:e}, X = {x:e}) for M0 = {m0:?}, W = {wv:?}"
+                ),
+            });
+        }
+        Ok(Amplitudes {
+            x,
+            r_abs,
+            s_abs,
+            omega,
+            s_amp,
+            r_amp,
+        })
+    }
+}
+
+/// The amplitudes of a triaxial Euler motion ([`TriaxialAxes::amplitudes`]):
+/// `X`, `|R̃|`, `|S̃|`, `ω`, and `S̃`, `R̃` with their signs.
+#[derive(Clone, Copy)]
+struct Amplitudes {
+    x: f64,
+    r_abs: f64,
+    s_abs: f64,
+    omega: f64,
+    s_amp: f64,
+    r_amp: f64,
+}
+
 impl EulerTop {
     /// The Euler top with coefficients `w` (double-doubles: a self-dual top's
     /// `W_j = −(c_kl + c_j4)` is a sum that the separatrix test needs exactly)
@@ -189,84 +304,67 @@ impl EulerTop {
 
     /// Three distinct `W`: Jacobi's elliptic functions, or the separatrix.
     fn triaxial(w: [Dd; 3], m0: [f64; 3]) -> Result<Self> {
-        let wv = w.map(|x| x.to_f64());
-        let diff = |i: usize, j: usize| w[i].sub(w[j]);
-        // b the middle axis.
-        let mut order = [0usize, 1, 2];
-        // The exact order of the double-double W (their sums may round alike).
-        order.sort_by(|&i, &j| signum0(diff(i, j)).total_cmp(&0.0));
-        let (lo, b, hi) = (order[0], order[1], order[2]);
-        // Δ with the two outer components scaled by a power of two μ (exact),
-        // so that their squares do not underflow when they are tiny beside
-        // M_b (a state within 1e-154 of the middle axis): Δ = μ² Δ'.
-        let big = m0[hi].abs().max(m0[lo].abs());
-        let mu = big.log2().floor().max(-1074.0).exp2();
-        let sq = |i: usize| {
-            let v = m0[i] / mu;
-            Dd::prod(v, v)
-        };
-        let t_hi = diff(hi, b).mul(sq(hi));
-        let t_lo = diff(lo, b).mul(sq(lo));
-        let delta = t_hi.add(t_lo);
-        let scale = t_hi.to_f64().abs() + t_lo.to_f64().abs();
-        let mut on_separatrix = delta.to_f64().abs() <= SEPARATRIX_RTOL * scale;
-        let (s, r) = if on_separatrix || signum0(delta) > 0.0 {
-            (hi, lo)
-        } else {
-            (lo, hi)
-        };
-        let chi = if s == (b + 1) % 3 { 1.0 } else { -1.0 };
-        let dsb = diff(s, b).to_f64();
-        let a_ = dsb.abs();
-        let b_ = diff(b, r).to_f64().abs();
-        let c_ = diff(s, r).to_f64().abs();
-        let (mb, mr, ms) = (m0[b], m0[r], m0[s]);
-        // Amplitudes as hypotenuses: no square underflows or overflows.
-        let x = mb.hypot((c_ / a_).sqrt() * mr);
-        let r_abs = mr.hypot((a_ / c_).sqrt() * mb);
-        let s_abs = ms.hypot((b_ / c_).sqrt() * mb);
-        let omega = a_.sqrt() * (b_.sqrt() * mb).hypot(c_.sqrt() * ms);
-        let s_amp = if ms < 0.0 { -s_abs } else { s_abs };
-        let r_amp = -chi * dsb.signum() * s_amp.signum() * r_abs;
-        let idx = [b, r, s];
-        let amp = [x, r_amp, s_amp];
-        if !(omega > 0.0 && x > 0.0 && r_abs > 0.0 && s_abs > 0.0) {
-            // Unreachable for finite M off the axes: each amplitude is at
-            // least one non-zero |M_i| (off the axes two are non-zero).
-            return Err(Error::InvalidArgument {
-                what: "Euler top",
-                reason: format!(
-                    "degenerate amplitudes (omega = {omega:e}, X = {x:e}) for M0 = {m0:?}, W = {wv:?}"
-                ),
-            });
-        }
+        let ax = TriaxialAxes::of(w, m0);
+        let amp = ax.amplitudes(w, m0)?;
         // k' = √(1 − m) = (μ/ω) √(|Δ'| C): no underflow down to μ ~ 1e-308.
-        let kc = (mu / omega) * (delta.to_f64().abs() * c_).sqrt();
+        let kc = (ax.mu / amp.omega) * (ax.delta.to_f64().abs() * ax.c_).sqrt();
         // A k' below the double range (μ subnormal): the separatrix to the
         // last bit; its period would exceed ~1400/ω.
-        on_separatrix |= kc == 0.0;
-        if on_separatrix {
-            // sech > 0: M_r and M_s keep their signs, so R̃ takes the sign of
-            // M_r and the equations fix the direction of the motion instead:
-            // −R̃ ω = χ (W_s − W_b) S̃ X gives the sign of ω.
-            let r_amp = if mr < 0.0 { -r_abs } else { r_abs };
-            let omega = -chi * dsb.signum() * (s_amp * r_amp).signum() * omega;
-            // tanh u0 = M_b/X, sech u0 = |M_s|/S: sinh u0 = (M_b/X)(S/|M_s|).
-            let u0 = (mb / x * (s_abs / ms.abs())).asinh();
-            return Ok(EulerTop {
-                m0,
-                w,
-                motion: Motion::Separatrix {
-                    idx,
-                    amp: [x, r_amp, s_amp],
-                    omega,
-                    u0,
-                },
-                regime: EulerRegime::Separatrix,
-                params: [1.0, 0.0, omega.abs()],
-            });
+        if ax.on_separatrix || kc == 0.0 {
+            return Ok(Self::separatrix(w, m0, &ax, &amp));
         }
-        let q = (a_ * b_).sqrt() * x / omega;
+        Self::elliptic(w, m0, &ax, &amp, kc)
+    }
+
+    /// On the separatrix (`Δ = 0`, `m = 1`): `sn → tanh`, `cn, dn → sech`.
+    fn separatrix(w: [Dd; 3], m0: [f64; 3], ax: &TriaxialAxes, amp: &Amplitudes) -> Self {
+        let (mb, mr, ms) = (m0[ax.b], m0[ax.r], m0[ax.s]);
+        let Amplitudes {
+            x,
+            r_abs,
+            s_abs,
+            omega,
+            s_amp,
+            ..
+        } = *amp;
+        // sech > 0: M_r and M_s keep their signs, so R̃ takes the sign of
+        // M_r and the equations fix the direction of the motion instead:
+        // −R̃ ω = χ (W_s − W_b) S̃ X gives the sign of ω.
+        let r_amp = if mr < 0.0 { -r_abs } else { r_abs };
+        let omega = -ax.chi * ax.dsb.signum() * (s_amp * r_amp).signum() * omega;
+        // tanh u0 = M_b/X, sech u0 = |M_s|/S: sinh u0 = (M_b/X)(S/|M_s|).
+        let u0 = (mb / x * (s_abs / ms.abs())).asinh();
+        EulerTop {
+            m0,
+            w,
+            motion: Motion::Separatrix {
+                idx: [ax.b, ax.r, ax.s],
+                amp: [x, r_amp, s_amp],
+                omega,
+                u0,
+            },
+            regime: EulerRegime::Separatrix,
+            params: [1.0, 0.0, omega.abs()],
+        }
+    }
+
+    /// Off the separatrix: `sn, cn, dn` of parameter `m < 1`, `k' = kc`.
+    fn elliptic(
+        w: [Dd; 3],
+        m0: [f64; 3],
+        ax: &TriaxialAxes,
+        amp: &Amplitudes,
+        kc: f64,
+    ) -> Result<Self> {
+        let (mb, mr, ms) = (m0[ax.b], m0[ax.r], m0[ax.s]);
+        let Amplitudes {
+            x,
+            omega,
+            s_amp,
+            r_amp,
+            ..
+        } = *amp;
+        let q = (ax.a_ * ax.b_).sqrt() * x / omega;
         let m = (q * q).min(1.0);
         let jac = Jacobi::with_kc(m, kc.min(1.0))?;
         let m1 = kc * kc;
@@ -283,8 +381,8 @@ impl EulerTop {
             m0,
             w,
             motion: Motion::Elliptic {
-                idx,
-                amp,
+                idx: [ax.b, ax.r, ax.s],
+                amp: [x, r_amp, s_amp],
                 jac: Box::new(jac),
                 nu,
                 x0: u0 / period,

@@ -350,90 +350,139 @@ pub fn monodromy(m: &Motion) -> Result<Monodromy> {
 /// [`monodromy`], checking `cancel` every few thousand steps (a map of many
 /// Euler states must stop on Ctrl-C; one state can take up to ~0.1 s).
 pub fn monodromy_with(m: &Motion, cancel: &Cancel) -> Result<Monodromy> {
-    let (emb, top) = m.euler().ok_or(Error::InvalidArgument {
-        what: "state l0",
-        reason: format!(
-            "the motion is of kind '{}', not an Euler top",
-            m.kind().name()
-        ),
-    })?;
-    if matches!(top.regime(), EulerRegime::Rest | EulerRegime::Separatrix) {
-        return Err(Error::InvalidArgument {
+    let orbit = Orbit::of(m)?;
+    let mut n = orbit.first_steps()?;
+    let (cos, sin) = orbit.converged_invariant(&mut n, cancel)?;
+    Ok(classify(cos, sin, n))
+}
+
+/// A periodic Euler orbit of (1): what the Magnus steps along it need.
+struct Orbit<'a> {
+    emb: Embedding,
+    c4: &'a [f64; 6],
+    top: &'a EulerTop,
+    /// The period `T` of the orbit.
+    period: f64,
+    /// `max ‖A‖` (row sums) at 64 points of the period: the rate of the
+    /// transverse rotation, which sets the steps and the rounding floor.
+    norm_a: f64,
+}
+
+impl<'a> Orbit<'a> {
+    /// The orbit of an Euler motion; errors for another kind of motion or a
+    /// motion without period (rest, separatrix).
+    fn of(m: &'a Motion) -> Result<Self> {
+        let (emb, top) = m.euler().ok_or(Error::InvalidArgument {
             what: "state l0",
-            reason: "the Euler motion has no period (at rest or on its separatrix)".into(),
-        });
-    }
-    let period = 1.0 / top.frequency();
-    let c4 = &m.frame().c4;
-    let norm_a = (0..64)
-        .map(|k| {
-            let a = coefficient(*emb, c4, &top.m(period * k as f64 / 64.0));
-            a.iter()
-                .map(|r| r.iter().map(|v| v.abs()).sum::<f64>())
-                .fold(0.0f64, f64::max)
-        })
-        .fold(0.0f64, f64::max);
-    let first = (norm_a * period).ceil().max(MIN_STEPS as f64);
-    if first.is_nan() || first > MAX_STEPS as f64 {
-        return Err(Error::NoConvergence {
-            what: "transverse monodromy of the Euler orbit (steps per period)",
-            tol: MONODROMY_TOL,
-            reached: f64::INFINITY,
-            iterations: MAX_STEPS,
-        });
-    }
-    let mut n = (first as usize).next_power_of_two();
-    let cap = (n << MAX_DOUBLINGS).min(MAX_STEPS);
-    // Values at n, 2n, 4n, … and their Richardson extrapolations
-    // r = v_2n + (v_2n − v_n)/63 (sixth order: the error of r is O(h^8)).
-    let mut prev = invariant(*emb, &propagate(*emb, c4, top, period, n, cancel)?);
-    let mut prev_r: Option<(f64, f64)> = None;
-    loop {
-        let next_n = 2 * n;
-        let phi = propagate(*emb, c4, top, period, next_n, cancel)?;
-        let cur = invariant(*emb, &phi);
-        n = next_n;
-        // Clearly hyperbolic at both counts: θ does not exist, ν_⊥ = 0; the
-        // exponent needs no more digits.
-        if cur.1.is_nan()
-            && cur.0.abs() > 1.0 + HYPERBOLIC_MARGIN
-            && prev.0.abs() > 1.0 + HYPERBOLIC_MARGIN
-        {
-            prev = cur;
-            break;
-        }
-        let r = (
-            cur.0 + (cur.0 - prev.0) / 63.0,
-            cur.1 + (cur.1 - prev.1) / 63.0,
-        );
-        prev = cur;
-        if let Some(pr) = prev_r {
-            let scale = r.0.abs().max(size(&phi));
-            let change = ((r.0 - pr.0).abs() / scale).max(if r.1.is_nan() {
-                0.0
-            } else {
-                (r.1 - pr.1).abs()
+            reason: format!(
+                "the motion is of kind '{}', not an Euler top",
+                m.kind().name()
+            ),
+        })?;
+        if matches!(top.regime(), EulerRegime::Rest | EulerRegime::Separatrix) {
+            return Err(Error::InvalidArgument {
+                what: "state l0",
+                reason: "the Euler motion has no period (at rest or on its separatrix)".into(),
             });
-            // The data fix θ only to the rounding of the total transverse
-            // rotation (‖A‖ T radians) and of the n-fold product.
-            let floor = 8.0 * f64::EPSILON * (norm_a * period + (n as f64).sqrt());
-            if change <= MONODROMY_TOL.max(floor) {
-                prev = r;
-                break;
-            }
-            if n >= cap {
-                return Err(Error::NoConvergence {
-                    what: "transverse monodromy of the Euler orbit",
-                    tol: MONODROMY_TOL,
-                    reached: change,
-                    iterations: n,
-                });
-            }
         }
-        prev_r = Some(r);
+        let period = 1.0 / top.frequency();
+        let c4 = &m.frame().c4;
+        let norm_a = (0..64)
+            .map(|k| {
+                let a = coefficient(*emb, c4, &top.m(period * k as f64 / 64.0));
+                a.iter()
+                    .map(|r| r.iter().map(|v| v.abs()).sum::<f64>())
+                    .fold(0.0f64, f64::max)
+            })
+            .fold(0.0f64, f64::max);
+        Ok(Orbit {
+            emb: *emb,
+            c4,
+            top,
+            period,
+            norm_a,
+        })
     }
-    let (cos, sin) = prev;
-    Ok(if !sin.is_nan() {
+
+    /// The first step count: `‖A‖ T` steps, at least [`MIN_STEPS`], rounded up
+    /// to a power of two; errors if that is beyond [`MAX_STEPS`].
+    fn first_steps(&self) -> Result<usize> {
+        let first = (self.norm_a * self.period).ceil().max(MIN_STEPS as f64);
+        if first.is_nan() || first > MAX_STEPS as f64 {
+            return Err(Error::NoConvergence {
+                what: "transverse monodromy of the Euler orbit (steps per period)",
+                tol: MONODROMY_TOL,
+                reached: f64::INFINITY,
+                iterations: MAX_STEPS,
+            });
+        }
+        Ok((first as usize).next_power_of_two())
+    }
+
+    /// `Φ(T)` with `n` Magnus steps ([`propagate`]).
+    fn propagate(&self, n: usize, cancel: &Cancel) -> Result<M3> {
+        propagate(self.emb, self.c4, self.top, self.period, n, cancel)
+    }
+
+    /// The invariant of `Φ(T)` ([`invariant`]) to [`MONODROMY_TOL`] (or the
+    /// rounding floor): step counts doubled from `*n` and Richardson
+    /// extrapolated, `*n` left at the last count used.
+    fn converged_invariant(&self, n: &mut usize, cancel: &Cancel) -> Result<(f64, f64)> {
+        let emb = self.emb;
+        let cap = (*n << MAX_DOUBLINGS).min(MAX_STEPS);
+        // Values at n, 2n, 4n, … and their Richardson extrapolations
+        // r = v_2n + (v_2n − v_n)/63 (sixth order: the error of r is O(h^8)).
+        let mut prev = invariant(emb, &self.propagate(*n, cancel)?);
+        let mut prev_r: Option<(f64, f64)> = None;
+        loop {
+            let next_n = 2 * *n;
+            let phi = self.propagate(next_n, cancel)?;
+            let cur = invariant(emb, &phi);
+            *n = next_n;
+            // Clearly hyperbolic at both counts: θ does not exist, ν_⊥ = 0; the
+            // exponent needs no more digits.
+            if cur.1.is_nan()
+                && cur.0.abs() > 1.0 + HYPERBOLIC_MARGIN
+                && prev.0.abs() > 1.0 + HYPERBOLIC_MARGIN
+            {
+                return Ok(cur);
+            }
+            let r = (
+                cur.0 + (cur.0 - prev.0) / 63.0,
+                cur.1 + (cur.1 - prev.1) / 63.0,
+            );
+            prev = cur;
+            if let Some(pr) = prev_r {
+                let scale = r.0.abs().max(size(&phi));
+                let change = ((r.0 - pr.0).abs() / scale).max(if r.1.is_nan() {
+                    0.0
+                } else {
+                    (r.1 - pr.1).abs()
+                });
+                // The data fix θ only to the rounding of the total transverse
+                // rotation (‖A‖ T radians) and of the n-fold product.
+                let floor = 8.0 * f64::EPSILON * (self.norm_a * self.period + (*n as f64).sqrt());
+                if change <= MONODROMY_TOL.max(floor) {
+                    return Ok(r);
+                }
+                if *n >= cap {
+                    return Err(Error::NoConvergence {
+                        what: "transverse monodromy of the Euler orbit",
+                        tol: MONODROMY_TOL,
+                        reached: change,
+                        iterations: *n,
+                    });
+                }
+            }
+            prev_r = Some(r);
+        }
+    }
+}
+
+/// The monodromy from the converged invariant `(cos θ, sin θ)` (a rotation)
+/// or `((tr Φ − 1)/2, NaN)` (a block: elliptic within `[−1, 1]`, else hyperbolic).
+fn classify(cos: f64, sin: f64, n: usize) -> Monodromy {
+    if !sin.is_nan() {
         Monodromy {
             kind: Transverse::Elliptic,
             angle_or_exponent: sin.atan2(cos),
@@ -452,7 +501,7 @@ pub fn monodromy_with(m: &Motion, cancel: &Cancel) -> Result<Monodromy> {
             angle_or_exponent: (cos.abs() + (cos * cos - 1.0).sqrt()).ln(),
             steps: n,
         }
-    })
+    }
 }
 
 /// `(ν_⊥, ν_E)` of an Euler motion in the user's time (see the module docs:
