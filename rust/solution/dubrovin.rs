@@ -459,70 +459,28 @@ pub fn half_period_velocities_lo(
     }
     let lv = Level::new(k, l0)?;
     let lr = lv.rounded();
-    // The states at the four half periods in double, the two smallest first.
-    let mut hps: Vec<(f64, HalfPeriod<C>)> = (1..5)
-        .map(|p| {
-            let hp = half_period(&lr, p);
-            (size2(&hp.l), hp)
-        })
-        .filter(|(s, _)| s.is_finite())
-        .collect();
-    hps.sort_by(|x, y| x.0.total_cmp(&y.0));
-    if hps.len() < 2 {
-        return Err(Error::InvalidArgument {
-            what: CLOSED_FORM,
-            reason: "fewer than two half periods give a finite state".into(),
-        });
-    }
+    let hps = two_smallest_half_periods(&lr)?;
     let l0size2: f64 = l0.iter().map(|x| x * x).sum();
-    let check_ratio2 = (hps[1].0 / l0size2).max(1.0);
-    // The DD states, built when first needed.
-    let mut best_dd: Option<HalfPeriod<Cdd>> = None;
-    let mut check_dd: Option<HalfPeriod<Cdd>> = None;
+    let mut at = HalfPeriodPair {
+        check_ratio2: (hps[1].0 / l0size2).max(1.0),
+        lv: &lv,
+        lr: &lr,
+        hps: &hps,
+        best_dd: None,
+        check_dd: None,
+        dd,
+    };
     let mut v = Vec::with_capacity(cs.len());
     let mut v_dd = Vec::with_capacity(cs.len());
     let mut agreement = 0.0f64;
     for (q, c4) in cs.iter().enumerate() {
         let c = c_dd(c4, cs_lo.get(q).unwrap_or(&[0.0; 6]));
-        let cc = c.map(|x| x.to_c());
         // The result in the precision asked, the check in double; where they
         // miss (double loses digits on widely spread d_j, ~1e-11 at |d_4| ~
         // 1e9), both again in DD.
-        let mut attempt = |full: bool| -> ([Cdd; 2], f64, f64) {
-            let (va, ra) = if dd || full {
-                let hp = best_dd.get_or_insert_with(|| half_period(&lv, hps[0].1.p));
-                velocity_at(&lv, hp, &c)
-            } else {
-                let (v, r) = velocity_at(&lr, &hps[0].1, &cc);
-                (v.map(Cdd::new), r)
-            };
-            let (vb, rb, ratio2) = if full {
-                let hp = check_dd.get_or_insert_with(|| half_period(&lv, hps[1].1.p));
-                let (v, r) = velocity_at(&lv, hp, &c);
-                (v.map(|z| z.to_c()), r, 1.0)
-            } else {
-                let (v, r) = velocity_at(&lr, &hps[1].1, &cc);
-                (v, r, check_ratio2)
-            };
-            let a = va.map(|z| z.to_c());
-            let scale = a[0].norm().max(a[1].norm());
-            let dev = |s: f64| (a[0] - s * vb[0]).norm().max((a[1] - s * vb[1]).norm());
-            let dist = dev(1.0).min(dev(-1.0)) / scale.max(f64::MIN_POSITIVE);
-            let finite = a.iter().all(|z| z.re.is_finite() && z.im.is_finite());
-            // a zero flow (b constant) has V = 0: nothing to compare
-            let worst = if !finite {
-                f64::INFINITY
-            } else if scale == 0.0 {
-                0.0
-            } else {
-                // the check's errors scale with the square of its state ratio
-                (dist.max(rb) / ratio2).max(ra)
-            };
-            (va, worst, dist)
-        };
-        let (mut va, mut worst, mut dist) = attempt(false);
+        let (mut va, mut worst, mut dist) = at.attempt(&c, false);
         if worst.is_nan() || worst > HALF_PERIOD_AGREE_RTOL {
-            (va, worst, dist) = attempt(true);
+            (va, worst, dist) = at.attempt(&c, true);
         }
         if worst.is_nan() || worst > HALF_PERIOD_AGREE_RTOL {
             return Err(Error::InvalidArgument {
@@ -548,6 +506,81 @@ pub fn half_period_velocities_lo(
         v_dd,
         branch_points_dd: lv.d,
     })
+}
+
+/// The states at the four half periods in double, the two smallest first
+/// (`|l|²` and the half period); at least two finite ones.
+fn two_smallest_half_periods(lr: &Level<C>) -> Result<Vec<(f64, HalfPeriod<C>)>> {
+    let mut hps: Vec<(f64, HalfPeriod<C>)> = (1..5)
+        .map(|p| {
+            let hp = half_period(lr, p);
+            (size2(&hp.l), hp)
+        })
+        .filter(|(s, _)| s.is_finite())
+        .collect();
+    hps.sort_by(|x, y| x.0.total_cmp(&y.0));
+    if hps.len() < 2 {
+        return Err(Error::InvalidArgument {
+            what: CLOSED_FORM,
+            reason: "fewer than two half periods give a finite state".into(),
+        });
+    }
+    Ok(hps)
+}
+
+/// The half period with the smallest state (the result) and the next one (the
+/// check), in double and, built when first needed, in DD.
+struct HalfPeriodPair<'a> {
+    lv: &'a Level<Cdd>,
+    lr: &'a Level<C>,
+    hps: &'a [(f64, HalfPeriod<C>)],
+    best_dd: Option<HalfPeriod<Cdd>>,
+    check_dd: Option<HalfPeriod<Cdd>>,
+    /// The check's `|l|²` over `|l0|²` (at least 1): its errors scale with it.
+    check_ratio2: f64,
+    dd: bool,
+}
+
+impl HalfPeriodPair<'_> {
+    /// The velocity of the flow `c` at the result's half period (in DD with
+    /// `dd` or `full`, else in double), the worst of its residual and its
+    /// distance from the check (in DD with `full`, else in double), and that
+    /// distance.
+    fn attempt(&mut self, c: &[Cdd; 6], full: bool) -> ([Cdd; 2], f64, f64) {
+        let cc = c.map(|x| x.to_c());
+        let (va, ra) = if self.dd || full {
+            let (lv, p) = (self.lv, self.hps[0].1.p);
+            let hp = self.best_dd.get_or_insert_with(|| half_period(lv, p));
+            velocity_at(self.lv, hp, c)
+        } else {
+            let (v, r) = velocity_at(self.lr, &self.hps[0].1, &cc);
+            (v.map(Cdd::new), r)
+        };
+        let (vb, rb, ratio2) = if full {
+            let (lv, p) = (self.lv, self.hps[1].1.p);
+            let hp = self.check_dd.get_or_insert_with(|| half_period(lv, p));
+            let (v, r) = velocity_at(self.lv, hp, c);
+            (v.map(|z| z.to_c()), r, 1.0)
+        } else {
+            let (v, r) = velocity_at(self.lr, &self.hps[1].1, &cc);
+            (v, r, self.check_ratio2)
+        };
+        let a = va.map(|z| z.to_c());
+        let scale = a[0].norm().max(a[1].norm());
+        let dev = |s: f64| (a[0] - s * vb[0]).norm().max((a[1] - s * vb[1]).norm());
+        let dist = dev(1.0).min(dev(-1.0)) / scale.max(f64::MIN_POSITIVE);
+        let finite = a.iter().all(|z| z.re.is_finite() && z.im.is_finite());
+        // a zero flow (b constant) has V = 0: nothing to compare
+        let worst = if !finite {
+            f64::INFINITY
+        } else if scale == 0.0 {
+            0.0
+        } else {
+            // the check's errors scale with the square of its state ratio
+            (dist.max(rb) / ratio2).max(ra)
+        };
+        (va, worst, dist)
+    }
 }
 
 /// Lattice coordinates of the velocities, with the real structure imposed.
@@ -604,101 +637,20 @@ pub(crate) fn lattice_rates_dd(
     e_lo: Option<&[C]>,
     v: &[[Cdd; 2]],
 ) -> Result<LatticeRates> {
-    use nalgebra::{Matrix4, Vector4};
-    let (a, b) = curve.periods();
-    let cols: [[C; 2]; 4] = [
-        [a[(0, 0)], a[(1, 0)]],
-        [a[(0, 1)], a[(1, 1)]],
-        [b[(0, 0)], b[(1, 0)]],
-        [b[(0, 1)], b[(1, 1)]],
-    ];
-    let pdd = match e_lo {
-        Some(lo) => curve.periods_dd(lo)?,
-        None => None,
-    };
-    // Π as a real 4 × 4 matrix (rows Re, Re, Im, Im), in DD.
-    let pi_dd: [[Dd; 4]; 4] = std::array::from_fn(|r| {
-        std::array::from_fn(|k| {
-            let z = match &pdd {
-                Some(p) if k < 2 => p.a[r % 2][k],
-                Some(p) => p.b[r % 2][k - 2],
-                None => Cdd::new(cols[k][r % 2]),
-            };
-            if r < 2 {
-                z.re
-            } else {
-                z.im
-            }
-        })
-    });
-    let real4 = |z: [C; 2]| Vector4::new(z[0].re, z[1].re, z[0].im, z[1].im);
-    let pi = Matrix4::from_fn(|r, k| pi_dd[r][k].to_f64());
-    let lu = pi.lu();
-    // Three refinements reach DD accuracy; with double periods one is as
-    // good as the periods.
-    let steps = if pdd.is_some() { 3 } else { 1 };
-    let solve = |rhs: [Dd; 4]| -> Option<[Dd; 4]> {
-        let mut w = [Dd::ZERO; 4];
-        for _ in 0..steps {
-            let res: [f64; 4] = std::array::from_fn(|r| {
-                (0..4)
-                    .fold(rhs[r], |acc, k| acc.sub(pi_dd[r][k].mul(w[k])))
-                    .to_f64()
-            });
-            let dw = lu.solve(&Vector4::from(res))?;
-            w = std::array::from_fn(|k| w[k].add(Dd::new(dw[k])));
-        }
-        w.iter().all(|x| x.hi.is_finite()).then_some(w)
-    };
+    let pm = PeriodMatrix::new(curve, e_lo)?;
     let singular = || Error::InvalidArgument {
         what: CLOSED_FORM,
         reason: "the period matrix [A B] is singular as a real 4 x 4 matrix".into(),
     };
     let mut w: Vec<[Dd; 4]> = v
         .iter()
-        .map(|z| solve([z[0].re, z[1].re, z[0].im, z[1].im]).ok_or_else(singular))
+        .map(|z| {
+            pm.solve([z[0].re, z[1].re, z[0].im, z[1].im])
+                .ok_or_else(singular)
+        })
         .collect::<Result<_>>()?;
-    // The involution: the candidate D that fixes every velocity (at least one
-    // of them non-zero) and maps the lattice to itself (found in double: T is
-    // an integer matrix).
-    let i = C::new(0.0, 1.0);
-    let one = C::new(1.0, 0.0);
     let vc: Vec<[C; 2]> = v.iter().map(|z| z.map(|x| x.to_c())).collect();
-    let nonzero = vc.iter().any(|z| z[0].norm().max(z[1].norm()) > 0.0);
-    let mut involution = None;
-    for dg in [[one, one], [-one, -one], [i, -i], [-i, i]] {
-        if !nonzero {
-            break;
-        }
-        let fixed = vc.iter().all(|z| {
-            let moved = (dg[0] * z[0].conj() - z[0])
-                .norm()
-                .max((dg[1] * z[1].conj() - z[1]).norm());
-            moved <= FIXED_TOL * z[0].norm().max(z[1].norm())
-        });
-        if !fixed {
-            continue;
-        }
-        let mut t = [[0i64; 4]; 4];
-        let mut ok = true;
-        for (k, col) in cols.iter().enumerate() {
-            let image = real4([dg[0] * col[0].conj(), dg[1] * col[1].conj()]);
-            match lu.solve(&image) {
-                Some(tk) => {
-                    for r in 0..4 {
-                        let n = tk[r].round();
-                        ok &= (tk[r] - n).abs() <= INTEGER_TOL && n.abs() < 1e6;
-                        t[r][k] = n as i64;
-                    }
-                }
-                None => ok = false,
-            }
-        }
-        if ok {
-            involution = Some(t);
-            break;
-        }
-    }
+    let involution = pm.involution(&vc);
     if let Some(t) = involution {
         for wf in &mut w {
             let tw: [Dd; 4] = std::array::from_fn(|r| {
@@ -727,9 +679,118 @@ pub(crate) fn lattice_rates_dd(
         u,
         w: hi,
         w_lo: lo,
-        periods_dd: pdd.is_some(),
+        periods_dd: pm.dd,
         involution,
     })
+}
+
+/// `Π = [A B]` as a real 4 × 4 matrix (rows Re, Re, Im, Im), in DD where the
+/// periods are, with the LU factors of its double for the refinements.
+struct PeriodMatrix {
+    /// The columns of `Π` in double (a- then b-periods).
+    cols: [[C; 2]; 4],
+    pi_dd: [[Dd; 4]; 4],
+    lu: nalgebra::LU<f64, nalgebra::Const<4>, nalgebra::Const<4>>,
+    /// Whether the periods entered in DD.
+    dd: bool,
+}
+
+impl PeriodMatrix {
+    fn new(curve: &HyperellipticCurve, e_lo: Option<&[C]>) -> Result<Self> {
+        let (a, b) = curve.periods();
+        let cols: [[C; 2]; 4] = [
+            [a[(0, 0)], a[(1, 0)]],
+            [a[(0, 1)], a[(1, 1)]],
+            [b[(0, 0)], b[(1, 0)]],
+            [b[(0, 1)], b[(1, 1)]],
+        ];
+        let pdd = match e_lo {
+            Some(lo) => curve.periods_dd(lo)?,
+            None => None,
+        };
+        let pi_dd: [[Dd; 4]; 4] = std::array::from_fn(|r| {
+            std::array::from_fn(|k| {
+                let z = match &pdd {
+                    Some(p) if k < 2 => p.a[r % 2][k],
+                    Some(p) => p.b[r % 2][k - 2],
+                    None => Cdd::new(cols[k][r % 2]),
+                };
+                if r < 2 {
+                    z.re
+                } else {
+                    z.im
+                }
+            })
+        });
+        let pi = nalgebra::Matrix4::from_fn(|r, k| pi_dd[r][k].to_f64());
+        Ok(PeriodMatrix {
+            cols,
+            pi_dd,
+            lu: pi.lu(),
+            dd: pdd.is_some(),
+        })
+    }
+
+    /// `Π w = rhs` in DD: the double LU refined with DD residuals, three
+    /// times with DD periods (DD accuracy), once with double ones (as good as
+    /// the periods). `None` where `Π` is singular or `w` not finite.
+    fn solve(&self, rhs: [Dd; 4]) -> Option<[Dd; 4]> {
+        let steps = if self.dd { 3 } else { 1 };
+        let mut w = [Dd::ZERO; 4];
+        for _ in 0..steps {
+            let res: [f64; 4] = std::array::from_fn(|r| {
+                (0..4)
+                    .fold(rhs[r], |acc, k| acc.sub(self.pi_dd[r][k].mul(w[k])))
+                    .to_f64()
+            });
+            let dw = self.lu.solve(&nalgebra::Vector4::from(res))?;
+            w = std::array::from_fn(|k| w[k].add(Dd::new(dw[k])));
+        }
+        w.iter().all(|x| x.hi.is_finite()).then_some(w)
+    }
+
+    /// The involution of the real structure: the integer matrix `T` of the
+    /// candidate `D` that fixes every velocity `vc` (at least one of them
+    /// non-zero) and maps the lattice to itself (found in double: `T` is an
+    /// integer matrix); `None` where no candidate does.
+    fn involution(&self, vc: &[[C; 2]]) -> Option<[[i64; 4]; 4]> {
+        let real4 = |z: [C; 2]| nalgebra::Vector4::new(z[0].re, z[1].re, z[0].im, z[1].im);
+        let i = C::new(0.0, 1.0);
+        let one = C::new(1.0, 0.0);
+        if !vc.iter().any(|z| z[0].norm().max(z[1].norm()) > 0.0) {
+            return None;
+        }
+        for dg in [[one, one], [-one, -one], [i, -i], [-i, i]] {
+            let fixed = vc.iter().all(|z| {
+                let moved = (dg[0] * z[0].conj() - z[0])
+                    .norm()
+                    .max((dg[1] * z[1].conj() - z[1]).norm());
+                moved <= FIXED_TOL * z[0].norm().max(z[1].norm())
+            });
+            if !fixed {
+                continue;
+            }
+            let mut t = [[0i64; 4]; 4];
+            let mut ok = true;
+            for (k, col) in self.cols.iter().enumerate() {
+                let image = real4([dg[0] * col[0].conj(), dg[1] * col[1].conj()]);
+                match self.lu.solve(&image) {
+                    Some(tk) => {
+                        for r in 0..4 {
+                            let n = tk[r].round();
+                            ok &= (tk[r] - n).abs() <= INTEGER_TOL && n.abs() < 1e6;
+                            t[r][k] = n as i64;
+                        }
+                    }
+                    None => ok = false,
+                }
+            }
+            if ok {
+                return Some(t);
+            }
+        }
+        None
+    }
 }
 
 /// The closed form and the theta quotients' fit at `v0` agree on `V` to this,

@@ -47,6 +47,7 @@ use crate::riemann::HyperellipticCurve;
 use crate::so4;
 use crate::theta::{char_index, LatticeLanes, SelectedBlock, ThetaJet, ThetaPlan, BLOCK};
 
+mod build;
 mod check;
 pub mod constant;
 pub mod dubrovin;
@@ -65,6 +66,7 @@ pub use check::{
 pub use level_set::{a_periods_of, level_set_curve, LevelSetCurve};
 pub use setup::{INCONSISTENT, QUOTIENT_RESIDUAL_RTOL};
 
+use build::{Candidates, Divisor0, Phase};
 use check::{sign_patterns, Built, SelfCheck};
 use level_set::{abel_of_point, eps41, map_coinciding};
 use setup::{
@@ -224,135 +226,43 @@ impl Solution {
         crate::error::check_finite("c", c4)?;
         crate::error::check_finite("c_lo", c4_lo)?;
         let c4 = *c4;
-        let LevelSetCurve {
+        let d = Divisor0::new(a, l0)?;
+        let at_v0 = ThetaAtV0::new(&d.jet, &d.idx)?;
+        let sc = d.state0.curve.c().map(sqrt_principal);
+        let eps = eps41(&d.kotter);
+        // The constants C_L (37) and the signs l0 decides.
+        let est = at_v0.estimates(&d.state0, &sc);
+        let est0 = at_v0.votes().then(|| est.map(|r| r * r));
+        let c2 = aux_constants_squared(&d.curve, &d.state0.curve, &d.plan, &d.idx, &d.rc, est0)?;
+        let (cl0, calibration) = signed_constants(&c2, &est);
+        // Where the closed form refuses (none known), U is the theta
+        // quotients' fit at v0.
+        let closed = build::closed_velocity(&d, l0, &c4, c4_lo);
+        let cands = Candidates {
+            d: &d,
+            at_v0,
+            sc,
+            eps,
+            c4,
+            closed: &closed,
+            check: SelfCheck::new(a, l0, &c4),
+        };
+        let (self_check, Built { cl, num, den, rate }) = cands.best(&cl0, &calibration)?;
+        drop(cands);
+        let (x0, y0) = d.curve.lattice_coordinates(&d.v0);
+        let phase = Phase::new(&d.curve, &closed, rate);
+        let Divisor0 {
             kotter,
-            kcurve: _,
             curve,
             chars,
-        } = level_set_curve(a, l0)?;
-        let state0 = kotter_with(kotter.clone(), l0).map_err(map_coinciding)?;
-        let tau_rm = curve.tau_row_major();
-        let tau: [C; 4] = [tau_rm[0], tau_rm[1], tau_rm[2], tau_rm[3]];
-        let plan = ThetaPlan::new(&tau, 2, THETA_TOL, 1)?.with_parallel(false);
-        let rcv = curve.riemann_constant()?;
-        let rc = [rcv[0], rcv[1]];
-        let mut idx = [0usize; 8];
-        idx[0] = char_index(&[0, 0], &[0, 0])?;
-        for (m, ch) in chars.iter().enumerate() {
-            idx[m + 1] = char_index(&ch.0, &ch.1)?;
-        }
-        // The divisor of l0 and v0 = u(P1) + u(P2) + K.
-        let pts = &state0.points;
-        let ua = abel_of_point(&curve, pts.z1, pts.y1, &pts.zd1)?;
-        let ub = abel_of_point(&curve, pts.z2, pts.y2, &pts.zd2)?;
-        let u0 = [ua[0] + ub[0], ua[1] + ub[1]];
-        let v0 = [u0[0] + rc[0], u0[1] + rc[1]];
-        let jet = plan.jet(&v0, 1)?;
-        let at_v0 = ThetaAtV0::new(&jet, &idx)?;
-        let sc = state0.curve.c().map(sqrt_principal);
-        let eps = eps41(&kotter);
-        let est = at_v0.estimates(&state0, &sc);
-        let est0 = at_v0.votes().then(|| est.map(|r| r * r));
-        let c2 = aux_constants_squared(&curve, &state0.curve, &plan, &idx, &rc, est0)?;
-        let (cl0, calibration) = signed_constants(&c2, &est);
-        // U in closed form (Dubrovin's equations at the half periods,
-        // [`dubrovin`]), with its lattice coordinates in DD and the real
-        // structure imposed: one for every sign pattern of the C_L below. Where
-        // it refuses (none known), U is the theta quotients' fit at v0.
-        //
-        // With rounding errors `c4_lo`, two flows: `c4` as rounded, which the
-        // theta quotients, their velocity fit and the self-check below are
-        // consistent with (they evaluate (1) with `c4`), and `c4 + c4_lo`, the
-        // unrounded top, whose lattice rates give the phase of l(t) and `U`:
-        // the two differ by the rounding of c (relative ε times the condition
-        // of the differences c_kj − c_ik, ~1e-10 where two a_i nearly meet).
-        let exact_flow = c4_lo.iter().any(|v| *v != 0.0);
-        let (flows, flows_lo): (&[[f64; 6]], &[[f64; 6]]) = if exact_flow {
-            (&[c4, c4], &[[0.0; 6], *c4_lo])
-        } else {
-            (&[c4], &[])
-        };
-        let closed = dubrovin::half_period_velocities_lo(&kotter, l0, flows, flows_lo, true);
-        let closed = closed.and_then(|hp| {
-            let e_lo = hp.branch_point_errors(&curve);
-            let lat = dubrovin::lattice_rates_dd(&curve, e_lo.as_ref().map(|e| &e[..]), &hp.v_dd)?;
-            Ok((hp.v[0], lat))
-        });
-        // Every sign pattern of the constants that l0 leaves undecided is built
-        // and checked (check.rs); the one that passes the self-check best is kept.
-        let check = SelfCheck::new(a, l0, &c4);
-        let build = |cl: [C; 7]| -> Result<(f64, Built)> {
-            let big_g = at_v0.big_g(&state0, &sc, &cl, eps);
-            let (num, den) = quotient_weights(&kotter, &sc, eps, big_g, &cl);
-            // The quotients' own velocity at v0 by least squares (see
-            // [`VelocitySystem`]): a set-up whose quotients fit (1) for no
-            // velocity, or for another one than the closed form, is refused;
-            // the fit gives the closed form its sign.
-            let (fit, residual) = VelocitySystem::at(&jet, &idx, &num, &den)?.rate(&c4, "U")?;
-            check_velocity_fit(residual)?;
-            let rate = match &closed {
-                Ok((v, lat)) => {
-                    let (s, dev) = dubrovin::sign_against(&curve, v, &fit);
-                    dubrovin::check_against_fit(dev)?;
-                    lat.u[0].map(|z| s * z)
-                }
-                Err(_) => fit,
-            };
-            let built = Built { cl, num, den, rate };
-            Ok((check.defect(&plan, &curve, &idx, &built, &v0)?, built))
-        };
-        let mut best: Option<(f64, Built)> = None;
-        let mut last_err: Option<Error> = None;
-        for cl in sign_patterns(&cl0, &calibration) {
-            match build(cl) {
-                Ok((d, b)) if best.as_ref().is_none_or(|(bd, _)| d < *bd) => best = Some((d, b)),
-                Ok(_) => {}
-                Err(e) => last_err = Some(e),
-            }
-        }
-        let (self_check, Built { cl, num, den, rate }) = match (best, last_err) {
-            (Some(b), _) => b,
-            (None, Some(e)) => return Err(e),
-            (None, None) => {
-                return Err(Error::Unverified {
-                    what: "solution of l0",
-                    reason: "no sign of the constants C_L gives a solution".into(),
-                })
-            }
-        };
-        if self_check.is_nan() || self_check > SELF_CHECK_RTOL {
-            return Err(Error::Unverified {
-                what: "solution of l0",
-                reason: format!(
-                    "the theta quotients (9)-(10) fail the self-check: relative defect \
-                     {self_check:e} > {SELF_CHECK_RTOL:e} in Frahm's equations (1), the \
-                     integrals (6)-(7) or l(0) = l0 at points of the torus"
-                ),
-            });
-        }
-        let (x0, y0) = curve.lattice_coordinates(&v0);
-        let (rate, lat_rate, lat_rate_lo, v_sign) = match &closed {
-            Ok((_, lat)) => {
-                let u = lat.u[0];
-                let s = if (u[0].conj() * rate[0] + u[1].conj() * rate[1]).re >= 0.0 {
-                    1.0
-                } else {
-                    -1.0
-                };
-                // the unrounded top's flow (the last) for U and the phase
-                let k = lat.u.len() - 1;
-                (
-                    lat.u[k].map(|z| s * z),
-                    lat.w[k].map(|x| s * x),
-                    lat.w_lo[k].map(|x| s * x),
-                    s,
-                )
-            }
-            Err(_) => {
-                let (xr, yr) = curve.lattice_coordinates(&rate);
-                (rate, [xr[0], xr[1], yr[0], yr[1]], [0.0; 4], 1.0)
-            }
-        };
+            state0,
+            tau,
+            plan,
+            rc,
+            idx,
+            u0,
+            ..
+        } = d;
         Ok(Solution {
             a: *a,
             c4,
@@ -364,11 +274,11 @@ impl Solution {
             tau,
             rc,
             u0,
-            rate,
+            rate: phase.rate,
             lat0: [x0[0], x0[1], y0[0], y0[1]],
-            lat_rate,
-            lat_rate_lo,
-            v_sign,
+            lat_rate: phase.lat_rate,
+            lat_rate_lo: phase.lat_rate_lo,
+            v_sign: phase.v_sign,
             closed_u: closed.is_ok(),
             idx,
             chars,
