@@ -248,7 +248,6 @@ impl Solution {
             check: SelfCheck::new(a, l0, &c4),
         };
         let (self_check, Built { cl, num, den, rate }) = cands.best(&cl0, &calibration)?;
-        drop(cands);
         let (x0, y0) = d.curve.lattice_coordinates(&d.v0);
         let phase = Phase::new(&d.curve, &closed, rate);
         let Divisor0 {
