@@ -269,7 +269,10 @@ def main() -> None:
             f"{np.max(r[:, 9]):.1e}; Theorem > gauss16 on {len(worse)} of {len(r)}"
             + (f": {', '.join(names[i] for i in worse)}" if len(worse) else "")
         )
-    print(f"long-double integration (or loading it from --cache): {np.sum(r[:, 6]):.0f} s in all")
+    print(
+        f"long-double integration: {np.sum(r[:, 6]):.0f} s in all"
+        + (" (trajectories found in --cache are loaded, not integrated)" if args.cache else "")
+    )
 
 
 if __name__ == "__main__":
