@@ -83,35 +83,45 @@ impl ThetaPlan {
         ws: &mut Workspace,
         cancel: Option<&Cancel>,
     ) -> Result<()> {
-        let rows = G2Rows::new(self, wr);
+        let mut buf = [(0i64, 1i64, 0i64); G2_MAX_ROWS];
+        let rows = G2Rows::new(self, wr, &mut buf);
+        let j1c = rows.geom.j1c;
         let q11 = self.qmat[0];
-        let kc = round_i64(rows.row(rows.j1c).0);
-        let start = [rows.j1c, kc];
+        let kc = round_i64(rows.row(j1c).0);
+        let start = [j1c, kc];
         let e0 = self.log_term(&start, zr, wr).exp();
         let a0 = self.ratio(1, &start, zr);
         let bup = self.ratio(0, &start, zr);
         let up = G2Cursor {
-            j1: rows.j1c,
+            j1: j1c,
             k: kc,
             e: e0,
             a: a0,
             ainv: self.qmat[3] / a0,
             bs: bup,
         };
-        self.walk_g2::<ORDER>(1, &rows, up, ws, cancel)?;
         let mut down = G2Cursor {
             bs: q11 / bup,
             ..up
         };
         // the first row of the downward pass is j1c - 1
         down.next_row(q11, self.qinv[1], self.qmat[1], -1);
-        self.walk_g2::<ORDER>(-1, &rows, down, ws, cancel)
+        // Without a token the walk has no poll at all: the check per row cost
+        // ~2.5 % of a single genus-2 point.
+        if cancel.is_some() {
+            self.walk_g2::<ORDER, true>(1, &rows, up, ws, cancel)?;
+            self.walk_g2::<ORDER, true>(-1, &rows, down, ws, cancel)
+        } else {
+            self.walk_g2::<ORDER, false>(1, &rows, up, ws, None)?;
+            self.walk_g2::<ORDER, false>(-1, &rows, down, ws, None)
+        }
     }
 
     /// One pass of [`ThetaPlan::sum_g2`] over the rows from the cursor's on,
-    /// upward (`dir = 1`) or downward (`dir = -1`).
+    /// upward (`dir = 1`) or downward (`dir = -1`); `POLL`: check `cancel`
+    /// every [`ROWS_PER_CHECK`] rows.
     #[inline(always)]
-    fn walk_g2<const ORDER: usize>(
+    fn walk_g2<const ORDER: usize, const POLL: bool>(
         &self,
         dir: i64,
         rows: &G2Rows,
@@ -122,8 +132,11 @@ impl ThetaPlan {
         let (q11, q12, q22) = (self.qmat[0], self.qmat[1], self.qmat[3]);
         let (q12i, q22i) = (self.qinv[1], self.qinv[3]);
         let (q12s, q12si) = if dir == 1 { (q12, q12i) } else { (q12i, q12) };
-        while (dir == 1 && cur.j1 <= rows.j1max) || (dir == -1 && cur.j1 >= rows.j1min) {
-            poll(ws, cancel)?;
+        let (j1min, j1max) = (rows.geom.j1min, rows.geom.j1max);
+        while (dir == 1 && cur.j1 <= j1max) || (dir == -1 && cur.j1 >= j1min) {
+            if POLL {
+                poll(ws, cancel)?;
+            }
             let (target, lo, hi) = rows.bounds(cur.j1);
             if lo <= hi {
                 while cur.k < target {
@@ -249,7 +262,20 @@ impl ThetaPlan {
 
 /// The rows of the genus-2 ellipsoid `Q(j/2 + w_r) < R²/π`: the range of
 /// `j1`, the start row, and per row the cursor target and the range of `j2`.
-struct G2Rows {
+///
+/// The table of row bounds lives in the caller's frame (`table`, borrowed):
+/// held by value it made this struct 2.3 kB, returned and copied with two
+/// `memcpy` calls per theta evaluation (+11 % on a single genus-2 point).
+struct G2Rows<'t> {
+    geom: G2Geometry,
+    /// `bounds_of(j1min + r)`, when there are at most [`G2_MAX_ROWS`] rows
+    /// (else empty: computed per row).
+    table: &'t [(i64, i64, i64)],
+}
+
+/// The scalars of [`G2Rows`].
+#[derive(Clone, Copy)]
+struct G2Geometry {
     rq: f64,
     d1: f64,
     d2: f64,
@@ -258,18 +284,19 @@ struct G2Rows {
     j1min: i64,
     j1max: i64,
     j1c: i64,
-    /// `bounds_of(j1min + r)`, when there are at most [`G2_MAX_ROWS`] rows.
-    table: [(i64, i64, i64); G2_MAX_ROWS],
-    precomputed: bool,
 }
 
 /// Rows are short (~10 terms): computing all bounds first lets the square
 /// roots overlap instead of sitting on each row's critical path.
 const G2_MAX_ROWS: usize = 96;
 
-impl G2Rows {
+impl<'t> G2Rows<'t> {
     #[inline(always)]
-    fn new(plan: &ThetaPlan, wr: &[f64]) -> G2Rows {
+    fn new(
+        plan: &ThetaPlan,
+        wr: &[f64],
+        buf: &'t mut [(i64, i64, i64); G2_MAX_ROWS],
+    ) -> G2Rows<'t> {
         let (d1, d2, l21) = (plan.ldl_d[0], plan.ldl_d[1], plan.ldl_l[2]);
         let rq = plan.rq;
         let h1 = (rq / d1).sqrt();
@@ -277,7 +304,7 @@ impl G2Rows {
         let j1max = floor_i64(2.0 * (h1 - wr[0]));
         let j1c = round_i64(-2.0 * wr[0]).clamp(j1min.min(j1max), j1max.max(j1min));
         let nrows = (j1max - j1min + 1).max(0) as usize;
-        let mut rows = G2Rows {
+        let geom = G2Geometry {
             rq,
             d1,
             d2,
@@ -286,17 +313,34 @@ impl G2Rows {
             j1min,
             j1max,
             j1c,
-            table: [(0i64, 1i64, 0i64); G2_MAX_ROWS],
-            precomputed: nrows <= G2_MAX_ROWS,
         };
-        if rows.precomputed {
-            for r in 0..nrows {
-                rows.table[r] = rows.bounds_of(j1min + r as i64);
+        let table: &[(i64, i64, i64)] = if nrows <= G2_MAX_ROWS {
+            for (r, slot) in buf[..nrows].iter_mut().enumerate() {
+                *slot = geom.bounds_of(j1min + r as i64);
             }
-        }
-        rows
+            &buf[..nrows]
+        } else {
+            &[]
+        };
+        G2Rows { geom, table }
     }
 
+    #[inline(always)]
+    fn row(&self, j1: i64) -> (f64, f64) {
+        self.geom.row(j1)
+    }
+
+    #[inline(always)]
+    fn bounds(&self, j1: i64) -> (i64, i64, i64) {
+        if !self.table.is_empty() {
+            self.table[(j1 - self.geom.j1min) as usize]
+        } else {
+            self.geom.bounds_of(j1)
+        }
+    }
+}
+
+impl G2Geometry {
     /// Centre and half-width (in `j2` units) of row `j1`; a negative width for
     /// a row outside the ellipsoid.
     #[inline(always)]
@@ -322,15 +366,6 @@ impl G2Rows {
             (0, 1, 0)
         } else {
             (round_i64(c), ceil_i64(c - hw), floor_i64(c + hw))
-        }
-    }
-
-    #[inline(always)]
-    fn bounds(&self, j1: i64) -> (i64, i64, i64) {
-        if self.precomputed {
-            self.table[(j1 - self.j1min) as usize]
-        } else {
-            self.bounds_of(j1)
         }
     }
 }
