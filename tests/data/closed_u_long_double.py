@@ -223,9 +223,9 @@ def main() -> None:
         g16 = cached(
             args.cache,
             "_g16",
-            lambda top=top, l0=l0, tq=tq: top.integrate(
-                l0, args.t_end, t_eval=tq, dt=top.default_dt(l0) / 4
-            ).l,
+            lambda top=top, l0=l0, tq=tq: (
+                top.integrate(l0, args.t_end, t_eval=tq, dt=top.default_dt(l0) / 4).l
+            ),
             a,
             b,
             l0,
