@@ -7,7 +7,7 @@ use rayon::prelude::*;
 use super::dopri5::Dopri5;
 use super::explicit::Explicit;
 use super::gauss::{run_gauss, GaussDyn, GaussFixed};
-use super::{batch, dop853, gauss_tables, taylor};
+use super::{batch, batch_dop853, dop853, gauss_tables, taylor};
 use super::{check_budget, check_sample_times, Method, Options, Trajectory, VectorField, LANES};
 use crate::error::{check_finite, Error, Result};
 use crate::numeric::alloc::{check_size, try_collect, try_vec};
@@ -405,14 +405,14 @@ fn lane_groups(
             map_chunks(y0s, out, gy, go, parallel, group)
         }
         _ => {
-            let o8 = batch::Dop853Opts {
+            let o8 = batch_dop853::Dop853Opts {
                 h0: opts.dt,
                 rtol: opts.rtol,
                 atol: opts.atol,
                 max_steps: opts.max_steps,
             };
             let group = |(y0, o): (&[f64], &mut [f64])| {
-                batch::dop853_group(c, y0, t0, times, o8, o, cancel)
+                batch_dop853::dop853_group(c, y0, t0, times, o8, o, cancel)
             };
             map_chunks(y0s, out, gy, go, parallel, group)
         }

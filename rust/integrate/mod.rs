@@ -51,6 +51,7 @@
 //! `taylor.rs`: the trajectory-lane kernels.
 
 mod batch;
+mod batch_dop853;
 mod dop853;
 mod dopri5;
 mod driver;
