@@ -59,15 +59,17 @@ pub enum Error {
     /// No real torus carries the motion (the frequency maps, `crate::tori`):
     /// `failure` says why. Python sees a `ValueError`.
     NoRealTorus { failure: TorusFailure },
-    /// The computation was cancelled (Ctrl-C in Python; see [`crate::numeric::cancel`]).
+    /// The computation was cancelled (Ctrl-C in Python; see `numeric::cancel`).
     Interrupted,
-    /// `count` items of `what` would take `bytes` bytes, more than one call may
-    /// allocate ([`crate::numeric::alloc::MAX_BYTES`]); checked before any work.
-    /// Python sees a `MemoryError` (as numpy's for an array it cannot allocate).
+    /// `count` items of `what` would take `bytes` bytes, more than the `limit`
+    /// one call may allocate (`numeric::alloc::MAX_BYTES`); checked before any
+    /// work. Python sees a `MemoryError` (as numpy's for an array it cannot
+    /// allocate).
     TooLarge {
         what: &'static str,
         count: usize,
         bytes: f64,
+        limit: f64,
     },
     /// `bytes` bytes for `what`, within the budget, could not be allocated.
     /// Python sees a `MemoryError`.
@@ -181,12 +183,17 @@ impl fmt::Display for Error {
             ),
             Error::NoRealTorus { failure } => write!(f, "invalid real torus: {failure}"),
             Error::Interrupted => write!(f, "interrupted"),
-            Error::TooLarge { what, count, bytes } => write!(
+            Error::TooLarge {
+                what,
+                count,
+                bytes,
+                limit,
+            } => write!(
                 f,
                 "cannot allocate {bytes:.0} bytes ({:.4} GiB) for {what} of {count} items: \
                  more than the {:.0} GiB one call may allocate; split the work into smaller calls",
                 bytes / GIB,
-                crate::numeric::alloc::MAX_BYTES as f64 / GIB
+                limit / GIB
             ),
             Error::OutOfMemory { what, bytes } => write!(
                 f,

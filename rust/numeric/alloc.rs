@@ -40,6 +40,7 @@ pub fn check_size(what: &'static str, count: usize, bytes_each: usize) -> Result
             what,
             count,
             bytes: count as f64 * bytes_each as f64,
+            limit: MAX_BYTES as f64,
         }),
     }
 }
