@@ -53,6 +53,7 @@ pub mod constant;
 pub mod dubrovin;
 pub mod euler;
 pub mod jacobi;
+mod lattice;
 mod level_set;
 pub mod motion;
 pub mod normalize;
