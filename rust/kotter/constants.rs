@@ -189,11 +189,7 @@ pub fn constants_from_h(a: &[f64; 4], h: &[f64; 4]) -> Result<KotterConstants> {
 /// in `h` loses all its digits near the singular set `m = ±n`, this product
 /// does not.
 fn den_from_state(m: &[f64; 3], n: &[f64; 3]) -> f64 {
-    let (mut dm, mut dp) = (0.0, 0.0);
-    for j in 0..3 {
-        dm += (m[j] - n[j]) * (m[j] - n[j]);
-        dp += (m[j] + n[j]) * (m[j] + n[j]);
-    }
+    let [dp, dm] = crate::so4::casimir_factors(&super::l_from_m_n(m, n));
     dm * dp
 }
 

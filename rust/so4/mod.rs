@@ -415,12 +415,16 @@ pub fn poisson_tensor(n: usize, l: &[f64], out: &mut [f64]) {
 /// relative accuracy (a difference of nearby components is exact), where
 /// `H1² − 4H0²`, their product, formed from `H0` and `H1` cancels to rounding
 /// near the self-dual states `m = ±n` (a one-factor rotation, `n = 0` or `m = 0`).
+///
+/// The terms are summed in the order of `|m ± n|²` with Kötter's `m = (l23,
+/// −l13, l12)`, `n = (l14, l24, l34)` (13), so that the reduction's
+/// denominator of (19), `|m − n|² |m + n|²`, is this product to the bit.
 pub fn casimir_factors(l: &[f64; 6]) -> [f64; 2] {
     let [l12, l13, l14, l23, l24, l34] = *l;
     let sq = |x: f64, y: f64, z: f64| x * x + y * y + z * z;
     [
-        sq(l12 + l34, l14 + l23, l13 - l24),
-        sq(l12 - l34, l14 - l23, l13 + l24),
+        sq(l23 + l14, l24 - l13, l12 + l34),
+        sq(l23 - l14, l13 + l24, l12 - l34),
     ]
 }
 

@@ -155,11 +155,12 @@ impl Motion {
         let body = match kind {
             Kind::Rest | Kind::Spherical | Kind::Equilibrium => Body::Constant,
             Kind::Euler | Kind::Separatrix => {
-                let emb = Embedding::of_state(&ln).ok_or(Error::InvalidArgument {
-                    what: "l0",
-                    reason: "classified as an Euler top but in no invariant subspace".into(),
-                });
-                let emb = emb.map_err(refusal)?;
+                let emb = Embedding::of_state(&ln)
+                    .ok_or(Error::InvalidArgument {
+                        what: "l0",
+                        reason: "classified as an Euler top but in no invariant subspace".into(),
+                    })
+                    .map_err(refusal)?;
                 let top = EulerTop::new(emb.w_of(&frame.c4), emb.m_of(&ln)).map_err(refusal)?;
                 Body::Euler {
                     emb,
