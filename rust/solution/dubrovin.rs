@@ -272,8 +272,9 @@ impl Level<Cdd> {
     }
 }
 
-/// The six `c_ij` of (2) (state order) as given, in DD. They arrive in
-/// double (`(b_i − b_j)/(a_i − a_j)` rounded, or normalized): six rounded
+/// The six `c_ij` of (2) (state order) in DD: `c4 + lo`, `lo` their rounding
+/// errors from the exact quotients of the double `a, b`
+/// (`normalize::c_rounding`; zero where not known). Rounded alone, six
 /// numbers are of the form (2) only to rounding, so the half periods agree to
 /// about that (far inside [`HALF_PERIOD_AGREE_RTOL`]), not to DD. A least-squares
 /// `b` does not help: on a top with one small spacing it moves that `c_ij` by
