@@ -43,6 +43,38 @@ pub fn two_prod(a: f64, b: f64) -> (f64, f64) {
     (p, ((ah * bh - p) + ah * bl + al * bh) + al * bl)
 }
 
+/// The exact product as a parameter: Dekker's from Veltkamp's split
+/// everywhere, or one fused multiply-add where the caller runs in code
+/// compiled for it (`#[target_feature(enable = "fma")]`, chosen at run time).
+/// Both give the same bits: the product's error is exact either way (for
+/// `|a|, |b| < 2^995` and no underflow).
+/// An error-free product `a b = p + e`.
+pub(crate) trait ExactProd {
+    fn two_prod(a: f64, b: f64) -> (f64, f64);
+}
+
+/// Dekker's product from Veltkamp's split (17 flops, any CPU).
+pub(crate) struct Veltkamp;
+
+impl ExactProd for Veltkamp {
+    #[inline(always)]
+    fn two_prod(a: f64, b: f64) -> (f64, f64) {
+        two_prod(a, b)
+    }
+}
+
+/// The product's error by one fused multiply-add. Only for callers compiled
+/// with the `fma` target feature: elsewhere `mul_add` is a library call.
+pub(crate) struct Fused;
+
+impl ExactProd for Fused {
+    #[inline(always)]
+    fn two_prod(a: f64, b: f64) -> (f64, f64) {
+        let p = a * b;
+        (p, a.mul_add(b, -p))
+    }
+}
+
 /// `Σ x_i y_i` in twice the working precision, rounded once (the Dot2
 /// algorithm of Ogita, Rump and Oishi, SIAM J. Sci. Comput. 26 (2005)):
 /// error-free products by `fma`, error-free sums by [`two_sum`], the errors

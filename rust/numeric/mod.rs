@@ -6,6 +6,8 @@
 //! * [`dd`]: double-double real and complex numbers built on them (the
 //!   reduction's level-set constants, `crate::kotter`; the separatrix test and
 //!   `1 − m` of the Euler tops, `crate::solution::euler`).
+//! * [`first_order`]: complex values with their first-order rounding error
+//!   (compensated arithmetic; the double-double periods' node sums).
 //! * [`complex`]: the principal square root with the crate's one branch cut
 //!   and Smith's complex division.
 //! * [`cancel`]: cooperative cancellation ([`cancel::Cancel`]), the poll of a
@@ -21,4 +23,5 @@ pub mod cancel;
 pub mod compensated;
 pub mod complex;
 pub mod dd;
+pub(crate) mod first_order;
 pub mod tol;
