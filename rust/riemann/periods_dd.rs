@@ -17,7 +17,9 @@ use std::sync::OnceLock;
 use super::quad::{self, SegmentSqrt};
 use super::HyperellipticCurve;
 use crate::error::Result;
+use crate::numeric::compensated::{ExactProd, Fused, Veltkamp};
 use crate::numeric::dd::{Cdd, Dd};
+use crate::numeric::first_order::{cmul_err, Cc};
 
 type C = Complex64;
 
@@ -82,9 +84,11 @@ fn rule_dd(n: usize) -> RuleDd {
     }
 }
 
-/// The Chebyshev node counts of the double quadrature, and their DD rules.
-const LADDER: [usize; 16] = [
-    6, 8, 10, 12, 16, 20, 24, 32, 40, 48, 64, 80, 96, 128, 160, 192,
+/// The Chebyshev node counts, and their DD rules (built once each): steps of
+/// at most ~1/6, since every node of a rounded-up count is paid per curve.
+const LADDER: [usize; 25] = [
+    6, 8, 10, 12, 14, 16, 18, 20, 24, 28, 32, 36, 40, 48, 56, 64, 72, 80, 96, 112, 128, 144, 160,
+    176, 192,
 ];
 static RULES: [OnceLock<RuleDd>; LADDER.len()] = [const { OnceLock::new() }; LADDER.len()];
 
@@ -174,6 +178,106 @@ fn gl_rule_dd(n: usize) -> &'static GlDd {
     GL_RULES[i].get_or_init(|| gl_dd(GL_LADDER[i]))
 }
 
+/// One Chebyshev edge `x = mid + h t` with the other branch points (with
+/// their rounding errors) and the rotations of their square roots.
+struct ChebEdge {
+    mid: Cc,
+    h: Cc,
+    others: Vec<(Cc, SegmentSqrt)>,
+    /// `1/Π c^{-1/2}` of the rotations.
+    inv_unrot: C,
+}
+
+/// A DD value as a double and its rounding error.
+fn first_order(z: Cdd) -> Cc {
+    let hi = z.to_c();
+    Cc::new(hi, z.sub(Cdd::new(hi)).to_c())
+}
+
+/// `acc[i] += x^i / Π_m φ_m(x)` over the nodes `t` (DD: `hi + lo`) of one
+/// Chebyshev edge, each term to `O(u²)` relative with its first-order error
+/// ([`Cc`]): `x` and the factors `w_m = x − e_m` carry the rounding errors of
+/// the nodes, of `mid`, `h` and of the branch points; `1/P` with
+/// `P² = Π w_m` is `q0 (1 − E/2)`, `q0 = 1/p0` for `p0` the double product of
+/// the roots on the branches of the double route and `E = Q q0² − 1` (of
+/// order `u`, so `E²` is below the target).
+fn cheb_node_sums(edge: &ChebEdge, nodes: &[Dd], acc: &mut [Cc]) {
+    #[cfg(target_arch = "x86_64")]
+    {
+        if std::is_x86_feature_detected!("fma") {
+            // SAFETY: the CPU supports FMA (checked just above).
+            return unsafe { cheb_node_sums_fma(edge, nodes, acc) };
+        }
+    }
+    cheb_node_sums_body::<Veltkamp>(edge, nodes, acc)
+}
+
+/// [`cheb_node_sums`] compiled with FMA: each exact product is one
+/// instruction instead of Dekker's seventeen (the same bits).
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "fma")]
+unsafe fn cheb_node_sums_fma(edge: &ChebEdge, nodes: &[Dd], acc: &mut [Cc]) {
+    cheb_node_sums_body::<Fused>(edge, nodes, acc)
+}
+
+#[inline(always)]
+fn cheb_node_sums_body<M: ExactProd>(edge: &ChebEdge, nodes: &[Dd], acc: &mut [Cc]) {
+    let one = C::new(1.0, 0.0);
+    let n = acc.len();
+    for t in nodes {
+        let x = edge.mid.add(edge.h.mul_real::<M>(t.hi, t.lo));
+        let mut q = Cc::new(one, C::new(0.0, 0.0));
+        // Π √(c_m w_m) as ±√(Π c_m w_m): one root instead of one per factor
+        // (the divider was the bottleneck). Each c_m w_m lies in the right
+        // half plane, so the argument of the partial products is the sum of
+        // theirs until it passes ±π, where the principal root of the product
+        // changes sign against the product of the roots: counted by the signs
+        // of the imaginary parts, as the principal root itself decides them.
+        let mut prod = one;
+        let mut flip = false;
+        for (k, (e, s)) in edge.others.iter().enumerate() {
+            let w = x.sub(*e);
+            let v = s.turn(w.hi);
+            let next = if k == 0 { v } else { prod * v };
+            if k > 0
+                && ((prod.im > 0.0 && v.im > 0.0 && next.im < 0.0)
+                    || (prod.im < 0.0 && v.im < 0.0 && next.im >= 0.0))
+            {
+                flip = !flip;
+            }
+            prod = next;
+            q = if k == 0 { w } else { q.mul::<M>(w) };
+        }
+        // 1/√prod = conj(√prod)/|prod| (principal root, Kahan's form)
+        let ss = prod.norm_sqr();
+        let r = if ss.is_normal() && ss < f64::MAX {
+            ss.sqrt()
+        } else {
+            prod.re.hypot(prod.im)
+        };
+        let im = prod.im + 0.0;
+        let tt = (0.5 * (r + prod.re.abs())).sqrt();
+        let root = if prod.re >= 0.0 {
+            C::new(tt, im / (2.0 * tt))
+        } else {
+            C::new(im.abs() / (2.0 * tt), tt.copysign(im))
+        };
+        let inv_r = if flip { -1.0 / r } else { 1.0 / r };
+        let q0 = edge.inv_unrot * (root.conj() * inv_r);
+        let (s_hi, s_err) = cmul_err::<M>(q0, q0);
+        let m = q.mul::<M>(Cc::new(s_hi, s_err));
+        // m.hi ≈ 1: its real part minus 1 is exact (Sterbenz)
+        let e = C::new(m.hi.re - 1.0, m.hi.im) + m.lo;
+        let mut f = Cc::new(q0, -0.5 * (q0 * e));
+        for (i, a) in acc.iter_mut().enumerate() {
+            *a = a.add(f);
+            if i + 1 < n {
+                f = f.mul::<M>(x);
+            }
+        }
+    }
+}
+
 /// The period matrices in DD: `a[i][j] = ∮_{a_j} x^i dx/y`, `b` likewise.
 #[derive(Debug, Clone)]
 pub(crate) struct PeriodsDd {
@@ -207,10 +311,13 @@ impl HyperellipticCurve {
             });
         }
         let g = self.g;
+        // e_lo in the internal coordinate x / 2^k (exact)
+        let down = 2f64.powi(-self.scale_exp);
+        let lo: Vec<C> = e_lo.iter().map(|v| v * down).collect();
         let mut edge = Vec::with_capacity(self.cycle_edges.len());
         for &ce in &self.cycle_edges {
             let (p, q) = self.tree[ce];
-            match self.edge_period_dd(p, q, e_lo) {
+            match self.edge_period_dd(p, q, &lo) {
                 Some(per) => edge.push(per),
                 None => return Ok(None),
             }
@@ -225,7 +332,8 @@ impl HyperellipticCurve {
                     continue;
                 }
                 for i in 0..g {
-                    let v = per[i].mul_f64(coef);
+                    // row i in the user's coordinate (a power of 2: exact)
+                    let v = per[i].mul_f64(coef * self.period_row_scale(i));
                     if j < g {
                         a[i][j] = a[i][j].add(v);
                     } else {
@@ -238,8 +346,17 @@ impl HyperellipticCurve {
     }
 
     /// The loop period of the tree edge `p → q` in DD (see `edge_period`):
-    /// `∮ ω_i = −2i ∫_{−1}^{1} x^i / Π_{k≠p,q} φ_k dt/√(1 − t²)`.
+    /// `∮ ω_i = −2i ∫_{−1}^{1} x^i / Π_{k≠p,q} φ_k dt/√(1 − t²)`, by
+    /// Chebyshev over the whole edge, else (a branch point near an end) as two
+    /// halves from the ends. `e_lo` in the internal coordinate.
     fn edge_period_dd(&self, p: usize, q: usize, e_lo: &[C]) -> Option<Vec<Cdd>> {
+        self.edge_period_cheb_dd(p, q, e_lo)
+            .or_else(|| self.edge_period_halves_dd(p, q, e_lo))
+    }
+
+    /// [`Self::edge_period_dd`] by Chebyshev over the whole edge, `None` where
+    /// a branch point near an end needs the halves.
+    fn edge_period_cheb_dd(&self, p: usize, q: usize, e_lo: &[C]) -> Option<Vec<Cdd>> {
         let g = self.g;
         let ed = |k: usize| Cdd::from_parts(self.e[k], e_lo[k]);
         let half = Dd::new(0.5);
@@ -252,33 +369,36 @@ impl HyperellipticCurve {
             .iter()
             .map(|&k| SegmentSqrt::new(mid_c - self.e[k] - h_c, 2.0 * h_c))
             .collect();
+        let segs_unrot = segs.iter().fold(C::new(1.0, 0.0), |u, s| u * s.unrot());
         let lr = super::basis::edge_quality(&self.e, p, q);
         let nc = (TARGET_LN_DD / (2.0 * lr)).ceil();
         if !(nc.is_finite() && nc <= quad::CHEB_MAX as f64) {
-            // A branch point near an end: two halves from the ends.
-            return self.edge_period_halves_dd(p, q, e_lo);
+            return None;
         }
         let rule = cheb_rule_dd(nc as usize)?;
-        let mut per = vec![Cdd::ZERO; g];
-        let mut ws = Vec::with_capacity(others.len());
-        for &t in &rule.nodes {
-            let x = mid.add(h.mul_dd(t));
-            ws.clear();
-            let mut p0 = C::new(1.0, 0.0);
-            for (&k, s) in others.iter().zip(&segs) {
-                let w = x.sub(ed(k));
-                p0 *= s.eval(w.to_c());
-                ws.push(w);
-            }
-            let f = inv_root_product(&ws, p0).mul_dd(rule.weight);
-            let mut xp = f;
-            for v in per.iter_mut() {
-                *v = v.add(xp);
-                xp = xp.mul(x);
-            }
-        }
-        // × (−2i)
-        Some(per.into_iter().map(|v| v.mul_i().mul_f64(-2.0)).collect())
+        let edge = ChebEdge {
+            mid: first_order(mid),
+            h: first_order(h),
+            others: others
+                .iter()
+                .zip(segs)
+                .map(|(&k, s)| (first_order(ed(k)), s))
+                .collect(),
+            inv_unrot: crate::numeric::complex::cdiv(C::new(1.0, 0.0), segs_unrot),
+        };
+        let mut acc = vec![Cc::ZERO; g];
+        cheb_node_sums(&edge, &rule.nodes, &mut acc);
+        // × weight × (−2i)
+        Some(
+            acc.into_iter()
+                .map(|v| {
+                    Cdd::from_parts(v.hi, v.lo)
+                        .mul_dd(rule.weight)
+                        .mul_i()
+                        .mul_f64(-2.0)
+                })
+                .collect(),
+        )
     }
 
     /// The loop period of the edge `p → q` as twice the difference of the
@@ -451,6 +571,41 @@ mod tests {
             for j in 0..2 {
                 assert!((pd.a[i][j].to_c() - a[(i, j)]).norm() <= 1e-14 * scale);
                 assert!((pd.b[i][j].to_c() - b[(i, j)]).norm() <= 1e-14 * scale);
+            }
+        }
+    }
+
+    /// On a curve beyond the internal scale (`|e_4|` = 9e22, the curve of a
+    /// state 1e-7 from an so(3) block of 'physical'), the DD periods are in
+    /// the user's coordinate like [`HyperellipticCurve::periods`]: the branch
+    /// points' errors enter scaled, the rows come back scaled (they were mixed
+    /// before, off by powers of 2^76).
+    #[test]
+    fn dd_periods_of_a_rescaled_curve_are_in_the_users_coordinate() {
+        let e = [
+            C::new(0.0, 0.0),
+            C::new(0.0, 50461376.96848367),
+            C::new(0.0, 15739201.518415319),
+            C::new(0.0, -114122608.17868833),
+            C::new(0.0, 9.063866112046367e+22),
+        ];
+        let curve = HyperellipticCurve::new(&e).unwrap();
+        assert!(curve.scale_exp != 0);
+        let pd = curve.periods_dd(&[C::new(0.0, 0.0); 5]).unwrap().unwrap();
+        let (a, b) = curve.periods();
+        for i in 0..2 {
+            let row = (0..2)
+                .map(|j| a[(i, j)].norm().max(b[(i, j)].norm()))
+                .fold(0.0f64, f64::max);
+            for j in 0..2 {
+                assert!(
+                    (pd.a[i][j].to_c() - a[(i, j)]).norm() <= 1e-13 * row,
+                    "a {i}{j}"
+                );
+                assert!(
+                    (pd.b[i][j].to_c() - b[(i, j)]).norm() <= 1e-13 * row,
+                    "b {i}{j}"
+                );
             }
         }
     }
