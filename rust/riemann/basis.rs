@@ -4,6 +4,7 @@
 //! §3–4, specialised to `m = 2`; the intersection rule below is derived in
 //! docs/riemann.md).
 
+use crate::numeric::complex::Modulus;
 use num_complex::Complex64;
 use std::cmp::Ordering;
 
@@ -60,14 +61,14 @@ pub fn edge_quality(e: &[C], p: usize, q: usize) -> f64 {
 /// `|w + v| − |v| = (|w|² + 2 Re(w v̄))/(|w + v| + |v|)` — no difference of
 /// nearly equal numbers — and `ln ρ = acosh(1 + x) = log1p(x + √(x(x + 2)))`.
 fn log_rho_near_end(ep: C, eq: C, em: C) -> f64 {
-    let (near, far) = if (em - ep).norm() <= (em - eq).norm() {
+    let (near, far) = if (em - ep).modulus() <= (em - eq).modulus() {
         (ep, eq)
     } else {
         (eq, ep)
     };
     let w = em - near;
     let v = near - far;
-    let (aw, av, awv) = (w.norm(), v.norm(), (w + v).norm());
+    let (aw, av, awv) = (w.modulus(), v.modulus(), (w + v).modulus());
     let x = (aw + (aw * aw + 2.0 * (w * v.conj()).re) / (awv + av)) / av;
     // Its rounding error is a few u |w|/|v|: below that the point lies on the
     // segment to rounding (x = 0, as the plain form has it), whatever its offset.

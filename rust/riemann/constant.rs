@@ -159,6 +159,27 @@ impl HyperellipticCurve {
         let found = [kidx];
         let k_char = crate::theta::char_from_index(g, found[0]);
         let k = self.half_period(&k_char.0, &k_char.1);
+        Ok(Derived {
+            plan,
+            k_char,
+            k,
+            calib: OnceLock::new(),
+        })
+    }
+
+    /// The calibration of the Jacobi inversion start ([`Derived::calib`]),
+    /// built on the first inversion: a curve that is only integrated over
+    /// (periods, Abel map, `K`) never needs it.
+    pub(super) fn calibration(&self) -> Result<&Calibration> {
+        let d = self.derived()?;
+        d.calib
+            .get_or_init(|| self.build_calibration(&d.plan, &d.k))
+            .as_ref()
+            .map_err(|e| e.clone())
+    }
+
+    fn build_calibration(&self, plan: &ThetaPlan, k: &[C]) -> Result<Calibration> {
+        let g = self.g;
         let mut calib = Vec::new();
         if g == 2 && self.e.len() == 5 {
             let (x1, y1) = self.test_point(0, 0);
@@ -178,20 +199,15 @@ impl HyperellipticCurve {
                 )));
             }
         } else if g == 2 && self.e.len() == 6 {
-            calib = self.calibrate_even(&plan, &k)?;
+            calib = self.calibrate_even(plan, k)?;
         }
-        Ok(Derived {
-            plan,
-            k_char,
-            k,
-            calib,
-        })
+        Ok(calib)
     }
 
     /// Degree 6: for each `j = 1..5` the pair of characteristics `(num, den)`
     /// with `(x1−e_j)(x2−e_j)/((x1−e_0)(x2−e_0)) · θ[den](v)²/θ[num](v)²`
     /// constant (relative [`K_SEARCH_RTOL`]) over four fixed divisors.
-    fn calibrate_even(&self, plan: &ThetaPlan, k: &[C]) -> Result<Vec<Option<(C, usize, usize)>>> {
+    fn calibrate_even(&self, plan: &ThetaPlan, k: &[C]) -> Result<Calibration> {
         let mut divs = Vec::new();
         for t in 0..4 {
             let (x1, y1) = self.test_point(t, 0);

@@ -45,7 +45,7 @@ impl HyperellipticCurve {
                 ),
             });
         }
-        let (p, s) = self.symmetric_start(&d.calib, &vals)?;
+        let (p, s) = self.symmetric_start(self.calibration()?, &vals)?;
         let disc = sqrt_principal(s * s - 4.0 * p);
         let mut x1 = 0.5 * (s + disc);
         let mut x2 = 0.5 * (s - disc);

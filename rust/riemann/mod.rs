@@ -163,6 +163,10 @@ pub struct HyperellipticCurve {
     derived: OnceLock<std::result::Result<Derived, Error>>,
 }
 
+/// The calibration of the Jacobi inversion start: per branch point `j`,
+/// `(c_j, num, den)` or `None` ([`Derived`]'s `calib`).
+type Calibration = Vec<Option<(C, usize, usize)>>;
+
 /// Theta plan, Riemann constant and inversion calibration (built on first use).
 #[derive(Debug, Clone)]
 struct Derived {
@@ -174,7 +178,7 @@ struct Derived {
     /// `f_j = (x1−e_j)(x2−e_j)` for odd `n` (then `num = η(e_j)`, `den = 0`, (34))
     /// and `f_j = (x1−e_j)(x2−e_j)/((x1−e_1)(x2−e_1))`, `j ≥ 1`, for even `n`
     /// (characteristics found numerically). `None` where none was found.
-    calib: Vec<Option<(C, usize, usize)>>,
+    calib: OnceLock<std::result::Result<Calibration, Error>>,
 }
 
 fn is_finite_c(v: C) -> bool {

@@ -5,6 +5,7 @@
 //! `τ = A^{-1} B` (Molin & Neurohr 2019; docs/riemann.md).
 
 use super::*;
+use crate::numeric::complex::Modulus;
 
 /// Two branch points closer than this relative to their modulus are one
 /// (the curve is singular to double precision).
@@ -40,13 +41,16 @@ impl HyperellipticCurve {
             });
         }
         // The internal coordinate x / 2^k (module docs, "Scale").
-        let big = branch_points.iter().map(|v| v.norm()).fold(0.0, f64::max);
+        let big = branch_points
+            .iter()
+            .map(|v| v.modulus())
+            .fold(0.0, f64::max);
         let scale_exp = if big > MAX_ABS_BRANCH_POINT {
             let k = 2 * (big.log2() / 2.0).floor() as i32;
             if k * n as i32 / 2 > MAX_Y_SCALE_EXP {
                 let kmax = branch_points
                     .iter()
-                    .position(|v| v.norm() == big)
+                    .position(|v| v.modulus() == big)
                     .unwrap_or(0);
                 return Err(Error::InvalidArgument {
                     what: "branch_points",
@@ -62,8 +66,8 @@ impl HyperellipticCurve {
         };
         for i in 0..n {
             for j in (i + 1)..n {
-                let scale = branch_points[i].norm().max(branch_points[j].norm());
-                if (branch_points[i] - branch_points[j]).norm() <= REPEATED_RTOL * scale {
+                let scale = branch_points[i].modulus().max(branch_points[j].modulus());
+                if (branch_points[i] - branch_points[j]).modulus() <= REPEATED_RTOL * scale {
                     return Err(Error::RepeatedBranchPoints {
                         i,
                         j,
@@ -81,12 +85,14 @@ impl HyperellipticCurve {
         };
         let g = (n - 1) / 2;
         let center = e.iter().sum::<C>() / n as f64;
-        let radius = e.iter().map(|v| (v - center).norm()).fold(0.0, f64::max);
+        let radius = e.iter().map(|v| (v - center).modulus()).fold(0.0, f64::max);
 
         let tree = basis::spanning_tree(&e)?;
-        let e_abs = e.iter().map(|&v| v.norm()).collect();
-        let e_dist = (0..n * n).map(|i| (e[i / n] - e[i % n]).norm()).collect();
-        let c_dist = e.iter().map(|&v| (v - center).norm()).collect();
+        let e_abs = e.iter().map(|&v| v.modulus()).collect();
+        let e_dist = (0..n * n)
+            .map(|i| (e[i / n] - e[i % n]).modulus())
+            .collect();
+        let c_dist = e.iter().map(|&v| (v - center).modulus()).collect();
         let mut this = HyperellipticCurve {
             e,
             e_user,
@@ -139,7 +145,7 @@ impl HyperellipticCurve {
             .iter()
             .chain(b.iter())
             .all(|v| v.re.is_finite() && v.im.is_finite())
-            || a.iter().all(|v| v.norm() == 0.0)
+            || a.iter().all(|v| v.modulus() == 0.0)
         {
             let scale = self.e_abs.iter().fold(0.0f64, |m, &v| m.max(v));
             return Err(Error::InvalidArgument {
@@ -256,9 +262,9 @@ impl HyperellipticCurve {
         // `e_p − e_k`, `e_q − e_k` at the ends (elsewhere, as before, the same bits).
         let near_end = others.iter().any(|&k| {
             (self.e[p] - self.e[k])
-                .norm()
-                .min((self.e[q] - self.e[k]).norm())
-                < NEAR_END_FRACTION * (2.0 * h).norm()
+                .modulus()
+                .min((self.e[q] - self.e[k]).modulus())
+                < NEAR_END_FRACTION * (2.0 * h).modulus()
         });
         let start = |k: usize| {
             if near_end {

@@ -333,31 +333,41 @@ fn class_table(g: usize) -> Vec<usize> {
 /// Any `ρ' ≤ ρ` is a valid packing constant; a smaller one trades the factor
 /// `(2/ρ')^g` for a later start of the integral. Keeps the best radius.
 fn summation_radius(g: usize, rho: f64, sk: f64, order: usize, tol: f64) -> (f64, f64, f64, f64) {
-    let mut radius = f64::INFINITY;
-    let mut rho_used = rho;
-    for frac in [1.0, 0.75, 0.5, 0.3] {
-        let rp = rho * frac;
-        let r = radius_for(|r| output_error_bound(g, rp, r, sk, order), 0.5 * rp, tol);
-        if r < radius {
-            radius = r;
-            rho_used = rp;
-        }
-    }
+    let (radius, rho_used) = best_radius(rho, tol, |rp, r| output_error_bound(g, rp, r, sk, order));
     let rq = radius * radius / pi();
     let rq_values = if order == 0 {
         rq
     } else {
-        let r0 = [1.0, 0.75, 0.5, 0.3]
-            .iter()
-            .map(|&frac| {
-                let rp = rho * frac;
-                radius_for(|r| output_error_bound(g, rp, r, sk, 0), 0.5 * rp, tol)
-            })
-            .fold(f64::INFINITY, f64::min);
+        let (r0, _) = best_radius(rho, tol, |rp, r| output_error_bound(g, rp, r, sk, 0));
         // never above the plan's own radius (the bisection is to ~1e-5)
         (r0 * r0 / pi()).min(rq)
     };
     (radius, rho_used, rq, rq_values)
+}
+
+/// The smallest of the radii [`radius_for`] gives with the packing constants
+/// `ρ' = ρ · {0.3, 0.5, 0.75, 1}`, and its `ρ'` (the largest on a tie). A
+/// constant whose bound still exceeds `tol` at the best radius so far has its
+/// radius above it (the bound decreases in `R`, and the bisection ends where
+/// the bound is within `tol`), so it is not searched: the same result, at a
+/// fraction of the bound evaluations.
+fn best_radius(rho: f64, tol: f64, bound: impl Fn(f64, f64) -> f64) -> (f64, f64) {
+    let mut radius = f64::INFINITY;
+    let mut rho_used = rho;
+    // the smallest constant first: it usually gives the smallest radius
+    for frac in [0.3, 0.5, 0.75, 1.0] {
+        let rp = rho * frac;
+        if radius < 1e3 && bound(rp, radius) > tol {
+            continue;
+        }
+        let r = radius_for(|r| bound(rp, r), 0.5 * rp, tol);
+        // on a tie the larger constant, as when searched from the largest
+        if r < radius || (r == radius && rp > rho_used) {
+            radius = r;
+            rho_used = rp;
+        }
+    }
+    (radius, rho_used)
 }
 
 /// Truncation bound for values (`p = 0`), gradients and Hessians: with
