@@ -52,6 +52,7 @@ mod wurzel;
 pub(crate) use inverse::InverseStart;
 pub use inverse::INVERSE_RTOL;
 
+use crate::numeric::complex::Modulus;
 use num_complex::Complex64;
 
 use crate::error::{Error, Result};
@@ -169,8 +170,8 @@ impl KotterCurve {
         let d = [Complex64::new(0.0, 0.0), d1, d2, d3, d4];
         for i in 0..5 {
             for j in (i + 1)..5 {
-                let scale = d[i].norm().max(d[j].norm());
-                if (d[i] - d[j]).norm() <= REPEATED_RTOL * scale {
+                let scale = d[i].modulus().max(d[j].modulus());
+                if (d[i] - d[j]).modulus() <= REPEATED_RTOL * scale {
                     return Err(Error::RepeatedBranchPoints { i, j, value: d[i] });
                 }
             }
@@ -224,8 +225,8 @@ impl KotterCurve {
     /// Checks that `(z, y)` is a finite point of the curve (to [`ON_CURVE_RTOL`]).
     pub fn check_point(&self, what: &'static str, z: Complex64, y: Complex64) -> Result<()> {
         check_finite_c(what, &[z, y])?;
-        let scale: f64 = self.d.iter().map(|dj| z.norm() + dj.norm()).product();
-        let resid = (y * y - self.r(z)).norm();
+        let scale: f64 = self.d.iter().map(|dj| z.modulus() + dj.modulus()).product();
+        let resid = (y * y - self.r(z)).modulus();
         // A NaN residual (overflow of huge inputs) is rejected too.
         if resid.is_nan() || resid > ON_CURVE_RTOL * scale {
             return Err(Error::InvalidArgument {
@@ -279,10 +280,10 @@ impl KotterCurve {
     pub fn check_curve_point(&self, what: &'static str, p: &CurvePoint) -> Result<()> {
         check_finite_c(what, &[p.z, p.y])?;
         check_finite_c(what, &p.zd)?;
-        let dmax = self.d.iter().map(|v| v.norm()).fold(0.0, f64::max);
+        let dmax = self.d.iter().map(|v| v.modulus()).fold(0.0, f64::max);
         for j in 0..5 {
-            let err = (p.zd[j] - (p.z - self.d[j])).norm();
-            if err.is_nan() || err > OFFSET_RTOL * (p.z.norm() + dmax) {
+            let err = (p.zd[j] - (p.z - self.d[j])).modulus();
+            if err.is_nan() || err > OFFSET_RTOL * (p.z.modulus() + dmax) {
                 return Err(Error::InvalidArgument {
                     what,
                     reason: format!(
@@ -294,9 +295,13 @@ impl KotterCurve {
                 });
             }
         }
-        let scale: f64 = self.d.iter().map(|dj| p.z.norm() + dj.norm()).product();
+        let scale: f64 = self
+            .d
+            .iter()
+            .map(|dj| p.z.modulus() + dj.modulus())
+            .product();
         let r: Complex64 = p.zd.iter().product();
-        let resid = (p.y * p.y - r).norm();
+        let resid = (p.y * p.y - r).modulus();
         if resid.is_nan() || resid > ON_CURVE_RTOL * scale {
             return Err(Error::InvalidArgument {
                 what,

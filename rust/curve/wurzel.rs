@@ -194,60 +194,82 @@ pub(super) fn wurzel_from_roots(
     eps: &[f64; 5],
 ) -> Wurzel {
     let zero = Complex64::new(0.0, 0.0);
-    let one = Complex64::new(1.0, 0.0);
     let p: [Complex64; 5] = std::array::from_fn(|j| eps[j] * r1[j] * r2[j]);
+    let fq = factor_quotients(r1, r2, dz);
     let mut pjk = [[zero; 5]; 5];
     for j in 0..5 {
         for k in (j + 1)..5 {
-            // factors in the order j, k, then the complement
-            let mut idx = [j, k, 0, 0, 0];
-            for (n, m) in (2..).zip((0..5).filter(|&m| m != j && m != k)) {
-                idx[n] = m;
-            }
-            let fa: [Complex64; 5] =
-                std::array::from_fn(|i| if i < 2 { r2[idx[i]] } else { r1[idx[i]] });
-            let fb: [Complex64; 5] =
-                std::array::from_fn(|i| if i < 2 { r1[idx[i]] } else { r2[idx[i]] });
-            // (A_i − B_i)/(z1 − z2): for i < 2, A − B = r2 − r1 = −(r1 − r2)
-            let q: [Complex64; 5] = std::array::from_fn(|i| {
-                let m = idx[i];
-                let v = factor_quotient(r1[m], r2[m], dz);
-                if i < 2 {
-                    -v
-                } else {
-                    v
-                }
-            });
-            let mut suffix = [one; 6];
-            for i in (0..5).rev() {
-                suffix[i] = suffix[i + 1] * fb[i];
-            }
-            let mut prefix = one;
-            let mut sum = zero;
-            let mut size_t = 0.0;
-            for i in 0..5 {
-                let term = prefix * q[i] * suffix[i + 1];
-                sum += term;
-                size_t += term.re.abs() + term.im.abs();
-                prefix *= fa[i];
-            }
-            // The plain difference (a − b)/(z1 − z2) rounds to u (|a| + |b|)/|z1 − z2|,
-            // the telescoped sum to u Σ|terms|: take the one with the smaller bound
-            // (far-apart points: the plain form, whose terms do not cancel).
-            let (a, b) = (prefix, suffix[0]);
-            // both bounds from above without a modulus (1-norm over ∞-norm, each
-            // within √2 of the modulus): hypot was the largest cost here
-            let l1 = |z: Complex64| z.re.abs() + z.im.abs();
-            let size_p = (l1(a) + l1(b)) / dz.re.abs().max(dz.im.abs());
-            let val = if dz != zero && size_p.is_finite() && size_p < size_t {
-                cdiv(a - b, dz)
-            } else {
-                sum
-            };
-            let v = eps[j] * eps[k] * val;
+            let v = eps[j] * eps[k] * pair_quotient(r1, r2, dz, &fq, j, k);
             pjk[j][k] = v;
             pjk[k][j] = v;
         }
     }
     Wurzel { p, pjk }
+}
+
+/// The quotients [`factor_quotient`] of the five factors (each pair's
+/// telescoped sum uses all five).
+#[inline]
+pub(super) fn factor_quotients(
+    r1: &[Complex64; 5],
+    r2: &[Complex64; 5],
+    dz: Complex64,
+) -> [Complex64; 5] {
+    std::array::from_fn(|m| factor_quotient(r1[m], r2[m], dz))
+}
+
+/// `(a − b)/(z1 − z2)` of (28) for the pair `j < k`, in the canonical branch
+/// (see [`wurzel_from_roots`]; `fq` from [`factor_quotients`]).
+pub(super) fn pair_quotient(
+    r1: &[Complex64; 5],
+    r2: &[Complex64; 5],
+    dz: Complex64,
+    fq: &[Complex64; 5],
+    j: usize,
+    k: usize,
+) -> Complex64 {
+    let zero = Complex64::new(0.0, 0.0);
+    let one = Complex64::new(1.0, 0.0);
+    // factors in the order j, k, then the complement
+    let mut idx = [j, k, 0, 0, 0];
+    for (n, m) in (2..).zip((0..5).filter(|&m| m != j && m != k)) {
+        idx[n] = m;
+    }
+    let fa: [Complex64; 5] = std::array::from_fn(|i| if i < 2 { r2[idx[i]] } else { r1[idx[i]] });
+    let fb: [Complex64; 5] = std::array::from_fn(|i| if i < 2 { r1[idx[i]] } else { r2[idx[i]] });
+    // (A_i − B_i)/(z1 − z2): for i < 2, A − B = r2 − r1 = −(r1 − r2)
+    let q: [Complex64; 5] = std::array::from_fn(|i| {
+        let v = fq[idx[i]];
+        if i < 2 {
+            -v
+        } else {
+            v
+        }
+    });
+    let mut suffix = [one; 6];
+    for i in (0..5).rev() {
+        suffix[i] = suffix[i + 1] * fb[i];
+    }
+    let mut prefix = one;
+    let mut sum = zero;
+    let mut size_t = 0.0;
+    for i in 0..5 {
+        let term = prefix * q[i] * suffix[i + 1];
+        sum += term;
+        size_t += term.re.abs() + term.im.abs();
+        prefix *= fa[i];
+    }
+    // The plain difference (a − b)/(z1 − z2) rounds to u (|a| + |b|)/|z1 − z2|,
+    // the telescoped sum to u Σ|terms|: take the one with the smaller bound
+    // (far-apart points: the plain form, whose terms do not cancel).
+    let (a, b) = (prefix, suffix[0]);
+    // both bounds from above without a modulus (1-norm over ∞-norm, each
+    // within √2 of the modulus): hypot was the largest cost here
+    let l1 = |z: Complex64| z.re.abs() + z.im.abs();
+    let size_p = (l1(a) + l1(b)) / dz.re.abs().max(dz.im.abs());
+    if dz != zero && size_p.is_finite() && size_p < size_t {
+        cdiv(a - b, dz)
+    } else {
+        sum
+    }
 }

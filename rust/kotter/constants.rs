@@ -9,6 +9,7 @@ use super::polish::{polish_root, Level, PolishedRoot};
 use super::roots::{check_repeated, quartic_f_den, quartic_roots};
 use super::{check_a, integrals, l_from_m_n, m_n, C, CYCLIC, ONE, ZERO};
 use crate::error::{check_finite, cnum, Error, Result, SingularKind};
+use crate::numeric::complex::Modulus;
 use crate::numeric::dd::Cdd;
 
 /// Residual (relative to the size of the terms) above which the existence
@@ -329,7 +330,7 @@ fn coefficients_20(
     let mut root_jd = [Cdd::ZERO; 3];
     for p in 0..4 {
         let sqrt_fp = roots[p].sqrt_fprime.to_c();
-        if !(sqrt_fp.norm().is_finite() && sqrt_fp.norm() > 0.0) {
+        if !(sqrt_fp.modulus().is_finite() && sqrt_fp.modulus() > 0.0) {
             let reason = format!(
                 "F'(s_{}) = {} (19) at the root s_{} = {} is zero or not finite",
                 p + 1,
@@ -339,7 +340,7 @@ fn coefficients_20(
             );
             // F'(s_p) = 0 is a repeated root of F, as in `check_repeated`; an
             // overflow is not a property of the state.
-            return Err(if sqrt_fp.norm() == 0.0 {
+            return Err(if sqrt_fp.modulus() == 0.0 {
                 Error::Singular {
                     what: "state l",
                     kind: SingularKind::RepeatedRoot,
@@ -356,7 +357,7 @@ fn coefficients_20(
             // the offsets are accurate to a few ulps relative (polish.rs, and
             // exact from w² at a branch point, pairs.rs) however small: only a
             // root at a_j itself is 0/0
-            if roots[p].x[j].to_c().norm() <= f64::MIN_POSITIVE * scale_a {
+            if roots[p].x[j].to_c().modulus() <= f64::MIN_POSITIVE * scale_a {
                 return Err(Error::Singular {
                     what: "state l",
                     kind: SingularKind::CoincidingBranchPoints,
@@ -449,9 +450,9 @@ impl BranchConstants {
         };
         for j in 0..3 {
             let d3 = dd[2][j];
-            let size = (u[0][j].to_c().norm() + v[0][j].to_c().norm())
-                * (u[1][j].to_c().norm() + v[1][j].to_c().norm());
-            if d3.to_c().norm() <= DELTA3_MIN_RTOL * size {
+            let size = (u[0][j].to_c().modulus() + v[0][j].to_c().modulus())
+                * (u[1][j].to_c().modulus() + v[1][j].to_c().modulus());
+            if d3.to_c().modulus() <= DELTA3_MIN_RTOL * size {
                 // √d_j = (Δ1 − iΔ2)/Δ3: d_j at infinity, where the curve (8)
                 // has its own branch point.
                 return Err(Error::Singular {
@@ -468,7 +469,7 @@ impl BranchConstants {
             // in one of Δ1 ∓ iΔ2; the other, larger one keeps full accuracy.
             let i_d2 = dd[1][j].mul_i();
             let (minus, plus) = (dd[0][j].sub(i_d2), dd[0][j].add(i_d2));
-            let sd = if minus.to_c().norm() >= plus.to_c().norm() {
+            let sd = if minus.to_c().modulus() >= plus.to_c().modulus() {
                 minus.div(d3)
             } else {
                 d3.div(plus).neg()
@@ -484,7 +485,7 @@ impl BranchConstants {
             bc.abgd_dd[2][j] = u2.add(u1.mul_i()).div(two_d3).neg();
             bc.abgd_dd[3][j] = u2.sub(u1.mul_i()).div(two_d3).neg();
             bc.d_dd[j] = dj;
-            if bc.d[j].norm() == 0.0 || !bc.d[j].norm().is_finite() {
+            if bc.d[j].modulus() == 0.0 || !bc.d[j].modulus().is_finite() {
                 // d_j = 0 meets the branch point d_0 = 0 of (8), d_j = ∞ the one
                 // at infinity: the genus drops, as for coinciding roots.
                 return Err(Error::Singular {
@@ -531,8 +532,8 @@ fn k_keps_dd(abgd: &[[Cdd; 3]; 4], d: &[Cdd; 3]) -> (C, C, C) {
         .max_by(|&(a, b), &(c, e)| {
             dw(a, b)
                 .to_c()
-                .norm()
-                .partial_cmp(&dw(c, e).to_c().norm())
+                .modulus()
+                .partial_cmp(&dw(c, e).to_c().modulus())
                 .unwrap_or(std::cmp::Ordering::Equal)
         })
         .unwrap_or((0, 1));
@@ -603,13 +604,13 @@ fn h0_structure(
     let eps = if k == ZERO { ZERO } else { k_eps / k };
     // The perfect square of (40), (Kε)² = K · Kε², with Kε² d4 = κ Σ c̃_j p_j;
     // relative to the size of the terms (the sum cancels when two d_j are close).
-    let terms_e2: f64 = (0..3).map(|j| (ct[j] * ac[j]).norm()).sum();
+    let terms_e2: f64 = (0..3).map(|j| (ct[j] * ac[j]).modulus()).sum();
     let k_eps2: C = kappa / d4 * (0..3).map(|j| ct[j] * ac[j]).sum::<C>();
     let r3 = if k == ZERO {
         0.0
     } else {
-        (k_eps * k_eps - k * k_eps2).norm()
-            / ((k_eps * k_eps).norm() + (k * kappa / d4).norm() * terms_e2)
+        (k_eps * k_eps - k * k_eps2).modulus()
+            / ((k_eps * k_eps).modulus() + (k * kappa / d4).modulus() * terms_e2)
     };
     let worst = r1.max(r2).max(r3);
     if worst.is_nan() || worst > STRUCTURE_RTOL {
@@ -653,22 +654,22 @@ fn existence_residuals(
 ) -> (f64, f64) {
     let rel_sum = |t: [C; 3], size: [f64; 3]| {
         let size: f64 = size.iter().sum();
-        (t[0] + t[1] + t[2]).norm() / size.max(f64::MIN_POSITIVE)
+        (t[0] + t[1] + t[2]).modulus() / size.max(f64::MIN_POSITIVE)
     };
     // The size of a term is that of the full products (|α_j| + |β_j|)(|γ_j| + |δ_j|)
     // of (23)'s coefficients, the scale of their rounding: near h0 = 0 some of
     // α_j … δ_j vanish like h0 (docs/degenerate.md), and the products p_j + r_j,
     // q_j with them, so relative to those products alone the sums would be noise.
     let full: [f64; 3] = std::array::from_fn(|j| {
-        (alpha[j].norm() + beta[j].norm()) * (gamma[j].norm() + delta[j].norm())
+        (alpha[j].modulus() + beta[j].modulus()) * (gamma[j].modulus() + delta[j].modulus())
     });
     let r1 = rel_sum(
         std::array::from_fn(|j| c33[j] * (ac[j] + cc[j])),
-        std::array::from_fn(|j| c33[j].norm() * full[j]),
+        std::array::from_fn(|j| c33[j].modulus() * full[j]),
     );
     let r2 = rel_sum(
         std::array::from_fn(|j| c33[j] * bc[j]),
-        std::array::from_fn(|j| c33[j].norm() * full[j]),
+        std::array::from_fn(|j| c33[j].modulus() * full[j]),
     );
     (r1, r2)
 }
@@ -685,7 +686,7 @@ fn coefficients_38(ac: &[C; 3], bc: &[C; 3], cc: &[C; 3], d: &[C; 3]) -> ([C; 3]
     let (tj, tk) = [(0, 1), (0, 2), (1, 2)]
         .into_iter()
         .fold((0, 1), |best, (j, kk)| {
-            if (t[j] - t[kk]).norm() > (t[best.0] - t[best.1]).norm() {
+            if (t[j] - t[kk]).modulus() > (t[best.0] - t[best.1]).modulus() {
                 (j, kk)
             } else {
                 best
@@ -758,7 +759,7 @@ fn real_state(k: &Coefficients23, xi: &[C; 3], eta: &[C; 3]) -> Result<[f64; 6]>
             });
         }
         im = im.max(mj.im.abs()).max(nj.im.abs());
-        size = size.max(mj.norm()).max(nj.norm());
+        size = size.max(mj.modulus()).max(nj.modulus());
         m[j] = mj.re;
         n[j] = nj.re;
     }

@@ -6,6 +6,7 @@
 use super::schottky::p_poly;
 use super::{C, CYCLIC, ONE, ZERO};
 use crate::numeric::complex::sqrt_principal;
+use crate::numeric::complex::Modulus;
 use crate::numeric::dd::{Cdd, Dd};
 
 /// What the polish of the roots of `F` needs of the level set: `a`, `h`,
@@ -69,15 +70,17 @@ impl Level<'_> {
                     let lj = r * (m[j] + tau * n[j])
                         + n[j] * (x[k] * x[l] - x[j] * x[3]) / (q + tau * r);
                     f += lj * lj;
-                    size += (r.norm() * m[j].abs() + q.norm() * n[j].abs()).powi(2);
+                    size += (r.modulus() * m[j].abs() + q.modulus() * n[j].abs()).powi(2);
                 }
                 (f, size)
             }
             None => {
                 let (p, _) = self.p_dp(s, x);
                 let [h0, h1, h2, h3] = *self.h;
-                let size =
-                    (h1 * s * s).norm() + (h2 * s).norm() + h3.abs() + (2.0 * h0 * sigma).norm();
+                let size = (h1 * s * s).modulus()
+                    + (h2 * s).modulus()
+                    + h3.abs()
+                    + (2.0 * h0 * sigma).modulus();
                 (p + 2.0 * h0 * sigma, size)
             }
         }
@@ -108,7 +111,7 @@ impl Level<'_> {
                     let wa = ONE / x[j] + ONE / x[3];
                     let wb = ONE / x[k] + ONE / x[l];
                     let wba = (a[k] - a[j]) / (x[j] * x[k]) + (a[l] - a[3]) / (x[l] * x[3]);
-                    let dlj = if wa.norm() <= wb.norm() {
+                    let dlj = if wa.modulus() <= wb.modulus() {
                         0.5 * (wa * lj + q * n[j] * wba)
                     } else {
                         0.5 * (wb * lj - r * m[j] * wba)
@@ -134,7 +137,7 @@ pub(super) fn offsets_at(a: &[f64; 4], i: usize, t: C) -> [C; 4] {
 /// The continuation of the branch `√G(s)`: the root of `Π x_m` nearest `prev`.
 fn sqrt_g_near(x: &[C; 4], prev: C) -> C {
     let r = sqrt_principal(x.iter().product());
-    if (r - prev).norm() <= (r + prev).norm() {
+    if (r - prev).modulus() <= (r + prev).modulus() {
         r
     } else {
         -r
@@ -195,7 +198,7 @@ pub(super) fn polish_root(lv: &Level, p_at_a: &[f64; 4], s0: C, branch: Option<C
     let a = lv.a;
     let mut best = 0;
     for i in 1..4 {
-        if (s0 - a[i]).norm() < (s0 - a[best]).norm() {
+        if (s0 - a[i]).modulus() < (s0 - a[best]).modulus() {
             best = i;
         }
     }
@@ -219,7 +222,7 @@ pub(super) fn polish_root_at(
         .map(|m| (a[m] - ai).abs())
         .fold(f64::INFINITY, f64::min);
     let mut t = t0;
-    if branch.is_none() && t.norm() < 0.1 * gap {
+    if branch.is_none() && t.modulus() < 0.1 * gap {
         t = refine_on_squared_form(lv, p_at_a, best, t);
     }
     let (x0, sigma) = starting_branch(lv, best, t, branch);
@@ -259,12 +262,12 @@ fn refine_on_squared_form(lv: &Level, p_at_a: &[f64; 4], best: usize, t0: C) -> 
         }
         let val = pt * pt - 4.0 * h0 * h0 * t * prod;
         let der = 2.0 * pt * dpt - 4.0 * h0 * h0 * (prod + t * dprod);
-        if der == ZERO || !(val / der).norm().is_finite() {
+        if der == ZERO || !(val / der).modulus().is_finite() {
             break;
         }
         let step = val / der;
         t -= step;
-        if step.norm() <= f64::EPSILON * t.norm() {
+        if step.modulus() <= f64::EPSILON * t.modulus() {
             break;
         }
     }
@@ -291,7 +294,7 @@ fn starting_branch(lv: &Level, best: usize, t: C, branch: Option<C>) -> ([C; 4],
         None => {
             let (fp, _) = lv.f(ai + t, &x0, g0);
             let (fm, _) = lv.f(ai + t, &x0, -g0);
-            if fp.norm() <= fm.norm() {
+            if fp.modulus() <= fm.modulus() {
                 g0
             } else {
                 -g0
@@ -309,7 +312,7 @@ fn newton_on_branch(lv: &Level, best: usize, t: C, x0: [C; 4], mut sigma: C) -> 
     let ai = a[best];
     let mut cur = (t, x0, sigma);
     let (f_cur, size) = lv.f(ai + t, &x0, sigma);
-    let mut res_best = f_cur.norm() / size.max(f64::MIN_POSITIVE);
+    let mut res_best = f_cur.modulus() / size.max(f64::MIN_POSITIVE);
     let mut best_state = cur;
     for _ in 0..8 {
         let (t, x, sg) = cur;
@@ -325,12 +328,14 @@ fn newton_on_branch(lv: &Level, best: usize, t: C, x0: [C; 4], mut sigma: C) -> 
         sigma = sqrt_g_near(&xn, sg);
         cur = (tn, xn, sigma);
         let (fn_, size) = lv.f(ai + tn, &xn, sigma);
-        let res = fn_.norm() / size.max(f64::MIN_POSITIVE);
+        let res = fn_.modulus() / size.max(f64::MIN_POSITIVE);
         if res < res_best {
             res_best = res;
             best_state = cur;
         }
-        if step.norm() <= 2.0 * f64::EPSILON * (ai + tn).norm().max(tn.norm()) || res == 0.0 {
+        if step.modulus() <= 2.0 * f64::EPSILON * (ai + tn).modulus().max(tn.modulus())
+            || res == 0.0
+        {
             break;
         }
     }

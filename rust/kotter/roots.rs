@@ -5,6 +5,7 @@
 
 use super::{C, ONE, ZERO};
 use crate::error::{check_finite, cnum_within, num, Error, Result, SingularKind};
+use crate::numeric::complex::Modulus;
 use crate::numeric::tol::REDUCTION_FLOOR_RTOL;
 
 /// Roots of `F` closer than `REPEATED_ROOT_RTOL` times their scale are
@@ -151,7 +152,7 @@ pub fn quartic_roots(f: &[f64; 5]) -> Result<[C; 4]> {
             }
         }
     }
-    let scale = z.iter().fold(1.0f64, |m, v| m.max(v.norm()));
+    let scale = z.iter().fold(1.0f64, |m, v| m.max(v.modulus()));
     // A cluster is reported as a repeated root even when the iteration has not
     // met its tolerance: Aberth converges only linearly to a multiple root.
     check_repeated(&z)?;
@@ -173,8 +174,8 @@ pub fn quartic_roots(f: &[f64; 5]) -> Result<[C; 4]> {
 pub(super) fn check_repeated(z: &[C]) -> Result<()> {
     for i in 0..z.len() {
         for j in (i + 1)..z.len() {
-            let pair = z[i].norm().max(z[j].norm());
-            if (z[i] - z[j]).norm() <= REPEATED_ROOT_RTOL * pair {
+            let pair = z[i].modulus().max(z[j].modulus());
+            if (z[i] - z[j]).modulus() <= REPEATED_ROOT_RTOL * pair {
                 return Err(Error::Singular {
                     what: "state l",
                     kind: SingularKind::RepeatedRoot,
@@ -182,10 +183,10 @@ pub(super) fn check_repeated(z: &[C]) -> Result<()> {
                         "F(s) (19) has a repeated root s = {} (|s_{} - s_{}| = {:.1e}): l^(p) \
                          (20) divides by sqrt(F'(s_p)) = 0",
                         // The pair's mean, to the digits its separation leaves.
-                        cnum_within((z[i] + z[j]) * 0.5, (z[i] - z[j]).norm()),
+                        cnum_within((z[i] + z[j]) * 0.5, (z[i] - z[j]).modulus()),
                         i + 1,
                         j + 1,
-                        (z[i] - z[j]).norm()
+                        (z[i] - z[j]).modulus()
                     ),
                 });
             }
@@ -222,8 +223,8 @@ fn order_roots(z: [C; 4], scale: f64) -> [C; 4] {
         let i2 = (0..3)
             .min_by(|&i, &j| {
                 (r[i] - s1.conj())
-                    .norm()
-                    .partial_cmp(&(r[j] - s1.conj()).norm())
+                    .modulus()
+                    .partial_cmp(&(r[j] - s1.conj()).modulus())
                     .unwrap_or(std::cmp::Ordering::Equal)
             })
             .unwrap_or(0);
