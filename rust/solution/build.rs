@@ -122,21 +122,23 @@ impl Candidates<'_> {
         // [`VelocitySystem`]): a set-up whose quotients fit (1) for no
         // velocity, or for another one than the closed form, is refused;
         // the fit gives the closed form its sign.
-        let (fit, residual) =
-            VelocitySystem::at(&d.jet, &d.idx, &num, &den)?.rate(&self.c4, "U")?;
+        let sys = VelocitySystem::at(&d.jet, &d.idx, &num, &den)?;
+        let (fit, residual) = sys.rate(&self.c4, "U")?;
         check_velocity_fit(residual)?;
         let rate = match self.closed {
             Ok((v, lat)) => {
                 let (s, dev) = dubrovin::sign_against(&d.curve, v, &fit);
-                dubrovin::check_against_fit(dev)?;
-                lat.u[0].map(|z| s * z)
+                let u = lat.u[0].map(|z| s * z);
+                let res_closed = sys.residual_at(&u, &self.c4);
+                dubrovin::check_against_fit(dev, res_closed, residual)?;
+                u
             }
             Err(_) => fit,
         };
         let built = Built { cl, num, den, rate };
         Ok((
             self.check
-                .defect(&d.plan, &d.curve, &d.idx, &built, &d.v0)?,
+                .defect(&d.plan, &d.curve, &d.idx, &built, &d.v0, &d.jet)?,
             built,
         ))
     }

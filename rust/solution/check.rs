@@ -13,7 +13,7 @@ use super::phase_mod2;
 use crate::error::Result;
 use crate::riemann::HyperellipticCurve;
 use crate::so4;
-use crate::theta::ThetaPlan;
+use crate::theta::{ThetaJet, ThetaPlan};
 
 type C = Complex64;
 
@@ -175,7 +175,7 @@ impl SelfCheck {
     /// counts as infinite): `|l(0) − l0|/|l0|`, `|Im l|/|l0|`, the integrals
     /// (6)–(7) of `Re l` against those of `l0`, and `|dl/dt − (1)|` relative to
     /// [`SelfCheck::rate_scale`], with `dl/dt = (∇N − l ∇D)·U / D` from the theta
-    /// jet.
+    /// jet (`jet0` that at `v0`, of order 1).
     pub(super) fn defect(
         &self,
         plan: &ThetaPlan,
@@ -183,6 +183,7 @@ impl SelfCheck {
         idx: &[usize; 8],
         b: &Built,
         v0: &[C; 2],
+        jet0: &ThetaJet,
     ) -> Result<f64> {
         // Lattice coordinates of v0 and U: the check points are taken modulo
         // twice the lattice (as l(t) is), at times that are fractions of the
@@ -235,8 +236,14 @@ impl SelfCheck {
             };
         };
         for (k, &t) in times.iter().enumerate() {
-            let v = if k == 0 { *v0 } else { at(t) };
-            let jet = plan.jet(&v, 1)?;
+            // the set-up's own jet at v0 for t = 0
+            let owned;
+            let jet = if k == 0 {
+                jet0
+            } else {
+                owned = plan.jet(&at(t), 1)?;
+                &owned
+            };
             let theta = |m: usize| jet.values[idx[m]];
             let grad = |m: usize, k: usize| jet.gradient[idx[m] * 2 + k];
             let d: C = (0..8).map(|m| b.den[m] * theta(m)).sum();

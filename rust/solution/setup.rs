@@ -4,6 +4,7 @@
 //! the velocity `U` from Frahm's equations (1) at `v0` by least squares.
 
 use super::*;
+use crate::riemann::quad::abs_fast;
 use std::cmp::Ordering;
 
 /// The estimate of the `C_L²` at `v0` takes part in the consensus of
@@ -164,6 +165,15 @@ impl VelocitySystem {
             lq: lq.map(|z| z.re),
             dval,
         })
+    }
+
+    /// The relative residual `|A u − r| / |r|` of a velocity `u` of the flow
+    /// with coefficients `c4`.
+    pub(super) fn residual_at(&self, u: &[C; 2], c4: &[f64; 6]) -> f64 {
+        let ldot = so4::vector_field4(c4, &self.lq);
+        let rhs = DVector::<C>::from_fn(6, |q, _| ldot[q] * self.dval);
+        let x = DVector::<C>::from_column_slice(u);
+        (&self.amat * &x - &rhs).norm() / rhs.norm().max(f64::MIN_POSITIVE)
     }
 
     /// The velocity of the flow with coefficients `c4` and the relative
@@ -396,10 +406,12 @@ pub(super) fn aux_constants_squared(
     if let Some(e) = est0 {
         cands.push((0.0, e));
     }
+    // moduli without libm's hypot (within 1.5 ulp; the vote is a threshold
+    // test, and these comparisons were the most frequent moduli of the set-up)
     let agree = |x: &[C; 7], y: &[C; 7]| {
         x.iter()
             .zip(y)
-            .all(|(p, q)| (p - q).norm() <= AUX_AGREE_RTOL * p.norm().max(q.norm()))
+            .all(|(p, q)| abs_fast(p - q) <= AUX_AGREE_RTOL * abs_fast(*p).max(abs_fast(*q)))
     };
     // (votes, q, index) of the best-supported candidate.
     let best = |cands: &[(f64, [C; 7])]| {
@@ -509,10 +521,11 @@ impl AuxDivisor<'_> {
         let ub = self.curve.abel(x2, y2)?;
         let v = [ua[0] + ub[0] + rc[0], ua[1] + ub[1] + rc[1]];
         let (vals, _) = self.plan.theta_all(&v)?;
-        let big = vals.iter().fold(0.0f64, |m, z| m.max(z.norm()));
+        // (moduli by abs_fast: q only ranks the divisors)
+        let big = vals.iter().fold(0.0f64, |m, z| m.max(abs_fast(*z)));
         let q = idx
             .iter()
-            .map(|&i| vals[i].norm() / big)
+            .map(|&i| abs_fast(vals[i]) / big)
             .fold(f64::INFINITY, f64::min);
         if q.is_nan() || q <= 0.0 {
             return Ok(None);
