@@ -184,8 +184,8 @@ struct ChebEdge {
     mid: Cc,
     h: Cc,
     others: Vec<(Cc, SegmentSqrt)>,
-    /// `1/Π c^{-1/2}` of the rotations.
-    inv_unrot: C,
+    /// `Π c^{-1/2}` of the rotations.
+    unrot: C,
 }
 
 /// A DD value as a double and its rounding error.
@@ -227,43 +227,13 @@ fn cheb_node_sums_body<M: ExactProd>(edge: &ChebEdge, nodes: &[Dd], acc: &mut [C
     for t in nodes {
         let x = edge.mid.add(edge.h.mul_real::<M>(t.hi, t.lo));
         let mut q = Cc::new(one, C::new(0.0, 0.0));
-        // Π √(c_m w_m) as ±√(Π c_m w_m): one root instead of one per factor
-        // (the divider was the bottleneck). Each c_m w_m lies in the right
-        // half plane, so the argument of the partial products is the sum of
-        // theirs until it passes ±π, where the principal root of the product
-        // changes sign against the product of the roots: counted by the signs
-        // of the imaginary parts, as the principal root itself decides them.
-        let mut prod = one;
-        let mut flip = false;
+        let mut p0 = edge.unrot;
         for (k, (e, s)) in edge.others.iter().enumerate() {
             let w = x.sub(*e);
-            let v = s.turn(w.hi);
-            let next = if k == 0 { v } else { prod * v };
-            if k > 0
-                && ((prod.im > 0.0 && v.im > 0.0 && next.im < 0.0)
-                    || (prod.im < 0.0 && v.im < 0.0 && next.im >= 0.0))
-            {
-                flip = !flip;
-            }
-            prod = next;
+            p0 *= s.rotated(w.hi);
             q = if k == 0 { w } else { q.mul::<M>(w) };
         }
-        // 1/√prod = conj(√prod)/|prod| (principal root, Kahan's form)
-        let ss = prod.norm_sqr();
-        let r = if ss.is_normal() && ss < f64::MAX {
-            ss.sqrt()
-        } else {
-            prod.re.hypot(prod.im)
-        };
-        let im = prod.im + 0.0;
-        let tt = (0.5 * (r + prod.re.abs())).sqrt();
-        let root = if prod.re >= 0.0 {
-            C::new(tt, im / (2.0 * tt))
-        } else {
-            C::new(im.abs() / (2.0 * tt), tt.copysign(im))
-        };
-        let inv_r = if flip { -1.0 / r } else { 1.0 / r };
-        let q0 = edge.inv_unrot * (root.conj() * inv_r);
+        let q0 = crate::numeric::complex::cdiv(one, p0);
         let (s_hi, s_err) = cmul_err::<M>(q0, q0);
         let m = q.mul::<M>(Cc::new(s_hi, s_err));
         // m.hi ≈ 1: its real part minus 1 is exact (Sterbenz)
@@ -384,7 +354,7 @@ impl HyperellipticCurve {
                 .zip(segs)
                 .map(|(&k, s)| (first_order(ed(k)), s))
                 .collect(),
-            inv_unrot: crate::numeric::complex::cdiv(C::new(1.0, 0.0), segs_unrot),
+            unrot: segs_unrot,
         };
         let mut acc = vec![Cc::ZERO; g];
         cheb_node_sums(&edge, &rule.nodes, &mut acc);

@@ -248,13 +248,6 @@ impl SegmentSqrt {
         sqrt_right(self.rot * w) * self.unrot
     }
 
-    /// `c w`, the point turned into the right half plane (its principal root
-    /// is [`Self::rotated`]).
-    #[inline(always)]
-    pub fn turn(&self, w: C) -> C {
-        self.rot * w
-    }
-
     /// `Π c^{-1/2}` is folded into one constant by callers that multiply many.
     #[inline(always)]
     pub fn rotated(&self, w: C) -> C {
