@@ -111,9 +111,32 @@ impl HyperellipticCurve {
         (x, self.y_int(x, if (j + l) % 2 == 0 { 1 } else { -1 }))
     }
 
+    /// [`Self::riemann_constant`] with `plan` for the theta values of its
+    /// check where the derived data are not built yet: a plan for this
+    /// curve's `τ` (checked; else the curve builds its own) with a tolerance
+    /// of at most 1e-15, e.g. the Theorem's set-up's, which saves building a
+    /// second plan for the same `τ`. `K` is the same half period either way.
+    pub(crate) fn riemann_constant_with(&self, plan: &ThetaPlan) -> Result<&[C]> {
+        let d = self
+            .derived
+            .get_or_init(|| {
+                if plan.genus() == self.g && plan.is_for(&self.tau_flat) {
+                    self.build_derived_with(plan.clone().with_parallel(true))
+                } else {
+                    self.build_derived()
+                }
+            })
+            .as_ref()
+            .map_err(|e| e.clone())?;
+        Ok(&d.k)
+    }
+
     fn build_derived(&self) -> Result<Derived> {
+        self.build_derived_with(ThetaPlan::new(&self.tau_flat, self.g, THETA_TOL, 0)?)
+    }
+
+    fn build_derived_with(&self, plan: ThetaPlan) -> Result<Derived> {
         let g = self.g;
-        let plan = ThetaPlan::new(&self.tau_flat, g, THETA_TOL, 0)?;
         // η(w) of the Weierstrass points other than the base point (∞ for odd
         // n, e_1 for even n).
         let first = if self.e.len() % 2 == 1 { 0 } else { 1 };

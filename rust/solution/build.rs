@@ -40,7 +40,7 @@ impl Divisor0 {
         let tau_rm = curve.tau_row_major();
         let tau: [C; 4] = [tau_rm[0], tau_rm[1], tau_rm[2], tau_rm[3]];
         let plan = ThetaPlan::new(&tau, 2, THETA_TOL, 1)?.with_parallel(false);
-        let rcv = curve.riemann_constant()?;
+        let rcv = curve.riemann_constant_with(&plan)?;
         let rc = [rcv[0], rcv[1]];
         let mut idx = [0usize; 8];
         idx[0] = char_index(&[0, 0], &[0, 0])?;

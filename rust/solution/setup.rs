@@ -201,9 +201,6 @@ impl VelocitySystem {
         // see), where Householder QR keeps roundoff. Where the SVD's solution
         // passes (every generic state) it is kept, with its bits.
         let ne = normal_residual(&self.amat, &x, &rhs);
-        if std::env::var("MANAKOV_DEBUG_CHECK").is_ok() {
-            eprintln!("NE {ne:e}");
-        }
         if !matches!(
             ne.partial_cmp(&NORMAL_RESIDUAL_RTOL),
             Some(Ordering::Less | Ordering::Equal)
@@ -453,14 +450,6 @@ pub(super) fn aux_constants_squared(
             if let Some(cand) = aux.estimate((x1, y1), (x2, y2))? {
                 cands.push(cand);
             }
-        }
-    }
-    if std::env::var("MANAKOV_DEBUG_CHECK").is_ok() {
-        if let Some(e) = est0 {
-            eprintln!("AUX est0 {:?}", e);
-        }
-        for c in &cands {
-            eprintln!("AUX q={:e} {:?}", c.0, c.1);
         }
     }
     best(&cands)

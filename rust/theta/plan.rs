@@ -132,6 +132,17 @@ impl ThetaPlan {
         self.order
     }
 
+    /// Whether the plan was built for `tau` (row-major, `g × g`): its
+    /// symmetrised real and imaginary parts are the plan's, to the bit.
+    pub fn is_for(&self, tau: &[Complex64]) -> bool {
+        tau.len() == self.g * self.g && {
+            let sym = symmetrised(tau, self.g);
+            sym.iter()
+                .zip(self.re_tau.iter().zip(&self.y))
+                .all(|(z, (re, im))| z.re == *re && z.im == *im)
+        }
+    }
+
     /// Radius, shortest vector, proven truncation bound and expected term count.
     pub fn info(&self) -> PlanInfo {
         let g = self.g;
