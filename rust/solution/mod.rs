@@ -349,8 +349,8 @@ impl Solution {
     /// own `c4` this is `U`.
     /// `dd`: the closed form and the periods in double-double on the unrounded
     /// curve (`X, Y` to ~1e-19, as the solution's own phase), else in double
-    /// with the curve's double periods (to ~1e-15, as the frequency map: a few
-    /// times cheaper).
+    /// with the curve's double periods (to ~1e-15, ~1e-11 on stiff tops, as the
+    /// frequency map: a few times cheaper).
     ///
     /// Errors: [`Error::InvalidArgument`] naming [`dubrovin::CLOSED_FORM`]
     /// where the closed form refuses, or refused for this solution's own `U`

@@ -159,7 +159,8 @@ pub fn level_set_flow_data_c4(
 ) -> Result<FlowData> {
     let (c4, c2) = (*c4, *c2);
     let ls = level_set_curve(a, l0)?;
-    // In double with the curve's double periods: frequencies to ~1e-15 (the
+    // In double with the curve's double periods: frequencies to ~1e-15 on
+    // well-separated a, ~1e-11 on the stiffest tops met (docs/tori.md; the
     // DD of the solution's phase would cost about as much as the rest of the
     // state), and `flow_data` takes the same numbers.
     let rates = match half_period_velocities(&ls.kotter, l0, &[c4, c2], false) {
