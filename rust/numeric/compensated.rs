@@ -43,12 +43,11 @@ pub fn two_prod(a: f64, b: f64) -> (f64, f64) {
     (p, ((ah * bh - p) + ah * bl + al * bh) + al * bl)
 }
 
-/// The exact product as a parameter: Dekker's from Veltkamp's split
-/// everywhere, or one fused multiply-add where the caller runs in code
-/// compiled for it (`#[target_feature(enable = "fma")]`, chosen at run time).
-/// Both give the same bits: the product's error is exact either way (for
-/// `|a|, |b| < 2^995` and no underflow).
-/// An error-free product `a b = p + e`.
+/// An error-free product `a b = p + e`, as a parameter: Dekker's from
+/// Veltkamp's split everywhere, or one fused multiply-add where the caller
+/// runs in code compiled for it (`#[target_feature(enable = "fma")]`, chosen
+/// at run time). Both give the same bits: the product's error is exact either
+/// way (for `|a|, |b| < 2^995` and no underflow).
 pub(crate) trait ExactProd {
     fn two_prod(a: f64, b: f64) -> (f64, f64);
 }

@@ -12,6 +12,7 @@ use num_complex::Complex64;
 /// `|w| = √(Re w² + Im w²)` directly while the sum of squares is a normal
 /// double (error ≤ 1 ulp, as `hypot`'s), else `hypot`: libm's `hypot` costs
 /// ~250 instructions and was 40 % of the reduction's per-state time.
+#[inline]
 pub fn sqrt_principal(w: Complex64) -> Complex64 {
     let (re, im) = (w.re, w.im + 0.0); // + 0.0 maps −0.0 to +0.0: one cut side
     if re == 0.0 && im == 0.0 {

@@ -103,12 +103,12 @@ impl HyperellipticCurve {
             Some(v) => v,
             None => {
                 for (d, &em) in dist_buf.iter_mut().zip(&self.e) {
-                    *d = abs_fast(x - em);
+                    *d = (x - em).modulus();
                 }
                 (&dist_buf[..n], self.branch_quality(k, &dist_buf[..n]))
             }
         };
-        let q = sqrt_fast(dx);
+        let q = sqrt_principal(dx);
         // Stack buffers: this is the per-point hot path. Factor m ≠ k is
         // a_m + s² dx, a_m = e_k − e_m, with |a_m| = |e_k − e_m| and
         // |a_m + dx| = |x − e_m|.
@@ -145,7 +145,7 @@ impl HyperellipticCurve {
         } else {
             let mut sing = [C::new(0.0, 0.0); 2 * MAX_N];
             for (i, &am) in a[..ns].iter().enumerate() {
-                let s = sqrt_fast(-am / dx);
+                let s = sqrt_principal(-am / dx);
                 sing[2 * i] = s;
                 sing[2 * i + 1] = -s;
             }
@@ -170,13 +170,13 @@ impl HyperellipticCurve {
         let (n, g) = (self.e.len(), self.g);
         let odd = n % 2 == 1;
         let xx = x - c;
-        let ax = abs_fast(xx);
+        let ax = xx.modulus();
         let mut dist_buf = [0.0; MAX_N];
         let dist = match known {
             Some((d, _)) => d,
             None => {
                 for (d, &em) in dist_buf.iter_mut().zip(&self.e) {
-                    *d = abs_fast(x - em);
+                    *d = (x - em).modulus();
                 }
                 &dist_buf[..n]
             }
@@ -223,7 +223,7 @@ impl HyperellipticCurve {
                 None => {
                     let mut best = f64::INFINITY;
                     for (&bm, &dm) in b[..n].iter().zip(dist) {
-                        let ab = abs_fast(bm);
+                        let ab = bm.modulus();
                         if ab > 0.0 {
                             best = best.min(focal_half_sum_sqrt(ax / ab, dm / ab));
                         }
@@ -243,7 +243,7 @@ impl HyperellipticCurve {
             let mut ns = 0;
             for &bm in &b[..n] {
                 if bm != C::new(0.0, 0.0) {
-                    let s = sqrt_fast(-xx / bm);
+                    let s = sqrt_principal(-xx / bm);
                     sing[ns] = s;
                     sing[ns + 1] = -s;
                     ns += 2;
@@ -286,7 +286,7 @@ impl HyperellipticCurve {
         }
         let mut dist = [0.0; MAX_N];
         for (d, &em) in dist.iter_mut().zip(&self.e) {
-            *d = abs_fast(x - em);
+            *d = (x - em).modulus();
         }
         self.check_point_with(x, y, &dist[..self.e.len()])
     }
@@ -306,7 +306,7 @@ impl HyperellipticCurve {
             }
             return Ok(());
         }
-        let ax = abs_fast(x);
+        let ax = x.modulus();
         let mut bound = ON_CURVE_RTOL;
         let mut r = C::new(1.0, 0.0);
         for ((&ek, &aek), &d) in self.e.iter().zip(&self.e_abs).zip(dist) {
@@ -370,7 +370,7 @@ impl HyperellipticCurve {
     /// `a² + b² = 2|w| + 2`, `ab = |w − 1|`. A branch point at `c` imposes
     /// nothing (its factor is constant along the ray).
     fn infinity_quality(&self, x: C, dist: &[f64]) -> f64 {
-        let dc = abs_fast(x - self.center);
+        let dc = (x - self.center).modulus();
         let odd = self.e.len() % 2 == 1;
         let mut best = f64::INFINITY;
         for (&cm, &dm) in self.c_dist.iter().zip(dist) {
@@ -395,7 +395,7 @@ impl HyperellipticCurve {
         let n = self.e.len();
         let mut dist = [0.0; MAX_N];
         for (d, &em) in dist.iter_mut().zip(&self.e) {
-            *d = abs_fast(x - em);
+            *d = (x - em).modulus();
         }
         self.abel_raw(x, y, &dist[..n])
     }
@@ -574,7 +574,7 @@ impl HyperellipticCurve {
         }
         let mut dist = [0.0; MAX_N];
         for (d, &em) in dist.iter_mut().zip(&self.e) {
-            *d = abs_fast(x - em);
+            *d = (x - em).modulus();
         }
         self.check_point_with(x, y, &dist[..n])?;
         let raw = self.abel_raw(x, y, &dist[..n])?;

@@ -75,8 +75,9 @@ use num_complex::Complex64;
 
 use crate::error::{Error, Result};
 use crate::numeric::complex::sqrt_principal;
+use crate::numeric::complex::Modulus;
 use crate::theta::ThetaPlan;
-use quad::{abs_fast, focal_half_sum_sqrt, nodes_for, sqrt_fast, Piece, SegmentSqrt, SqrtProduct};
+use quad::{focal_half_sum_sqrt, nodes_for, Piece, SegmentSqrt, SqrtProduct};
 
 type C = Complex64;
 

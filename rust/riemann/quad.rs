@@ -17,6 +17,7 @@ use num_complex::Complex64;
 use std::sync::OnceLock;
 
 use crate::error::{Error, Result};
+use crate::numeric::complex::{sqrt_principal, Modulus};
 
 type C = Complex64;
 
@@ -146,36 +147,6 @@ pub fn nodes_for(log_rho: f64) -> f64 {
     (TARGET_LN / (2.0 * log_rho)).ceil()
 }
 
-/// `|z|` as `√(re² + im²)` where `|z|²` lies safely inside the double range
-/// (then within 1.5 ulp of the true modulus), libm's `hypot` elsewhere: the
-/// per-point Abel path takes a dozen moduli, and `hypot` costs several times
-/// a square root.
-#[inline(always)]
-pub fn abs_fast(z: C) -> f64 {
-    let s = z.norm_sqr();
-    if s > 1e-290 && s < 1e290 {
-        s.sqrt()
-    } else {
-        z.re.hypot(z.im)
-    }
-}
-
-/// [`crate::numeric::complex::sqrt_principal`] (same branch, Kahan's formulation) with
-/// the modulus from [`abs_fast`].
-#[inline(always)]
-pub fn sqrt_fast(w: C) -> C {
-    let (re, im) = (w.re, w.im + 0.0);
-    if re == 0.0 && im == 0.0 {
-        return C::new(0.0, 0.0);
-    }
-    let t = ((abs_fast(C::new(re, im)) + re.abs()) / 2.0).sqrt();
-    if re >= 0.0 {
-        C::new(t, im / (2.0 * t))
-    } else {
-        C::new(im.abs() / (2.0 * t), t.copysign(im))
-    }
-}
-
 /// The focal half sum [`focal_half_sum`] of `√w` from moduli alone:
 /// `(|√w − 1| + |√w + 1|)² = 2|w| + 2 + 2|w − 1|`, so with `abs_w = |w|` and
 /// `abs_w1 = |w − 1|` it is `√((|w| + 1 + |w − 1|)/2)` — no complex root, and
@@ -231,14 +202,14 @@ impl SegmentSqrt {
             0.0
         };
         let p = a + b * v;
-        let r = abs_fast(p);
+        let r = p.modulus();
         let rot = if r > 0.0 {
             p.conj() / r
         } else {
             C::new(1.0, 0.0)
         };
         // c^{-1/2} = conj(√c) for |c| = 1; √c with Re c arbitrary: principal.
-        let unrot = sqrt_fast(rot).conj();
+        let unrot = sqrt_principal(rot).conj();
         (SegmentSqrt { rot, unrot }, r)
     }
 
@@ -320,7 +291,7 @@ impl SqrtProduct {
             let u0 = am / r0;
             let u1 = (am + bm) / r1;
             let bis = u0 + u1;
-            let lb = abs_fast(bis);
+            let lb = bis.modulus();
             let (c, d, min_mod) = if r0 > 0.0 && r1 > 0.0 && lb > 1e-6 {
                 let c = bis.conj() / lb;
                 // e^{±iδ}: the rotated end; δ ∈ [0, π/2) from its imaginary part's sign
@@ -360,7 +331,7 @@ impl SqrtProduct {
             sp.ends[sp.groups] = nf;
             sp.groups += 1;
         }
-        sp.unrot = sqrt_fast(all).conj();
+        sp.unrot = sqrt_principal(all).conj();
         sp
     }
 
@@ -374,7 +345,7 @@ impl SqrtProduct {
             for m in start + 1..end {
                 p *= self.ra[m] + self.rb[m] * v;
             }
-            acc *= sqrt_fast(p);
+            acc *= sqrt_principal(p);
             start = end;
         }
         acc
@@ -413,7 +384,7 @@ impl SqrtProduct {
 #[inline(always)]
 pub fn inv_sqrt_principal(p: C) -> C {
     let (re, im) = (p.re, p.im + 0.0); // one cut side, as sqrt_principal
-    let r = abs_fast(p);
+    let r = p.modulus();
     if re >= 0.0 {
         let t2 = 0.5 * (r + re);
         let inv = 1.0 / (t2.sqrt() * r);

@@ -4,7 +4,7 @@
 //! the velocity `U` from Frahm's equations (1) at `v0` by least squares.
 
 use super::*;
-use crate::riemann::quad::abs_fast;
+use crate::numeric::complex::Modulus;
 use std::cmp::Ordering;
 
 /// The estimate of the `C_L²` at `v0` takes part in the consensus of
@@ -408,7 +408,7 @@ pub(super) fn aux_constants_squared(
     let agree = |x: &[C; 7], y: &[C; 7]| {
         x.iter()
             .zip(y)
-            .all(|(p, q)| abs_fast(p - q) <= AUX_AGREE_RTOL * abs_fast(*p).max(abs_fast(*q)))
+            .all(|(p, q)| (p - q).modulus() <= AUX_AGREE_RTOL * (*p).modulus().max((*q).modulus()))
     };
     // (votes, q, index) of the best-supported candidate.
     let best = |cands: &[(f64, [C; 7])]| {
@@ -510,11 +510,11 @@ impl AuxDivisor<'_> {
         let ub = self.curve.abel(x2, y2)?;
         let v = [ua[0] + ub[0] + rc[0], ua[1] + ub[1] + rc[1]];
         let (vals, _) = self.plan.theta_all(&v)?;
-        // (moduli by abs_fast: q only ranks the divisors)
-        let big = vals.iter().fold(0.0f64, |m, z| m.max(abs_fast(*z)));
+        // (moduli without hypot: q only ranks the divisors)
+        let big = vals.iter().fold(0.0f64, |m, z| m.max((*z).modulus()));
         let q = idx
             .iter()
-            .map(|&i| abs_fast(vals[i]) / big)
+            .map(|&i| vals[i].modulus() / big)
             .fold(f64::INFINITY, f64::min);
         if q.is_nan() || q <= 0.0 {
             return Ok(None);
