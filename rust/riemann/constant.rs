@@ -95,8 +95,22 @@ pub(super) fn riemann_char_from_etas(g: usize, etas: &[usize]) -> Option<usize> 
 
 impl HyperellipticCurve {
     pub(super) fn derived(&self) -> Result<&Derived> {
+        self.derived_with(None)
+    }
+
+    /// The derived data, built on first use with `plan` for its theta values
+    /// where that is a plan for this curve's `τ` (else with its own).
+    fn derived_with(&self, plan: Option<&ThetaPlan>) -> Result<&Derived> {
         self.derived
-            .get_or_init(|| self.build_derived())
+            .get_or_init(|| {
+                let plan = match plan {
+                    Some(p) if p.genus() == self.g && p.is_for(&self.tau_flat) => {
+                        p.clone().with_parallel(true)
+                    }
+                    _ => ThetaPlan::new(&self.tau_flat, self.g, THETA_TOL, 0)?,
+                };
+                self.build_derived(plan)
+            })
             .as_ref()
             .map_err(|e| e.clone())
     }
@@ -117,25 +131,10 @@ impl HyperellipticCurve {
     /// of at most 1e-15, e.g. the Theorem's set-up's, which saves building a
     /// second plan for the same `τ`. `K` is the same half period either way.
     pub(crate) fn riemann_constant_with(&self, plan: &ThetaPlan) -> Result<&[C]> {
-        let d = self
-            .derived
-            .get_or_init(|| {
-                if plan.genus() == self.g && plan.is_for(&self.tau_flat) {
-                    self.build_derived_with(plan.clone().with_parallel(true))
-                } else {
-                    self.build_derived()
-                }
-            })
-            .as_ref()
-            .map_err(|e| e.clone())?;
-        Ok(&d.k)
+        Ok(&self.derived_with(Some(plan))?.k)
     }
 
-    fn build_derived(&self) -> Result<Derived> {
-        self.build_derived_with(ThetaPlan::new(&self.tau_flat, self.g, THETA_TOL, 0)?)
-    }
-
-    fn build_derived_with(&self, plan: ThetaPlan) -> Result<Derived> {
+    fn build_derived(&self, plan: ThetaPlan) -> Result<Derived> {
         let g = self.g;
         // η(w) of the Weierstrass points other than the base point (∞ for odd
         // n, e_1 for even n).

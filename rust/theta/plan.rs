@@ -368,7 +368,7 @@ fn best_radius(rho: f64, tol: f64, bound: impl Fn(f64, f64) -> f64) -> (f64, f64
     // the smallest constant first: it usually gives the smallest radius
     for frac in [0.3, 0.5, 0.75, 1.0] {
         let rp = rho * frac;
-        if radius < 1e3 && bound(rp, radius) > tol {
+        if radius < RADIUS_CAP && bound(rp, radius) > tol {
             continue;
         }
         let r = radius_for(|r| bound(rp, r), 0.5 * rp, tol);
@@ -397,12 +397,16 @@ fn output_error_bound(g: usize, rho: f64, r: f64, s: f64, order: usize) -> f64 {
     e
 }
 
+/// The largest radius [`radius_for`] grows to; [`best_radius`] prunes only
+/// below it, where a radius is one whose bound is within `tol`.
+const RADIUS_CAP: f64 = 1e3;
+
 /// Smallest `R ≥ r0` (to ~1e-5 relative, from above) with `bound(R) ≤ tol`; `bound` is
 /// decreasing in `R` and `+∞` below `r0`.
 fn radius_for(bound: impl Fn(f64) -> f64, r0: f64, tol: f64) -> f64 {
     let mut lo = r0;
     let mut hi = r0.max(1.0);
-    while bound(hi) > tol && hi < 1e3 {
+    while bound(hi) > tol && hi < RADIUS_CAP {
         lo = hi;
         hi *= 1.25;
     }
