@@ -255,3 +255,83 @@ def test_valid_states_are_refused_only_with_closed_form_error() -> None:
         kinds["solved"] = kinds.get("solved", 0) + 1
     # The draw does reach the refusals it is meant to test.
     assert kinds.get("refused", 0) >= 10, kinds
+
+
+#: States of the harsh random draw (tests/data/every_state_harsh.py, seed 5) on
+#: which two roots of F (19) lie within rounding of each other at a branch
+#: point a_i of sqrt(G), with h0 far from 0 (two close a_i, a state near an
+#: so(3) block or a single component): (a, b, l0, end of the window).
+CLUSTER_STATES = [
+    (
+        [-0.5699246469346912, 855.4483672027682, 855.5731054625766, 958.7881964968162],
+        [0.045481262824797586, 48.29630214972522, 203.85599855664822, 91.30340829679875],
+        [
+            0.7386540895343079,
+            -1.745142062430734e-05,
+            -1.463901016021305,
+            -9.069212285202308e-06,
+            6.972018558250771e-06,
+            0.011415015013868518,
+        ],
+        0.4885939575737082,
+    ),
+    (
+        [-0.5416395512520442, 0.47951360951690325, 4.889542694558962, 4.892187276416959],
+        [0.8790376648365072, -2.9539518676193444, -2.9497694412929913, -3.97508940456997],
+        [
+            -0.0006189041416833222,
+            1299.7689099395732,
+            0.8665841355033265,
+            0.0022412784592958047,
+            -13543.639725664656,
+            1.806023827629232e-06,
+        ],
+        0.00018957032911484756,
+    ),
+    (
+        [-0.14017939687161474, -0.09549848096987264, -0.07912835246764993, -0.055741480724717796],
+        [-0.0299598313311209, -0.03667037148413177, -0.03818343109360826, -0.05729730670191798],
+        [
+            -0.04491525339267031,
+            2.6825050285826673,
+            -10602.629878536763,
+            222902.03489092624,
+            -0.1445265624177776,
+            -0.0014520928380921277,
+        ],
+        0.006182148593002741,
+    ),
+    (
+        [-0.7080459093577172, 6.738285726909448, 6.85975624031309, 7.065165453737771],
+        [-0.42968854066418816, -0.6828997636414241, -9.860430101541512, -9.892929770773232],
+        [
+            69687.89737118773,
+            -0.436941341500539,
+            -1890.931773480241,
+            -0.9762489430321891,
+            -6.582080356389694e-05,
+            -121.25383218783925,
+        ],
+        0.00018994274473968972,
+    ),
+]
+
+
+@pytest.mark.parametrize("case", range(len(CLUSTER_STATES)))
+def test_roots_of_f_clustered_at_a_branch_point_are_solved(case: int) -> None:
+    """Solved to HARSH_BOUND against the long-double reference over the harsh
+    draw's window; the earlier code refused each ("F(s) (19) has a repeated
+    root")."""
+    pytest.importorskip("heyoka")
+    data = str(Path(__file__).resolve().parent / "data")
+    if data not in sys.path:
+        sys.path.insert(0, data)
+    import longdouble_ref
+
+    a, b, l0, t_end = CLUSTER_STATES[case]
+    a, b, l0 = np.array(a), np.array(b), np.array(l0)
+    t = np.linspace(0.0, t_end, 51)
+    ref = longdouble_ref.reference(a, b, l0, t)
+    sol = manakov.ManakovTop(a, b).solve(l0)
+    err = float(np.max(np.abs(np.asarray(sol.l(t), dtype=np.longdouble) - ref)))
+    assert err / float(np.linalg.norm(l0)) <= HARSH_BOUND

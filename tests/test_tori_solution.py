@@ -279,8 +279,9 @@ GENUS2_REFUSALS = [
         # The root's digits belong to the root finder: start and end only.
         (
             "invalid state l: F(s) (19) has a repeated root s = 5.28842",
-            # (the separation of a double root is rounding noise: no digits)
-            "(|s_1 - s_4| = ",
+            # (the separation of a double root is rounding noise: no digits; the
+            # indices are those of the documented order of the roots)
+            "(|s_1 - s_2| = ",
             "e-7): l^(p) (20) divides by sqrt(F'(s_p)) = 0",
         ),
     ),

@@ -6,7 +6,10 @@
 
 use super::pairs::{self, PAIR_ROUTE_RTOL};
 use super::polish::{polish_root, Level, PolishedRoot};
-use super::roots::{check_repeated, quartic_f_den, quartic_roots};
+use super::roots::{
+    check_converged, order_for_polish, quartic_f_den, quartic_roots_unordered, repeated_pair,
+    repeated_root_error,
+};
 use super::{check_a, integrals, l_from_m_n, m_n, C, CYCLIC, ONE, ZERO};
 use crate::error::{check_finite, cnum, Error, Result, SingularKind};
 use crate::numeric::complex::Modulus;
@@ -281,9 +284,28 @@ fn roots_of_f(
                 .into(),
         });
     }
-    let s0 = quartic_roots(f)?;
-    let roots = polished_roots(lv, p_at_a, &s0);
-    check_repeated(&roots.iter().map(|r| r.s).collect::<Vec<_>>())?;
+    let (z, converged, last) = quartic_roots_unordered(f)?;
+    let z = order_for_polish(z);
+    let clustered = repeated_pair(&z);
+    if clustered.is_none() {
+        check_converged(converged, last)?;
+    }
+    let roots = polished_roots(lv, p_at_a, &z);
+    let s: Vec<C> = roots.iter().map(|r| r.s).collect();
+    let repeated = match (clustered, repeated_pair(&s)) {
+        (Some((i, j)), _) => Some((i, j, repeated_root_error(&z, i, j))),
+        (None, Some((i, j))) => Some((i, j, repeated_root_error(&s, i, j))),
+        (None, None) => None,
+    };
+    if let Some((i, j, err)) = repeated {
+        // Two roots within rounding of each other (or polished onto each
+        // other) at a branch point of √G: found in the local parameter there
+        // (pairs.rs), or refused as a repeated root.
+        return match pairs::branch_point_cluster(lv, p_at_a, roots, (i, j)) {
+            Some((r, partner, side)) => Ok((r.into(), Some(PairStructure { partner, side }))),
+            None => Err(err),
+        };
+    }
     Ok((roots, None))
 }
 

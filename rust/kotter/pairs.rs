@@ -49,6 +49,7 @@ use num_complex::Complex64;
 use std::cmp::Ordering;
 
 use super::polish::{offsets_at, polish_root, polish_root_at, Level, PolishedRoot};
+use super::roots::repeated_pair;
 use crate::numeric::complex::sqrt_principal;
 
 type C = Complex64;
@@ -334,10 +335,16 @@ fn branch_point_pair(lv: &Level, p_at_a: &[f64; 4], i: usize) -> Option<[PairRoo
         }
         let sigma = w * sp;
         let root = polish_root_at(lv, p_at_a, i, t, Some(sigma));
-        // the DD polish must keep the root at its offset
+        // The DD polish must keep the root at its offset: within a quarter of
+        // the members' separation (it does not run to the other one) and 1e-3
+        // of the offset (nor off the pair). The double Newton in `w` leaves
+        // `t` good to about 1e-6 relative where the members nearly coincide in
+        // `t` (`w_1 ≈ −w_2`); the DD polish takes it from there.
         let off = root.x[i].to_c();
+        let sep = (seeds[0] * seeds[0] - seeds[1] * seeds[1]).norm();
+        let moved_tol = (1e-6 * t.norm()).max((0.25 * sep).min(1e-3 * t.norm()));
         if !matches!(
-            (off - t).norm().partial_cmp(&(1e-6 * t.norm())),
+            (off - t).norm().partial_cmp(&moved_tol),
             Some(Ordering::Less | Ordering::Equal)
         ) {
             return None;
@@ -409,4 +416,134 @@ fn polish_w(lv: &Level, i: usize, w0: C, sqrt_pi0: C) -> Option<(C, C)> {
     };
     // it must stay with its seed (not run to the other zero or off the pair)
     ((w - w0).norm() <= 0.5 * w0.norm() && w.re.is_finite() && w.im.is_finite()).then_some((w, sp))
+}
+
+/// The four roots of `F` when the quartic put two of them within rounding of
+/// each other at a branch point `a_i` of `√G` away from `h0 = 0` (two `a_i`
+/// close together, with `P(a_i)` small: a state near an so(3) block or a
+/// single component of a top with nearly equal `a_i`): the pair is taken in
+/// the local parameter `w = √(s − a_i)` ([`branch_point_pair`], whose
+/// expansion of `φ(w)` needs `w` small against the gap to the other `a_m`,
+/// not `h0` small), the other two roots as the quartic polished them. The
+/// members are told apart by their exact offsets `t = s − a_i`, which the
+/// double `s` rounds away. Ordered by the documented rule (module docs of
+/// [`super`]), the tie within the pair broken by the offsets. `None` when no
+/// such pair explains the cluster (the caller then reports a repeated root).
+pub(super) fn branch_point_cluster(
+    lv: &Level,
+    p_at_a: &[f64; 4],
+    quartic: Vec<PolishedRoot>,
+    repeated: (usize, usize),
+) -> Option<PairRoute> {
+    let mut rest: Vec<Member> = quartic
+        .into_iter()
+        .map(|root| Member {
+            key: [root.s.im, root.s.re, 0.0],
+            root,
+            pair: None,
+            side: 0.0,
+        })
+        .collect();
+    let mut all: Vec<Member> = Vec::with_capacity(4);
+    // up to two clusters (an equilibrium l_ij E_ij + l_kl E_kl has one at each of
+    // two a_i)
+    let mut next = Some(repeated);
+    for group in 0..2 {
+        let Some((i, j)) = next else { break };
+        let (si, sj) = (rest[i].root.s, rest[j].root.s);
+        let mean = (si + sj) * 0.5;
+        // a cluster off the real axis is not at a branch point
+        if mean.im.abs() > 2.0 * (si - sj).norm().max(f64::EPSILON * mean.norm()) {
+            return None;
+        }
+        let (k, agap) = nearest_a(lv.a, mean.re);
+        let ak = C::new(lv.a[k], 0.0);
+        if (mean - ak).norm() > BRANCH_POINT_FRACTION * agap {
+            return None;
+        }
+        let [m1, m2] = branch_point_pair(lv, p_at_a, k)?;
+        // the members must be distinct (a true double root stays refused), and
+        // the other roots off the pair's neighbourhood
+        if m1.off == m2.off {
+            return None;
+        }
+        rest = rest
+            .into_iter()
+            .enumerate()
+            .filter(|(p, _)| *p != i && *p != j)
+            .map(|(_, r)| r)
+            .collect();
+        if rest
+            .iter()
+            .any(|r| (r.root.s - ak).norm() <= BRANCH_POINT_FRACTION * agap)
+        {
+            return None;
+        }
+        for m in [m1, m2] {
+            all.push(Member {
+                key: [m.off.im, lv.a[k] + m.off.re, m.off.re],
+                root: m.root,
+                pair: Some(group),
+                side: m.side,
+            });
+        }
+        next = repeated_pair(&rest.iter().map(|r| r.root.s).collect::<Vec<_>>());
+    }
+    if next.is_some() {
+        return None;
+    }
+    all.extend(rest);
+    let cmp = |x: &[f64; 3], y: &[f64; 3]| {
+        x[0].total_cmp(&y[0])
+            .then(x[1].total_cmp(&y[1]))
+            .then(x[2].total_cmp(&y[2]))
+    };
+    let re_cmp = |x: &[f64; 3], y: &[f64; 3]| x[1].total_cmp(&y[1]).then(x[2].total_cmp(&y[2]));
+    let mut partner = [false; 4];
+    let mut order: Vec<Member> = Vec::with_capacity(4);
+    if all.iter().any(|r| r.key[0] != 0.0) {
+        let i1 = (0..all.len())
+            .filter(|&p| all[p].key[0] != 0.0)
+            .max_by(|&p, &q| cmp(&all[p].key, &all[q].key))?;
+        let s1 = all.remove(i1);
+        // its conjugate: the other member of its pair, or the quartic root at conj(s1)
+        let i2 = (0..all.len()).find(|&p| all[p].is_partner_of(&s1))?;
+        let s2 = all.remove(i2);
+        order.push(s1);
+        order.push(s2);
+        partner[1] = true;
+        all.sort_by(|p, q| cmp(&q.key, &p.key));
+        let conj34 = all[0].key[0] != 0.0 && all[1].is_partner_of(&all[0]);
+        order.extend(all);
+        partner[3] = conj34;
+    } else {
+        all.sort_by(|p, q| re_cmp(&q.key, &p.key));
+        order.extend(all);
+    }
+    let side: [f64; 4] = std::array::from_fn(|p| order[p].side);
+    let mut it = order.into_iter().map(|p| p.root);
+    let roots = [it.next()?, it.next()?, it.next()?, it.next()?];
+    Some((roots, partner, side))
+}
+
+/// A root of [`branch_point_cluster`] with what orders it.
+struct Member {
+    root: PolishedRoot,
+    /// The cluster it belongs to (`None`: a root the quartic found alone).
+    pair: Option<usize>,
+    /// `(Im s, Re s, offset)`: the offset from `a_i` breaks the tie within a
+    /// pair, whose members the double `s` may not tell apart.
+    key: [f64; 3],
+    side: f64,
+}
+
+impl Member {
+    /// The conjugate partner: the other member of its pair, or the quartic's
+    /// root at the exact conjugate.
+    fn is_partner_of(&self, other: &Member) -> bool {
+        match other.pair {
+            Some(g) => self.pair == Some(g),
+            None => self.pair.is_none() && self.root.s == other.root.s.conj(),
+        }
+    }
 }

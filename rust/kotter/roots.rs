@@ -98,6 +98,32 @@ fn horner(c: &[f64; 5], s: C) -> (C, C) {
 /// Errors: two roots closer than [`REPEATED_ROOT_RTOL`] (repeated roots of
 /// F, where (20) divides by `F'(s_p) = 0`); no convergence.
 pub fn quartic_roots(f: &[f64; 5]) -> Result<[C; 4]> {
+    let (z, converged, last) = quartic_roots_unordered(f)?;
+    let scale = z.iter().fold(1.0f64, |m, v| m.max(v.modulus()));
+    // A cluster is reported as a repeated root even when the iteration has not
+    // met its tolerance: Aberth converges only linearly to a multiple root.
+    check_repeated(&z)?;
+    check_converged(converged, last)?;
+    Ok(order_roots(z, scale))
+}
+
+/// The no-convergence error of [`quartic_roots_unordered`]'s iteration.
+pub(super) fn check_converged(converged: bool, last: f64) -> Result<()> {
+    if !converged && last > ROOT_STAGNATION {
+        return Err(Error::NoConvergence {
+            what: "roots of F(s) (19)",
+            tol: ROOT_STAGNATION,
+            reached: last,
+            iterations: 500,
+        });
+    }
+    Ok(())
+}
+
+/// The Aberth–Ehrlich iteration and two Newton steps of [`quartic_roots`],
+/// unordered and unchecked, with whether it converged and its last relative
+/// step.
+pub(super) fn quartic_roots_unordered(f: &[f64; 5]) -> Result<([C; 4], bool, f64)> {
     check_finite("F coefficients", f)?;
     // Cauchy bound for the initial circle.
     let rad = 1.0 + f[1..].iter().fold(0.0f64, |m, c| m.max(c.abs()));
@@ -152,19 +178,7 @@ pub fn quartic_roots(f: &[f64; 5]) -> Result<[C; 4]> {
             }
         }
     }
-    let scale = z.iter().fold(1.0f64, |m, v| m.max(v.modulus()));
-    // A cluster is reported as a repeated root even when the iteration has not
-    // met its tolerance: Aberth converges only linearly to a multiple root.
-    check_repeated(&z)?;
-    if !converged && last > ROOT_STAGNATION {
-        return Err(Error::NoConvergence {
-            what: "roots of F(s) (19)",
-            tol: ROOT_STAGNATION,
-            reached: last,
-            iterations: 500,
-        });
-    }
-    Ok(order_roots(z, scale))
+    Ok((z, converged, last))
 }
 
 /// Two roots closer than [`REPEATED_ROOT_RTOL`] times the larger of the two
@@ -172,27 +186,48 @@ pub fn quartic_roots(f: &[f64; 5]) -> Result<[C; 4]> {
 /// the singular set `h1² = 4h0²` one or two roots of `F` grow like the
 /// inverse distance to it while the others stay of the size of the `a_i`.
 pub(super) fn check_repeated(z: &[C]) -> Result<()> {
+    match repeated_pair(z) {
+        None => Ok(()),
+        Some((i, j)) => Err(repeated_root_error(z, i, j)),
+    }
+}
+
+/// The error of a repeated root `z_i ≈ z_j` of `F`.
+pub(super) fn repeated_root_error(z: &[C], i: usize, j: usize) -> Error {
+    Error::Singular {
+        what: "state l",
+        kind: SingularKind::RepeatedRoot,
+        reason: format!(
+            "F(s) (19) has a repeated root s = {} (|s_{} - s_{}| = {:.1e}): l^(p) \
+                         (20) divides by sqrt(F'(s_p)) = 0",
+            // The pair's mean, to the digits its separation leaves.
+            cnum_within((z[i] + z[j]) * 0.5, (z[i] - z[j]).modulus()),
+            i + 1,
+            j + 1,
+            (z[i] - z[j]).modulus()
+        ),
+    }
+}
+
+/// The first two roots closer than [`REPEATED_ROOT_RTOL`] times the larger of
+/// the two ([`check_repeated`]).
+pub(super) fn repeated_pair(z: &[C]) -> Option<(usize, usize)> {
     for i in 0..z.len() {
         for j in (i + 1)..z.len() {
             let pair = z[i].modulus().max(z[j].modulus());
             if (z[i] - z[j]).modulus() <= REPEATED_ROOT_RTOL * pair {
-                return Err(Error::Singular {
-                    what: "state l",
-                    kind: SingularKind::RepeatedRoot,
-                    reason: format!(
-                        "F(s) (19) has a repeated root s = {} (|s_{} - s_{}| = {:.1e}): l^(p) \
-                         (20) divides by sqrt(F'(s_p)) = 0",
-                        // The pair's mean, to the digits its separation leaves.
-                        cnum_within((z[i] + z[j]) * 0.5, (z[i] - z[j]).modulus()),
-                        i + 1,
-                        j + 1,
-                        (z[i] - z[j]).modulus()
-                    ),
-                });
+                return Some((i, j));
             }
         }
     }
-    Ok(())
+    None
+}
+
+/// The roots of [`quartic_roots_unordered`] in the documented order, as
+/// [`quartic_roots`] returns them.
+pub(super) fn order_for_polish(z: [C; 4]) -> [C; 4] {
+    let scale = z.iter().fold(1.0f64, |m, v| m.max(v.modulus()));
+    order_roots(z, scale)
 }
 
 fn order_roots(z: [C; 4], scale: f64) -> [C; 4] {

@@ -629,3 +629,102 @@ fn constants_are_continuous_down_to_h0_zero() {
         .fold(0.0f64, |m, (x, y)| m.max((x - y).abs()));
     assert!(err <= 1e-14, "round trip at h0 = 0: {err:e}");
 }
+
+/// Two roots of `F` within rounding of each other at a branch point `a_i` of
+/// `√G`, with `h0` far from 0 (close `a_i` and a state near an so(3) block or
+/// a single component): the quartic cannot separate them, the local parameter
+/// `w = √(s − a_i)` does (pairs.rs, `branch_point_cluster`). The reduction
+/// must reproduce the state; the earlier code refused these with "F(s) (19)
+/// has a repeated root". States of the harsh random draw of
+/// tests/data/every_state_harsh.py (seed 5).
+#[test]
+fn roots_clustered_at_a_branch_point_away_from_h0_zero() {
+    let cases: [([f64; 4], [f64; 6]); 3] = [
+        (
+            [
+                -0.5416395512520442,
+                0.47951360951690325,
+                4.889542694558962,
+                4.892187276416959,
+            ],
+            [
+                -0.0006189041416833222,
+                1299.7689099395732,
+                0.8665841355033265,
+                0.0022412784592958047,
+                -13543.639725664656,
+                1.806023827629232e-06,
+            ],
+        ),
+        (
+            [
+                -0.14017939687161474,
+                -0.09549848096987264,
+                -0.07912835246764993,
+                -0.055741480724717796,
+            ],
+            [
+                -0.04491525339267031,
+                2.6825050285826673,
+                -10602.629878536763,
+                222902.03489092624,
+                -0.1445265624177776,
+                -0.0014520928380921277,
+            ],
+        ),
+        (
+            [
+                -0.7080459093577172,
+                6.738285726909448,
+                6.85975624031309,
+                7.065165453737771,
+            ],
+            [
+                69687.89737118773,
+                -0.436941341500539,
+                -1890.931773480241,
+                -0.9762489430321891,
+                -6.582080356389694e-05,
+                -121.25383218783925,
+            ],
+        ),
+    ];
+    for (a, l) in cases {
+        let h = crate::so4::integrals4(&a, &l);
+        assert!(
+            h[0].abs() > PAIR_ROUTE_RTOL * h[1],
+            "h0 = {} is not small",
+            h[0]
+        );
+        let st = kotter(&a, &l).unwrap();
+        let s = st.constants.s;
+        // the quartic's roots are within its tolerance of each other
+        assert!(
+            (0..4)
+                .any(|p| (p + 1..4)
+                    .any(|q| (s[p] - s[q]).norm() <= REPEATED_ROOT_RTOL * s[p].norm())),
+            "{s:?}"
+        );
+        let p = st.points;
+        let coef = st.constants.coefficients23();
+        let back = from_kotter(
+            &coef,
+            st.constants.d,
+            [p.z1, p.z2],
+            [p.y1, p.y2],
+            Some([p.zd1, p.zd2]),
+            p.g,
+            p.eps,
+        )
+        .unwrap();
+        let size = l.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        for i in 0..6 {
+            assert!(
+                (back[i] - l[i]).abs() < 1e-12 * size,
+                "{i}: {} vs {}",
+                back[i],
+                l[i]
+            );
+        }
+    }
+}
