@@ -317,8 +317,42 @@ CLUSTER_STATES = [
 ]
 
 
-@pytest.mark.parametrize("case", range(len(CLUSTER_STATES)))
-def test_roots_of_f_clustered_at_a_branch_point_are_solved(case: int) -> None:
+#: States of the same draw on which two roots of F lie within rounding of each
+#: other next to a root of P = h1 s^2 - h2 s + h3, away from the a_i, with
+#: |h0|/h1 = 0.035 and 0.017 (above the pair route's 1e-3): the split
+#: 2 h0 sqrt(G)/P' is small through P', not h0.
+PAIR_STATES = [
+    (
+        [-0.9951366762932148, 948.531250339171, 949.2619142052537, 949.2815598804792],
+        [-0.6968989864077537, -0.6991830716498965, -63.39953204648922, -37.985709036616605],
+        [
+            1.8231679977685282,
+            -1.3296300379761022e-05,
+            -64.66413535809383,
+            -901.43183158627,
+            -916.8193631675098,
+            -0.19621366384946143,
+        ],
+        0.0005631180549792926,
+    ),
+    (
+        [-0.002446992418382754, 554.2295408869272, 554.2313026024733, 554.2327151334017],
+        [-8.298901766390365e-05, 0.01607113304812659, 0.014257872339679026, 191.40932528286078],
+        [
+            154.71090042954992,
+            -0.12847263543816254,
+            -11490.807922001155,
+            -661993.3476735733,
+            2049.0836916049125,
+            -2.493589028176023,
+        ],
+        1.1146609661210694e-08,
+    ),
+]
+
+
+@pytest.mark.parametrize("case", CLUSTER_STATES + PAIR_STATES)
+def test_roots_of_f_clustered_at_a_branch_point_are_solved(case) -> None:
     """Solved to HARSH_BOUND against the long-double reference over the harsh
     draw's window; the earlier code refused each ("F(s) (19) has a repeated
     root")."""
@@ -328,7 +362,7 @@ def test_roots_of_f_clustered_at_a_branch_point_are_solved(case: int) -> None:
         sys.path.insert(0, data)
     import longdouble_ref
 
-    a, b, l0, t_end = CLUSTER_STATES[case]
+    a, b, l0, t_end = case
     a, b, l0 = np.array(a), np.array(b), np.array(l0)
     t = np.linspace(0.0, t_end, 51)
     ref = longdouble_ref.reference(a, b, l0, t)

@@ -262,7 +262,10 @@ fn constants_impl(
 /// The four roots of `F` (19), polished, in the documented order: near
 /// `h0 = 0` as pairs on the two branches of `√G` ([`pairs`], with the pair
 /// structure returned), elsewhere (or where the pair route does not apply)
-/// from the quartic.
+/// from the quartic; where the quartic leaves two roots within rounding of
+/// each other, as a cluster at a branch point `a_i`
+/// ([`pairs::branch_point_cluster`]) or as the pairs at the roots of `P`
+/// whatever `h0`, else refused as a repeated root.
 fn roots_of_f(
     lv: &Level,
     p_at_a: &[f64; 4],
@@ -301,7 +304,11 @@ fn roots_of_f(
         // Two roots within rounding of each other (or polished onto each
         // other) at a branch point of √G: found in the local parameter there
         // (pairs.rs), or refused as a repeated root.
-        return match pairs::branch_point_cluster(lv, p_at_a, roots, (i, j)) {
+        let found = pairs::branch_point_cluster(lv, p_at_a, roots, (i, j))
+            // a pair at a root of P = h1 s^2 - h2 s + h3 whose split 2 h0 √G/P' is
+            // small though h0 is not (pairs.rs checks the split and the polish)
+            .or_else(|| pairs::pair_roots(lv, p_at_a));
+        return match found {
             Some((r, partner, side)) => Ok((r.into(), Some(PairStructure { partner, side }))),
             None => Err(err),
         };
