@@ -369,3 +369,47 @@ def test_roots_of_f_clustered_at_a_branch_point_are_solved(case) -> None:
     sol = manakov.ManakovTop(a, b).solve(l0)
     err = float(np.max(np.abs(np.asarray(sol.l(t), dtype=np.longdouble) - ref)))
     assert err / float(np.linalg.norm(l0)) <= HARSH_BOUND
+
+
+#: States of the harsh draw (seed 5) whose branch points spread over 1e18 and
+#: more: their torus took the double route and ``sol.frequencies`` raised
+#: ValueError ("the solution's set-up is wrong at this state") though the
+#: solution was right; (a, b, l0).
+SPREAD_STATES = [
+    (
+        [-0.5630926758516333, -0.31464237130253814, 255.87507735534564, 259.7169338702697],
+        [-0.026554014195668163, 22.629406253804408, -878.9893212327829, -879.0901403315715],
+        [
+            49504.16870807477,
+            2.739389208508241e-05,
+            649.6268124168995,
+            -3.5422608914148285e-06,
+            0.004003930336512628,
+            3.826376985499442e-05,
+        ],
+    ),
+    (
+        [0.07828133577034713, 0.13409514555402444, 2.1268089038481874, 6.403827318755395],
+        [-0.3274417052805392, -4.392221581904577, -37.8793544116951, -38.01244153268952],
+        [
+            -7.548993824969804e-05,
+            -0.07304856531414634,
+            -805.1580264902159,
+            -1568.7801856400263,
+            1.9734814177250387e-05,
+            8.810749853188926e-05,
+        ],
+    ),
+]
+
+
+@pytest.mark.parametrize("case", SPREAD_STATES)
+def test_frequencies_of_spread_curves_agree_with_the_map(case) -> None:
+    """``sol.frequencies`` is given (no ValueError for a valid state) and equals
+    the frequency map's to the bit: both take the DD route on these curves."""
+    a, b, l0 = (np.array(v) for v in case)
+    top = manakov.ManakovTop(a, b)
+    nu = np.asarray(top.solve(l0).frequencies)
+    fm = manakov.frequency_map(top, l0[None, :])
+    assert manakov.tori.STATUS_NAMES[int(fm.status[0])] == "ok"
+    np.testing.assert_array_equal(nu, fm.frequencies[0])

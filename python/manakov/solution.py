@@ -387,7 +387,20 @@ class Solution:
         """The real torus of a genus-2 motion (docs/tori.md): a reduced basis
         ``λ1, λ2`` of the periods of ``l`` in the real plane of ``U`` and a
         second commuting flow (normalized frame), and ``(ν1, ν2)`` with
-        ``U T = ν1 λ1 + ν2 λ2`` (cycles per unit of the user's time)."""
+        ``U T = ν1 λ1 + ν2 λ2`` (cycles per unit of the user's time).
+
+        The frequencies come from the lattice coordinates of ``U`` in closed
+        form, in double-double where the branch points of (8) spread over more
+        than two orders of magnitude; they are those of
+        :func:`manakov.frequency_map` to the bit.
+
+        Raises
+        ------
+        ClosedFormError
+            The torus of this (valid) state could not be verified: the theta
+            quotients' second flow disagrees with its closed form, or no real
+            lattice fits. The message names the step.
+        """
         self._genus2("torus")
         if self._torus is None:
             lam, coords, nu, _ = self._motion.torus()

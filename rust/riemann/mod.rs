@@ -204,6 +204,23 @@ impl HyperellipticCurve {
         &self.e_user
     }
 
+    /// The spread of the branch points: `max_k |e_k| / min_{i<j} |e_i − e_j|`,
+    /// the ratio of the curve's largest scale to its smallest. Periods
+    /// computed in double are accurate to ~ε relative to the largest period,
+    /// so the periods of the smallest cycles, and what is solved from all of
+    /// them together, lose up to this factor.
+    pub fn spread(&self) -> f64 {
+        let e = &self.e_user;
+        let big = e.iter().fold(0.0f64, |m, z| m.max(z.norm()));
+        let mut sep = f64::INFINITY;
+        for i in 0..e.len() {
+            for j in (i + 1)..e.len() {
+                sep = sep.min((e[i] - e[j]).norm());
+            }
+        }
+        big / sep
+    }
+
     /// `x` (or an offset `dx`) in the internal coordinate `x / 2^k`.
     #[inline]
     fn x_in(&self, x: C) -> C {

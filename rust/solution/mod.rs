@@ -342,6 +342,23 @@ impl Solution {
         c4s.iter().map(|c4| sys.rate(c4, "U'")).collect()
     }
 
+    /// The velocity of the flow with coefficients `c4` fitted as in
+    /// [`Solution::rates`], with the relative residual of the fit and that of
+    /// `candidate` in the same equations (the quotients' velocity equations at
+    /// `v0`): where the quotients hardly depend on one direction of `u` (next
+    /// to a pinched curve) the fit is undetermined along it, and a candidate
+    /// that satisfies the equations as well as the fit does is as good.
+    pub fn rate_and_residual_of(
+        &self,
+        c4: &[f64; 6],
+        candidate: &[C; 2],
+    ) -> Result<(([C; 2], f64), f64)> {
+        let v0 = [self.u0[0] + self.rc[0], self.u0[1] + self.rc[1]];
+        let jet = self.plan.jet(&v0, 1)?;
+        let sys = VelocitySystem::at(&jet, &self.idx, &self.num, &self.den)?;
+        Ok((sys.rate(c4, "U'")?, sys.residual_at(candidate, c4)))
+    }
+
     /// The velocities `U` of the Manakov flows (1) with coefficients `c`
     /// (state order) for each `c` in `cs` on this level set, in closed form
     /// ([`dubrovin`]) and in this solution's sign convention, with their

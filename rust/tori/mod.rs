@@ -212,6 +212,24 @@ pub fn real_torus(
     u2: &C2,
     chars: &[Char],
 ) -> std::result::Result<RealTorus, TorusFailure> {
+    real_torus_with_rates(tau, u, u2, chars, None)
+}
+
+/// [`real_torus`] with the lattice coordinates `w = (X1, X2, Y1, Y2)` of `U`
+/// (`U = X + τY`) where they are known more accurately than `U` and `τ`
+/// (the closed form's lattice rates, [`crate::solution::dubrovin`]): the
+/// lattice basis is found from `U`, `U'` and `τ` as there, and `ν` from
+/// `w = ν1 c1 + ν2 c2` in the integer coordinates `c1`, `c2` of `λ1`, `λ2`,
+/// with no rounding of `τ` in it. Near pinched curves (branch points spread
+/// over 1e16, `τ` with entries of very different sizes) the metric's normal
+/// equations in `C²` lose up to 1e-11 of `ν` that `w` carries.
+pub fn real_torus_with_rates(
+    tau: &Tau,
+    u: &C2,
+    u2: &C2,
+    chars: &[Char],
+    w: Option<&[f64; 4]>,
+) -> std::result::Result<RealTorus, TorusFailure> {
     let finite = |z: &Complex64| z.re.is_finite() && z.im.is_finite();
     if !(tau.iter().flatten().all(finite) && u.iter().all(finite) && u2.iter().all(finite)) {
         return Err(TorusFailure::NonFinite);
@@ -236,6 +254,9 @@ pub fn real_torus(
     if residual.is_nan() || residual > RESIDUAL_TOL {
         return Err(TorusFailure::NoRealLattice { residual });
     }
+    if let Some(w) = w {
+        nu = rates_in_coords(w, &a.0, &b.0)?;
+    }
     for (k, v) in [&mut a, &mut b].into_iter().enumerate() {
         if nu[k] < 0.0 {
             nu[k] = -nu[k];
@@ -248,6 +269,29 @@ pub fn real_torus(
         coords: [c1, c2],
         nu,
     })
+}
+
+/// `(ν1, ν2)` with `w = ν1 c1 + ν2 c2` by least squares in `R⁴` (`c1`, `c2`
+/// independent integer vectors), with the relative residual against
+/// [`RESIDUAL_TOL`].
+fn rates_in_coords(
+    w: &[f64; 4],
+    c1: &Coords,
+    c2: &Coords,
+) -> std::result::Result<[f64; 2], TorusFailure> {
+    let (x, y) = (c1.map(|v| v as f64), c2.map(|v| v as f64));
+    let dot = |p: &[f64; 4], q: &[f64; 4]| (0..4).map(|k| p[k] * q[k]).sum::<f64>();
+    let (g11, g12, g22) = (dot(&x, &x), dot(&x, &y), dot(&y, &y));
+    let (r1, r2) = (dot(&x, w), dot(&y, w));
+    // integer vectors: g11 g22 − g12² is an integer, computed exactly
+    let gd = g11 * g22 - g12 * g12;
+    let nu = [(g22 * r1 - g12 * r2) / gd, (g11 * r2 - g12 * r1) / gd];
+    let fit: [f64; 4] = std::array::from_fn(|k| w[k] - nu[0] * x[k] - nu[1] * y[k]);
+    let residual = dot(&fit, &fit).sqrt() / dot(w, w).sqrt();
+    if residual.is_nan() || residual > RESIDUAL_TOL {
+        return Err(TorusFailure::NoRealLattice { residual });
+    }
+    Ok(nu)
 }
 
 /// `‖p1‖` and an orthonormal basis `(e1, e2, q1, q2)` of `R⁴` in the metric
@@ -649,6 +693,9 @@ pub struct FlowData {
     pub u: C2,
     pub u2: C2,
     pub chars: Vec<Char>,
+    /// The lattice coordinates `(X1, X2, Y1, Y2)` of `u` (`U = X + τY`) where
+    /// the closed form gave them ([`real_torus_with_rates`]).
+    pub w: Option<[f64; 4]>,
 }
 
 /// `b'` of the second commuting flow (see `docs/tori.md` §2): with the cubic
@@ -693,7 +740,7 @@ where
         Ok(d) => d,
         Err(e) => return MapEntry::failed(classify(&e)),
     };
-    match real_torus(&d.tau, &d.u, &d.u2, &d.chars) {
+    match real_torus_with_rates(&d.tau, &d.u, &d.u2, &d.chars, d.w.as_ref()) {
         Ok(t) => MapEntry {
             status: Status::Ok,
             nu: t.nu,

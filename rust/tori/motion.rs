@@ -16,7 +16,7 @@
 use num_complex::Complex64 as C;
 
 use super::solve::{classify as classify_error, flow_data, level_set_entry};
-use super::{real_torus, MapEntry, RealTorus, Status};
+use super::{real_torus_with_rates, MapEntry, RealTorus, Status};
 use crate::error::{Error, Result};
 use crate::numeric::cancel::Cancel;
 use crate::solution::motion::{classify, Kind, Motion};
@@ -73,7 +73,7 @@ pub fn state_frequencies_in_with(frame: &TopFrame, l0: &[f64; 6], cancel: &Cance
 /// user's time.
 ///
 /// Errors: a motion of another kind (the message names it; those have no
-/// 2-torus), and those of [`flow_data`] and [`real_torus`].
+/// 2-torus), and those of [`flow_data`] and [`real_torus_with_rates`].
 pub fn torus_of_motion(m: &Motion) -> Result<(RealTorus, [C; 2])> {
     let sol = m.genus2().ok_or_else(|| Error::InvalidArgument {
         what: "state l0",
@@ -83,8 +83,31 @@ pub fn torus_of_motion(m: &Motion) -> Result<(RealTorus, [C; 2])> {
             m.kind().name()
         ),
     })?;
-    let d = flow_data(sol, &m.frame().second_flow_b())?;
-    let mut t = real_torus(&d.tau, &d.u, &d.u2, &d.chars)?;
+    let torus = flow_data(sol, &m.frame().second_flow_b()).and_then(|d| {
+        Ok((
+            real_torus_with_rates(&d.tau, &d.u, &d.u2, &d.chars, d.w.as_ref())?,
+            d.u2,
+        ))
+    });
+    let (mut t, u2) = torus.map_err(torus_refusal)?;
     t.nu = t.nu.map(|v| v * m.time_scale());
-    Ok((t, d.u2))
+    Ok((t, u2))
+}
+
+/// An error of the torus of a valid genus-2 motion: a refusal
+/// ([`Error::Unverified`], Python's `ClosedFormError`) naming the step, not
+/// invalid input (as the set-up's own refusals, `solution::motion`);
+/// cancellation passes.
+fn torus_refusal(e: Error) -> Error {
+    let step = match &e {
+        Error::Unverified { .. } | Error::Interrupted => return e,
+        Error::Singular { what, reason, .. } | Error::InvalidArgument { what, reason } => {
+            format!("{what}: {reason}")
+        }
+        other => other.to_string(),
+    };
+    Error::Unverified {
+        what: "torus of this l0",
+        reason: format!("{step}; the state is valid"),
+    }
 }

@@ -22,12 +22,35 @@ use num_complex::Complex64 as C;
 use super::{frequencies_of_state, second_flow_b, Char, FlowData, MapEntry, RealTorus, Status};
 use crate::error::{Error, Result, SingularKind};
 use crate::numeric::cancel::Cancel;
+use crate::riemann::HyperellipticCurve;
 use crate::so4;
 use crate::solution::dubrovin::{
-    half_period_velocities, lattice_rates_dd, CLOSED_FORM, CLOSED_VS_FIT_RTOL,
+    check_against_fit, half_period_velocities, lattice_rates_dd, CLOSED_FORM,
 };
 use crate::solution::velocity::algebraic_rates;
 use crate::solution::{a_periods_of, level_set_curve, Solution};
+
+/// Above this spread of the branch points ([`HyperellipticCurve::spread`])
+/// the frequencies are computed from the velocities and periods in
+/// double-double on the unrounded branch points, below it in double. The
+/// double route is accurate to ~ε times the spread: against the DD route, at
+/// most 4.7e-15 (relative, max norm) where the spread is at most 100, on 1000
+/// random tops (`a` sorted uniform in [−2, 2], `b` uniform, `l0` normal) and on
+/// the 887 states of the harsh draw (tests/data/every_state_harsh.py) that
+/// have one; up to 3.3e-14 at spreads up to 1e3, and 4.6e-3 on the harsh draw's
+/// spreads (up to 1e29), where it was the frequency maps' error. The DD route
+/// costs about 1.5 times the double one per state; the shared tops have
+/// spreads 21–65.
+pub const DD_SPREAD: f64 = 100.0;
+
+/// Whether the frequencies of a level set with this curve take the DD route
+/// ([`DD_SPREAD`]): both the frequency map and `sol.torus` decide by it, on
+/// the same curve, so they give the same frequencies.
+pub fn needs_dd(curve: &HyperellipticCurve) -> bool {
+    // a NaN spread (non-finite branch points) takes the DD route too
+    let spread = curve.spread();
+    spread.is_nan() || spread > DD_SPREAD
+}
 
 /// The six `c_ij` (`i < j`, state order) of `ManakovTop(a, b)` (2).
 pub fn c_pairs(a: &[f64; 4], b: &[f64; 4]) -> Result<[f64; 6]> {
@@ -46,9 +69,31 @@ pub fn flow_data(sol: &Solution, b2: &[f64; 4]) -> Result<FlowData> {
         .map(|(a, b)| [a[0], a[1], b[0], b[1]])
         .collect();
     let c2 = c_pairs(sol.a(), b2)?;
+    // The velocities themselves in closed form (the solution's sign
+    // convention), in double or DD by the curve's spread ([`needs_dd`]), as
+    // the frequency map takes them (the same numbers, so the two routes give
+    // the same frequencies).
+    // Where the closed form refuses (its half periods disagree beyond
+    // rounding: the Clebsch contraction's top, one a_i ~ 1e8 and more, whose
+    // rounded c_ij are of the form (2) only to ~1e-12 of the flow), the
+    // solution's U is its fit, and so is U'.
+    let closed = match sol.closed_rates(&[*sol.c4(), c2], needs_dd(sol.curve())) {
+        Ok(lat) => Some(lat),
+        Err(Error::InvalidArgument {
+            what: CLOSED_FORM, ..
+        }) => None,
+        Err(e) => return Err(e),
+    };
     // The top's own flow was checked by `Solution::new` (the same equations);
-    // the second flow's fit must hold as well before it defines the real plane.
-    let (u2, res) = sol.rates(&[c2])?[0];
+    // the second flow's fit must hold as well before it defines the real plane,
+    // and it must agree with the closed form: within CLOSED_VS_FIT_RTOL, or
+    // the closed form satisfies the quotients' equations as well as the fit
+    // does (next to a pinched curve the fit is undetermined along one
+    // direction; `dubrovin::check_against_fit`, as `Solution::new` does for U).
+    let candidate = closed
+        .as_ref()
+        .map_or([C::new(0.0, 0.0); 2], |lat| lat.u[1]);
+    let ((u2, res), res_closed) = sol.rate_and_residual_of(&c2, &candidate)?;
     if res.is_nan() || res > QUOTIENT_RESIDUAL_RTOL {
         return Err(Error::Singular {
             what: INCONSISTENT,
@@ -61,49 +106,36 @@ pub fn flow_data(sol: &Solution, b2: &[f64; 4]) -> Result<FlowData> {
             ),
         });
     }
-    // The velocities themselves in closed form (the solution's sign
-    // convention) with the curve's double periods, as the frequency map takes
-    // them (the same numbers, so the two routes give the same frequencies);
-    // the fit must reproduce the second flow's.
-    // Where the closed form refuses (its half periods disagree beyond
-    // rounding: the Clebsch contraction's top, one a_i ~ 1e8 and more, whose
-    // rounded c_ij are of the form (2) only to ~1e-12 of the flow), the
-    // solution's U is its fit, and so is U'.
-    let lat = match sol.closed_rates(&[*sol.c4(), c2], false) {
-        Ok(lat) => lat,
-        Err(Error::InvalidArgument {
-            what: CLOSED_FORM, ..
-        }) => {
-            return Ok(FlowData {
-                tau: [[t[0], t[1]], [t[2], t[3]]],
-                u: sol.rate(),
-                u2,
-                chars,
-            })
-        }
-        Err(e) => return Err(e),
+    let Some(lat) = closed else {
+        return Ok(FlowData {
+            tau: [[t[0], t[1]], [t[2], t[3]]],
+            u: sol.rate(),
+            u2,
+            chars,
+            w: None,
+        });
     };
     let (u, u2_closed) = (lat.u[0], lat.u[1]);
     let dev = (u2_closed[0] - u2[0])
         .norm()
         .max((u2_closed[1] - u2[1]).norm())
         / u2[0].norm().max(u2[1].norm()).max(f64::MIN_POSITIVE);
-    if dev.is_nan() || dev > CLOSED_VS_FIT_RTOL {
-        return Err(Error::Singular {
-            what: INCONSISTENT,
-            kind: SingularKind::InconsistentQuotients,
-            reason: format!(
-                "the theta quotients (9)-(10) at v0 move along the second flow at a velocity \
-                 {dev:e} (relative) away from the closed form: the solution's set-up is wrong \
-                 at this state; its frequencies would be too"
-            ),
-        });
-    }
+    check_against_fit(dev, res_closed, res).map_err(|_| Error::Singular {
+        what: INCONSISTENT,
+        kind: SingularKind::InconsistentQuotients,
+        reason: format!(
+            "the theta quotients (9)-(10) at v0 move along the second flow at a velocity \
+             {dev:e} (relative) away from the closed form, which leaves a residual \
+             {res_closed:e} in their equations against {res:e} for their own fit: the \
+             solution's set-up is wrong at this state; its frequencies would be too"
+        ),
+    })?;
     Ok(FlowData {
         tau: [[t[0], t[1]], [t[2], t[3]]],
         u,
         u2: u2_closed,
         chars,
+        w: Some(lat.w[0]),
     })
 }
 
@@ -157,17 +189,42 @@ pub fn level_set_flow_data_c4(
     c2: &[f64; 6],
     l0: &[f64; 6],
 ) -> Result<FlowData> {
+    level_set_flow_data_route(a, c4, c2, l0, None)
+}
+
+/// [`level_set_flow_data_c4`] with the route forced: `Some(true)` DD,
+/// `Some(false)` double, `None` by [`needs_dd`] (the tests compare them).
+pub(crate) fn level_set_flow_data_route(
+    a: &[f64; 4],
+    c4: &[f64; 6],
+    c2: &[f64; 6],
+    l0: &[f64; 6],
+    route: Option<bool>,
+) -> Result<FlowData> {
     let (c4, c2) = (*c4, *c2);
     let ls = level_set_curve(a, l0)?;
-    // In double with the curve's double periods: frequencies to ~1e-15 on
-    // well-separated a, ~1e-11 on the stiffest tops met (docs/tori.md; the
-    // DD of the solution's phase would cost about as much as the rest of the
-    // state), and `flow_data` takes the same numbers.
-    let rates = match half_period_velocities(&ls.kotter, l0, &[c4, c2], false) {
-        Ok(hp) => lattice_rates_dd(&ls.curve, None, &hp.v_dd)?.u,
+    // In double with the curve's double periods where the branch points are
+    // spread over less than DD_SPREAD (frequencies to ~5e-15), else in DD on
+    // the unrounded branch points ([`needs_dd`]); `flow_data` takes the same
+    // numbers.
+    let dd = route.unwrap_or_else(|| needs_dd(&ls.curve));
+    let (rates, w) = match half_period_velocities(&ls.kotter, l0, &[c4, c2], dd) {
+        Ok(hp) => {
+            let e_lo = if dd {
+                hp.branch_point_errors(&ls.curve)
+            } else {
+                None
+            };
+            let lat = lattice_rates_dd(&ls.curve, e_lo.as_ref().map(|e| &e[..]), &hp.v_dd)?;
+            let w = lat.w[0];
+            (lat.u, Some(w))
+        }
         Err(Error::InvalidArgument {
             what: CLOSED_FORM, ..
-        }) => algebraic_rates(&ls.kotter, &ls.kcurve, &a_periods_of(&ls.curve), &[c4, c2])?.rates,
+        }) => (
+            algebraic_rates(&ls.kotter, &ls.kcurve, &a_periods_of(&ls.curve), &[c4, c2])?.rates,
+            None,
+        ),
         Err(e) => return Err(e),
     };
     let t = ls.curve.tau_row_major();
@@ -180,6 +237,7 @@ pub fn level_set_flow_data_c4(
             .iter()
             .map(|(a, b)| [a[0], a[1], b[0], b[1]])
             .collect(),
+        w,
     })
 }
 
@@ -276,8 +334,9 @@ pub fn rate_for(sol: &Solution, c4: &[f64; 6]) -> Result<[C; 2]> {
 pub use crate::solution::{INCONSISTENT, QUOTIENT_RESIDUAL_RTOL};
 
 /// The real torus of the state `l0` of the top `(a, b)` and the second
-/// velocity `U'`, or the error that stopped it (the solution's, or the
-/// lattice's as [`Error::InvalidArgument`]).
+/// velocity `U'`, or the error that stopped it: invalid input, the solution's
+/// refusal, or the torus's own ([`Error::Unverified`] naming the step: a
+/// valid state whose torus could not be verified).
 ///
 /// Through the dispatcher ([`crate::solution::motion::Motion`]): the torus of
 /// a genus-2 state of the normalized top, frequencies in the user's time; a
