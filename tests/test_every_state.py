@@ -351,11 +351,31 @@ PAIR_STATES = [
 ]
 
 
-@pytest.mark.parametrize("case", CLUSTER_STATES + PAIR_STATES)
+#: A state of the same draw on which Aberth's iteration for the roots of F
+#: stagnates at 4e-8 (two roots close on different branches of sqrt(G)); the
+#: polish on each root's branch takes them from there.
+STAGNATED_STATES = [
+    (
+        [0.4906486624518043, 849.2029365673407, 852.4395190667476, 853.1409658853977],
+        [-0.15449475690630932, 1.9144575054865607, -127.61880186474794, -127.60585586348964],
+        [
+            -456.9904385747293,
+            5509.035025749608,
+            1.8910900566656828,
+            97.27429121140668,
+            -0.00048433758429113104,
+            245.90032603668266,
+        ],
+        0.004512779735189873,
+    ),
+]
+
+
+@pytest.mark.parametrize("case", CLUSTER_STATES + PAIR_STATES + STAGNATED_STATES)
 def test_roots_of_f_clustered_at_a_branch_point_are_solved(case) -> None:
     """Solved to HARSH_BOUND against the long-double reference over the harsh
     draw's window; the earlier code refused each ("F(s) (19) has a repeated
-    root")."""
+    root", or for the last "roots of F(s) (19) did not converge")."""
     pytest.importorskip("heyoka")
     data = str(Path(__file__).resolve().parent / "data")
     if data not in sys.path:
