@@ -107,6 +107,9 @@ pub(super) struct Built {
     pub(super) num: [[C; 8]; 6],
     pub(super) den: [C; 8],
     pub(super) rate: [C; 2],
+    /// Whether `rate` is the closed form's (else the quotients' fit: the
+    /// closed form refused, or disagreed with the quotients' equations).
+    pub(super) closed: bool,
 }
 
 /// The sign patterns to try: the signs decided at `v0` with every

@@ -248,8 +248,27 @@ impl Solution {
             closed: &closed,
             check: SelfCheck::new(a, l0, &c4),
         };
-        let (self_check, Built { cl, num, den, rate }) = cands.best(&cl0, &calibration)?;
+        let (
+            self_check,
+            Built {
+                cl,
+                num,
+                den,
+                rate,
+                closed: closed_used,
+            },
+        ) = cands.best(&cl0, &calibration)?;
         let (x0, y0) = d.curve.lattice_coordinates(&d.v0);
+        // the phase of the closed form where the checked pattern took it, else
+        // of the fit
+        let closed = if closed_used {
+            closed
+        } else {
+            Err(Error::InvalidArgument {
+                what: dubrovin::CLOSED_FORM,
+                reason: "the closed form misses the theta quotients' equations at v0".into(),
+            })
+        };
         let phase = Phase::new(&d.curve, &closed, rate);
         let Divisor0 {
             kotter,

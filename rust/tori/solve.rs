@@ -34,14 +34,24 @@ use crate::solution::{a_periods_of, level_set_curve, Solution};
 /// the frequencies are computed from the velocities and periods in
 /// double-double on the unrounded branch points, below it in double. The
 /// double route is accurate to ~ε times the spread: against the DD route, at
-/// most 4.7e-15 (relative, max norm) where the spread is at most 100, on 1000
-/// random tops (`a` sorted uniform in [−2, 2], `b` uniform, `l0` normal) and on
-/// the 887 states of the harsh draw (tests/data/every_state_harsh.py) that
-/// have one; up to 3.3e-14 at spreads up to 1e3, and 4.6e-3 on the harsh draw's
-/// spreads (up to 1e29), where it was the frequency maps' error. The DD route
-/// costs about 1.5 times the double one per state; the shared tops have
-/// spreads 21–65.
+/// most 4.2e-15 (relative, max norm) where the spread is at most 100 (Rust
+/// `tori::tests::the_double_route_is_good_where_the_spread_is_moderate`), up
+/// to 3.3e-14 at spreads up to 1e3 and 1e-11 at spreads up to 1e12 (tops with
+/// two close `a_i`). The DD route costs about 1.5 times the double one per
+/// state; the shared tops have spreads 21–65.
 pub const DD_SPREAD: f64 = 100.0;
+
+/// Above this spread of the branch points the frequency map does not take
+/// the level set's closed form unchecked: it takes the Theorem's solution,
+/// whose set-up checks the closed form against the theta quotients' own
+/// velocity at `v0` and takes their fit where the two disagree
+/// (docs/theorem.md). There the clustered branch points are below the
+/// resolution of the largest one in double; on the harsh random draw
+/// (tests/data/every_state_harsh.py, seed 5, 2000 states) the closed form's
+/// frequencies were off by 1e-12 … 3.5e5 relative on 28 states, all with
+/// spreads from 9.8e16 up (none below), while the Theorem's agreed with the
+/// spectrum of an integrated trajectory.
+pub const CLOSED_FORM_SPREAD: f64 = 1e14;
 
 /// Whether the frequencies of a level set with this curve take the DD route
 /// ([`DD_SPREAD`]): both the frequency map and `sol.torus` decide by it, on
@@ -203,6 +213,18 @@ pub(crate) fn level_set_flow_data_route(
 ) -> Result<FlowData> {
     let (c4, c2) = (*c4, *c2);
     let ls = level_set_curve(a, l0)?;
+    let spread = ls.curve.spread();
+    if spread.is_nan() || spread > CLOSED_FORM_SPREAD {
+        return Err(Error::Singular {
+            what: CLOSED_FORM,
+            kind: SingularKind::NoVelocityConsensus,
+            reason: format!(
+                "the branch points of (8) spread over {:e} (> {CLOSED_FORM_SPREAD:e}): the level \
+                 set's closed form is not checked there; the Theorem's solution checks it",
+                spread
+            ),
+        });
+    }
     // In double with the curve's double periods where the branch points are
     // spread over less than DD_SPREAD (frequencies to ~5e-15), else in DD on
     // the unrounded branch points ([`needs_dd`]); `flow_data` takes the same
