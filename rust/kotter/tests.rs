@@ -265,27 +265,32 @@ fn round_trip_near_branch_point_uses_offsets() {
             .map(|dj| (p.z2 - dj).norm().min((p.z1 - dj).norm()))
             .fold(f64::INFINITY, f64::min);
         assert!(near < 1e-8, "{near}");
-        let coef = st.constants.coefficients23();
-        let d = st.constants.d;
-        let back = from_kotter(
-            &coef,
-            d,
-            [p.z1, p.z2],
-            [p.y1, p.y2],
-            Some([p.zd1, p.zd2]),
-            p.g,
-            p.eps,
-        )
-        .unwrap();
-        let size = l.iter().fold(0.0f64, |m, v| m.max(v.abs()));
-        for i in 0..6 {
-            assert!(
-                (back[i] - l[i]).abs() < 1e-12 * size,
-                "{i}: {} vs {}",
-                back[i],
-                l[i]
-            );
-        }
+        assert_reproduces_the_state(&st, &l);
+    }
+}
+
+/// The state back from the reduction's points (23) to 1e-12 of its size.
+fn assert_reproduces_the_state(st: &KotterState, l: &[f64; 6]) {
+    let p = st.points;
+    let coef = st.constants.coefficients23();
+    let back = from_kotter(
+        &coef,
+        st.constants.d,
+        [p.z1, p.z2],
+        [p.y1, p.y2],
+        Some([p.zd1, p.zd2]),
+        p.g,
+        p.eps,
+    )
+    .unwrap();
+    let size = l.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    for i in 0..6 {
+        assert!(
+            (back[i] - l[i]).abs() < 1e-12 * size,
+            "{i}: {} vs {}",
+            back[i],
+            l[i]
+        );
     }
 }
 
@@ -705,26 +710,6 @@ fn roots_clustered_at_a_branch_point_away_from_h0_zero() {
                     .any(|q| (s[p] - s[q]).norm() <= REPEATED_ROOT_RTOL * s[p].norm())),
             "{s:?}"
         );
-        let p = st.points;
-        let coef = st.constants.coefficients23();
-        let back = from_kotter(
-            &coef,
-            st.constants.d,
-            [p.z1, p.z2],
-            [p.y1, p.y2],
-            Some([p.zd1, p.zd2]),
-            p.g,
-            p.eps,
-        )
-        .unwrap();
-        let size = l.iter().fold(0.0f64, |m, v| m.max(v.abs()));
-        for i in 0..6 {
-            assert!(
-                (back[i] - l[i]).abs() < 1e-12 * size,
-                "{i}: {} vs {}",
-                back[i],
-                l[i]
-            );
-        }
+        assert_reproduces_the_state(&st, &l);
     }
 }

@@ -102,6 +102,13 @@ pub struct Motion {
 /// coordinate of the reduction, an iteration that did not converge). The step
 /// and its numbers stay in the message; cancellation and size errors pass.
 fn refusal(e: Error) -> Error {
+    refusal_of("closed form for this l0", "integrate it instead", e)
+}
+
+/// [`Error::Unverified`] for `what` of a valid state, the failed step and
+/// its numbers in the message, then `advice`; cancellation and size errors
+/// pass (the closed form's refusals here, the torus's in `tori::motion`).
+pub(crate) fn refusal_of(what: &'static str, advice: &str, e: Error) -> Error {
     let step = match &e {
         Error::Unverified { .. }
         | Error::Interrupted
@@ -113,8 +120,8 @@ fn refusal(e: Error) -> Error {
         other => other.to_string(),
     };
     Error::Unverified {
-        what: "closed form for this l0",
-        reason: format!("{step}; the state is valid: integrate it instead"),
+        what,
+        reason: format!("{step}; the state is valid: {advice}"),
     }
 }
 

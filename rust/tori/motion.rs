@@ -19,7 +19,7 @@ use super::solve::{classify as classify_error, flow_data, level_set_entry};
 use super::{real_torus_with_rates, MapEntry, RealTorus, Status};
 use crate::error::{Error, Result};
 use crate::numeric::cancel::Cancel;
-use crate::solution::motion::{classify, Kind, Motion};
+use crate::solution::motion::{classify, refusal_of, Kind, Motion};
 use crate::solution::normalize::TopFrame;
 use crate::solution::transverse::euler_frequencies_with;
 
@@ -96,18 +96,11 @@ pub fn torus_of_motion(m: &Motion) -> Result<(RealTorus, [C; 2])> {
 
 /// An error of the torus of a valid genus-2 motion: a refusal
 /// ([`Error::Unverified`], Python's `ClosedFormError`) naming the step, not
-/// invalid input (as the set-up's own refusals, `solution::motion`);
-/// cancellation passes.
+/// invalid input, as the set-up's own refusals.
 fn torus_refusal(e: Error) -> Error {
-    let step = match &e {
-        Error::Unverified { .. } | Error::Interrupted => return e,
-        Error::Singular { what, reason, .. } | Error::InvalidArgument { what, reason } => {
-            format!("{what}: {reason}")
-        }
-        other => other.to_string(),
-    };
-    Error::Unverified {
-        what: "torus of this l0",
-        reason: format!("{step}; the state is valid"),
-    }
+    refusal_of(
+        "torus of this l0",
+        "its solution l(t) stands; its frequencies are not known",
+        e,
+    )
 }
