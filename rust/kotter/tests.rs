@@ -141,19 +141,7 @@ proptest! {
 fn uniformization_round_trip() {
     let st = kotter(&A, &L0).unwrap();
     let p = st.points;
-    let back = from_kotter(
-        &st.constants.coefficients23(),
-        st.constants.d,
-        [p.z1, p.z2],
-        [p.y1, p.y2],
-        Some([p.zd1, p.zd2]),
-        p.g,
-        p.eps,
-    )
-    .unwrap();
-    for i in 0..6 {
-        assert_relative_eq!(back[i], L0[i], epsilon = 1e-12);
-    }
+    assert_reproduces_the_state(&st, &L0);
     let w = st
         .curve
         .wurzel(p.z1, p.y1, p.z2, p.y2, Some(p.eps))
@@ -269,12 +257,11 @@ fn round_trip_near_branch_point_uses_offsets() {
     }
 }
 
-/// The state back from the reduction's points (23) to 1e-12 of its size.
-fn assert_reproduces_the_state(st: &KotterState, l: &[f64; 6]) {
+/// The state back from the reduction's points by (23).
+fn state_back(st: &KotterState) -> [f64; 6] {
     let p = st.points;
-    let coef = st.constants.coefficients23();
-    let back = from_kotter(
-        &coef,
+    from_kotter(
+        &st.constants.coefficients23(),
         st.constants.d,
         [p.z1, p.z2],
         [p.y1, p.y2],
@@ -282,7 +269,12 @@ fn assert_reproduces_the_state(st: &KotterState, l: &[f64; 6]) {
         p.g,
         p.eps,
     )
-    .unwrap();
+    .unwrap()
+}
+
+/// The state back from the reduction's points (23) to 1e-12 of its size.
+fn assert_reproduces_the_state(st: &KotterState, l: &[f64; 6]) {
+    let back = state_back(st);
     let size = l.iter().fold(0.0f64, |m, v| m.max(v.abs()));
     for i in 0..6 {
         assert!(
@@ -617,17 +609,7 @@ fn constants_are_continuous_down_to_h0_zero() {
         .fold(1.0f64, |m, d| m.max(d.norm()).max(1.0 / d.norm()));
     assert!(q3.norm() <= 1e-14 * scale * dmax, "{q3}");
     let st = kotter_with(at0, &l).unwrap();
-    let p = st.points;
-    let back = from_kotter(
-        &st.constants.coefficients23(),
-        st.constants.d,
-        [p.z1, p.z2],
-        [p.y1, p.y2],
-        Some([p.zd1, p.zd2]),
-        p.g,
-        p.eps,
-    )
-    .unwrap();
+    let back = state_back(&st);
     let err = back
         .iter()
         .zip(&l)
