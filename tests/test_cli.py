@@ -15,24 +15,17 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from _npz import load_npz
 
 import manakov
 from manakov import cli
 from manakov._progress import ProgressBar
 
 
-def _load_npz(path):
-    """The arrays of an .npz file, read and the file closed (an open NpzFile
-    left to the garbage collector warns, and pytest turns that into a failure
-    of whichever test runs then)."""
-    with np.load(path) as f:
-        return {k: f[k] for k in f.files}
-
-
 def test_simulate_builtin_problem_writes_npz_and_png(tmp_path, capsys):
     out = tmp_path / "gen.npz"
     assert cli.main(["simulate", "generic", "--t-end", "20", "-o", str(out)]) == 0
-    data = _load_npz(out)
+    data = load_npz(out)
     p = manakov.problem("generic")
     np.testing.assert_array_equal(data["l"][0], p.l0)
     assert data["t"][-1] == 20.0 and data["l"].shape == (data["t"].size, 6)
@@ -177,7 +170,7 @@ def test_explicit_methods_run_without_dt(method, tmp_path, capsys):
     assert cli.main(argv) == 0
     text = capsys.readouterr().out
     assert f"with {method}" in text and "mean step" in text
-    data = _load_npz(out)
+    data = load_npz(out)
     assert data["t"][-1] == 5.0 and not data["partial"]
 
 
@@ -198,7 +191,7 @@ def test_default_samples_do_not_shrink_the_step_and_the_step_used_is_printed(tmp
     assert steps == samples - 1  # one step per sample interval
     assert step == pytest.approx(t_end / steps, rel=1e-3)
     assert dt / 1.01 < step <= dt * (1 + 1e-9)  # the method's step, not smaller
-    assert _load_npz(out)["t"].size == samples
+    assert load_npz(out)["t"].size == samples
 
 
 def test_explicit_samples_print_the_step_they_force(tmp_path, capsys):
@@ -394,7 +387,7 @@ def test_sigint_writes_partial_output_and_exits_130(tmp_path, suffix):
     assert str(part) in err and "(partial)" in err
     assert not out.exists()
     if suffix == ".npz":
-        data = _load_npz(part)
+        data = load_npz(part)
         t, l = data["t"], data["l"]
         assert bool(data["partial"])
     else:
@@ -543,7 +536,7 @@ def test_every_top_command_takes_a_problem_file(tmp_path, suffix):
         r = _run(*argv, "--problem-file", str(path), cwd=tmp_path)
         assert r.returncode == 0, (argv, r.stderr)
         assert "mytop" in r.stdout, (argv, r.stdout)
-    np.testing.assert_array_equal(_load_npz(tmp_path / "s.npz")["l"][0], l0v)
+    np.testing.assert_array_equal(load_npz(tmp_path / "s.npz")["l"][0], l0v)
 
 
 def test_a_problem_file_with_a_table_of_tops_is_picked_by_name(tmp_path):

@@ -16,6 +16,7 @@ import time
 
 import numpy as np
 import pytest
+from _npz import load_npz
 
 import manakov
 from manakov import HyperellipticCurve
@@ -37,14 +38,6 @@ TOP = manakov.ManakovTop(P.a, P.b)
 L0 = np.asarray(P.l0, dtype=float)
 
 posix = pytest.mark.skipif(sys.platform == "win32", reason="POSIX signals and rlimits")
-
-
-def _load_npz(path):
-    """The arrays of an .npz file, read and the file closed (an open NpzFile
-    left to the garbage collector warns, and pytest turns that into a failure
-    of whichever test runs then)."""
-    with np.load(path) as f:
-        return {k: f[k] for k in f.files}
 
 
 def _limited() -> None:  # runs in the child before exec
@@ -362,7 +355,7 @@ def test_cli_without_matplotlib_names_the_extra_and_writes_the_data(tmp_path):
     )
     assert "Traceback" not in proc.stderr, proc.stderr[-2000:]
     assert "manakov[plot]" in proc.stderr, proc.stderr
-    data = _load_npz(tmp_path / "m.npz")
+    data = load_npz(tmp_path / "m.npz")
     assert data["status"].shape == (3, 3) and data["nu"].shape == (3, 3, 2)
     argv = ["theorem", "generic", "-o", str(png), "--t-end", "1", "--samples", "3"]
     proc = subprocess.run(
