@@ -7,7 +7,7 @@
 use super::pairs::{self, PAIR_ROUTE_RTOL};
 use super::polish::{polish_root, Level, PolishedRoot};
 use super::roots::{
-    check_converged, order_for_polish, quartic_f_den, quartic_roots_unordered, repeated_pair,
+    check_converged, documented_order, quartic_f_den, quartic_roots_unordered, repeated_pair,
     repeated_root_error,
 };
 use super::{check_a, integrals, l_from_m_n, m_n, C, CYCLIC, ONE, ZERO};
@@ -288,11 +288,16 @@ fn roots_of_f(
         });
     }
     let (z, converged, last) = quartic_roots_unordered(f)?;
-    let z = order_for_polish(z);
-    let clustered = repeated_pair(&z);
+    let z = documented_order(z);
     let roots = polished_roots(lv, p_at_a, &z);
     let s: Vec<C> = roots.iter().map(|r| r.s).collect();
-    if clustered.is_none() && repeated_pair(&s).is_none() {
+    // two roots within rounding of each other in the iterate, or polished onto
+    // each other
+    let repeated = match repeated_pair(&z) {
+        Some(pair) => Some((pair, &z[..])),
+        None => repeated_pair(&s).map(|pair| (pair, &s[..])),
+    };
+    let Some(((i, j), at)) = repeated else {
         // Aberth stagnates where two roots of F lie close on different
         // branches of √G (it sees F, not f): the polish on each root's own
         // branch takes them from the stagnated iterate, and the roots stand
@@ -306,26 +311,16 @@ fn roots_of_f(
                 return Err(e);
             }
         }
-    }
-    let repeated = match (clustered, repeated_pair(&s)) {
-        (Some((i, j)), _) => Some((i, j, repeated_root_error(&z, i, j))),
-        (None, Some((i, j))) => Some((i, j, repeated_root_error(&s, i, j))),
-        (None, None) => None,
+        return Ok((roots, None));
     };
-    if let Some((i, j, err)) = repeated {
-        // Two roots within rounding of each other (or polished onto each
-        // other) at a branch point of √G: found in the local parameter there
-        // (pairs.rs), or refused as a repeated root.
-        let found = pairs::branch_point_cluster(lv, p_at_a, roots, (i, j))
-            // a pair at a root of P = h1 s^2 - h2 s + h3 whose split 2 h0 √G/P' is
-            // small though h0 is not (pairs.rs checks the split and the polish)
-            .or_else(|| pairs::pair_roots(lv, p_at_a));
-        return match found {
-            Some((r, partner, side)) => Ok((r.into(), Some(PairStructure { partner, side }))),
-            None => Err(err),
-        };
-    }
-    Ok((roots, None))
+    // A cluster at a branch point of √G is found in the local parameter there;
+    // a pair at a root of P = h1 s^2 - h2 s + h3 whose split 2 h0 √G/P' is
+    // small though h0 is not, by the pair route (pairs.rs checks the split and
+    // the polish); else a repeated root.
+    pairs::branch_point_cluster(lv, p_at_a, roots, (i, j))
+        .or_else(|| pairs::pair_roots(lv, p_at_a))
+        .map(|(r, partner, side)| (r.into(), Some(PairStructure { partner, side })))
+        .ok_or_else(|| repeated_root_error(at, i, j))
 }
 
 /// What the pair route knows of its roots ([`pairs::pair_roots`]): which is

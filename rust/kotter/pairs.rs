@@ -219,45 +219,87 @@ pub(super) fn pair_roots(lv: &Level, p_at_a: &[f64; 4]) -> Option<PairRoute> {
 fn order_pairs(roots: Vec<PairRoot>, h0: f64) -> Option<PairRoute> {
     let kappa = if h0 == 0.0 { 1.0 } else { h0 };
     // Im s: that of the offset (exact at a branch point, first order in a pair of
-    // the expansion), ties (h0 = 0) broken by the first-order split.
-    let im = |p: &PairRoot| p.off.im;
-    let im_cmp = |p: &PairRoot, q: &PairRoot| {
-        im(p)
-            .total_cmp(&im(q))
-            .then((p.rho * kappa).im.total_cmp(&(q.rho * kappa).im))
-    };
-    let re_cmp = |p: &PairRoot, q: &PairRoot| {
-        p.r.total_cmp(&q.r)
-            .then(p.off.re.total_cmp(&q.off.re))
-            .then((p.rho * kappa).re.total_cmp(&(q.rho * kappa).re))
-    };
-    let by_im_re = |p: &PairRoot, q: &PairRoot| im_cmp(p, q).then(re_cmp(p, q));
-    let mut rest: Vec<PairRoot> = roots;
-    let mut order: Vec<PairRoot> = Vec::with_capacity(4);
+    // the expansion), ties (h0 = 0) broken by the first-order split; Re s by the
+    // root of P, then the offset, then the split. The members of a pair share r.
+    order_members(
+        roots
+            .into_iter()
+            .map(|p| {
+                let split = p.rho * kappa;
+                Member {
+                    pair: Some(p.r.to_bits()),
+                    im: [p.off.im, split.im],
+                    re: [p.r, p.off.re, split.re],
+                    side: p.side,
+                    root: p.root,
+                }
+            })
+            .collect(),
+    )
+}
+
+/// A root of `F` with what orders it ([`order_members`]).
+struct Member {
+    root: PolishedRoot,
+    /// The pair it belongs to (`None`: a root the quartic found alone): the
+    /// two members of a non-real pair are each other's conjugates.
+    pair: Option<u64>,
+    /// Lexicographic keys of `Im s` and `Re s`: where the double `s` cannot
+    /// tell the members of a pair apart, their exact offsets (and, at
+    /// `h0 = 0`, their first-order split) can.
+    im: [f64; 2],
+    re: [f64; 3],
+    side: f64,
+}
+
+impl Member {
+    fn is_real(&self) -> bool {
+        self.im == [0.0, 0.0]
+    }
+
+    /// The conjugate partner: the other member of its pair, or the quartic's
+    /// root at the exact conjugate.
+    fn is_partner_of(&self, other: &Member) -> bool {
+        match other.pair {
+            Some(g) => self.pair == Some(g),
+            None => self.pair.is_none() && self.root.s == other.root.s.conj(),
+        }
+    }
+}
+
+fn lex(x: &[f64], y: &[f64]) -> Ordering {
+    x.iter()
+        .zip(y)
+        .map(|(a, b)| a.total_cmp(b))
+        .find(|o| o.is_ne())
+        .unwrap_or(Ordering::Equal)
+}
+
+/// The four roots in the documented order (module docs of [`super`]) by their
+/// keys, with the conjugate-partner flags and the sides: `s1` the non-real
+/// root of largest imaginary part (then real part), `s2` its conjugate, `s3`
+/// the remaining one of larger imaginary part (then real part), `s4` the last;
+/// four real roots by decreasing real part.
+fn order_members(mut rest: Vec<Member>) -> Option<PairRoute> {
+    let by_im_re = |p: &Member, q: &Member| lex(&p.im, &q.im).then(lex(&p.re, &q.re));
+    let mut order: Vec<Member> = Vec::with_capacity(4);
     let mut partner = [false; 4];
-    if rest
-        .iter()
-        .any(|p| im(p) != 0.0 || (p.rho * kappa).im != 0.0)
-    {
-        // s1: the non-real root of largest imaginary part; s2 its conjugate
-        // (the other member of its pair); s3 the remaining one of larger
-        // imaginary part (then real part); s4 the last.
+    if rest.iter().any(|p| !p.is_real()) {
         let i1 = (0..rest.len())
-            .filter(|&i| im(&rest[i]) != 0.0 || (rest[i].rho * kappa).im != 0.0)
+            .filter(|&i| !rest[i].is_real())
             .max_by(|&i, &j| by_im_re(&rest[i], &rest[j]))?;
         let s1 = rest.remove(i1);
-        let i2 = (0..rest.len()).find(|&i| rest[i].r == s1.r)?;
+        let i2 = (0..rest.len()).find(|&i| rest[i].is_partner_of(&s1))?;
         let s2 = rest.remove(i2);
         order.push(s1);
         order.push(s2);
         partner[1] = true;
         rest.sort_by(|p, q| by_im_re(q, p));
-        let conj34 =
-            rest[0].r == rest[1].r && (im(&rest[0]) != 0.0 || (rest[0].rho * kappa).im != 0.0);
+        let conj34 = !rest[0].is_real() && rest[1].is_partner_of(&rest[0]);
         order.extend(rest);
         partner[3] = conj34;
     } else {
-        rest.sort_by(|p, q| re_cmp(q, p));
+        rest.sort_by(|p, q| lex(&q.re, &p.re));
         order.extend(rest);
     }
     let side: [f64; 4] = std::array::from_fn(|p| order[p].side);
@@ -438,10 +480,11 @@ pub(super) fn branch_point_cluster(
     let mut rest: Vec<Member> = quartic
         .into_iter()
         .map(|root| Member {
-            key: [root.s.im, root.s.re, 0.0],
-            root,
             pair: None,
+            im: [root.s.im, 0.0],
+            re: [root.s.re, 0.0, 0.0],
             side: 0.0,
+            root,
         })
         .collect();
     let mut all: Vec<Member> = Vec::with_capacity(4);
@@ -481,10 +524,11 @@ pub(super) fn branch_point_cluster(
         }
         for m in [m1, m2] {
             all.push(Member {
-                key: [m.off.im, lv.a[k] + m.off.re, m.off.re],
-                root: m.root,
                 pair: Some(group),
+                im: [m.off.im, 0.0],
+                re: [lv.a[k] + m.off.re, m.off.re, 0.0],
                 side: m.side,
+                root: m.root,
             });
         }
         next = repeated_pair(&rest.iter().map(|r| r.root.s).collect::<Vec<_>>());
@@ -493,57 +537,5 @@ pub(super) fn branch_point_cluster(
         return None;
     }
     all.extend(rest);
-    let cmp = |x: &[f64; 3], y: &[f64; 3]| {
-        x[0].total_cmp(&y[0])
-            .then(x[1].total_cmp(&y[1]))
-            .then(x[2].total_cmp(&y[2]))
-    };
-    let re_cmp = |x: &[f64; 3], y: &[f64; 3]| x[1].total_cmp(&y[1]).then(x[2].total_cmp(&y[2]));
-    let mut partner = [false; 4];
-    let mut order: Vec<Member> = Vec::with_capacity(4);
-    if all.iter().any(|r| r.key[0] != 0.0) {
-        let i1 = (0..all.len())
-            .filter(|&p| all[p].key[0] != 0.0)
-            .max_by(|&p, &q| cmp(&all[p].key, &all[q].key))?;
-        let s1 = all.remove(i1);
-        // its conjugate: the other member of its pair, or the quartic root at conj(s1)
-        let i2 = (0..all.len()).find(|&p| all[p].is_partner_of(&s1))?;
-        let s2 = all.remove(i2);
-        order.push(s1);
-        order.push(s2);
-        partner[1] = true;
-        all.sort_by(|p, q| cmp(&q.key, &p.key));
-        let conj34 = all[0].key[0] != 0.0 && all[1].is_partner_of(&all[0]);
-        order.extend(all);
-        partner[3] = conj34;
-    } else {
-        all.sort_by(|p, q| re_cmp(&q.key, &p.key));
-        order.extend(all);
-    }
-    let side: [f64; 4] = std::array::from_fn(|p| order[p].side);
-    let mut it = order.into_iter().map(|p| p.root);
-    let roots = [it.next()?, it.next()?, it.next()?, it.next()?];
-    Some((roots, partner, side))
-}
-
-/// A root of [`branch_point_cluster`] with what orders it.
-struct Member {
-    root: PolishedRoot,
-    /// The cluster it belongs to (`None`: a root the quartic found alone).
-    pair: Option<usize>,
-    /// `(Im s, Re s, offset)`: the offset from `a_i` breaks the tie within a
-    /// pair, whose members the double `s` may not tell apart.
-    key: [f64; 3],
-    side: f64,
-}
-
-impl Member {
-    /// The conjugate partner: the other member of its pair, or the quartic's
-    /// root at the exact conjugate.
-    fn is_partner_of(&self, other: &Member) -> bool {
-        match other.pair {
-            Some(g) => self.pair == Some(g),
-            None => self.pair.is_none() && self.root.s == other.root.s.conj(),
-        }
-    }
+    order_members(all)
 }

@@ -99,12 +99,11 @@ fn horner(c: &[f64; 5], s: C) -> (C, C) {
 /// F, where (20) divides by `F'(s_p) = 0`); no convergence.
 pub fn quartic_roots(f: &[f64; 5]) -> Result<[C; 4]> {
     let (z, converged, last) = quartic_roots_unordered(f)?;
-    let scale = z.iter().fold(1.0f64, |m, v| m.max(v.modulus()));
     // A cluster is reported as a repeated root even when the iteration has not
     // met its tolerance: Aberth converges only linearly to a multiple root.
     check_repeated(&z)?;
     check_converged(converged, last)?;
-    Ok(order_roots(z, scale))
+    Ok(documented_order(z))
 }
 
 /// The no-convergence error of [`quartic_roots_unordered`]'s iteration.
@@ -225,7 +224,7 @@ pub(super) fn repeated_pair(z: &[C]) -> Option<(usize, usize)> {
 
 /// The roots of [`quartic_roots_unordered`] in the documented order, as
 /// [`quartic_roots`] returns them.
-pub(super) fn order_for_polish(z: [C; 4]) -> [C; 4] {
+pub(super) fn documented_order(z: [C; 4]) -> [C; 4] {
     let scale = z.iter().fold(1.0f64, |m, v| m.max(v.modulus()));
     order_roots(z, scale)
 }
