@@ -130,15 +130,16 @@ impl Candidates<'_> {
                 let (s, dev) = dubrovin::sign_against(&d.curve, v, &fit);
                 let u = lat.u[0].map(|z| s * z);
                 let res_closed = sys.residual_at(&u, &self.c4);
-                match dubrovin::check_against_fit(dev, res_closed, residual) {
-                    Ok(()) => (u, true),
+                if dubrovin::closed_form_fits(dev, res_closed, residual) {
+                    (u, true)
+                } else {
                     // The closed form misses the quotients' own equations at v0
                     // where their fit holds (next to a pinched curve `U = A⁻¹V`
                     // with an ill-conditioned `A` loses the direction `A` nearly
                     // annihilates): the fit is taken, and the self-check, which
                     // evaluates the velocity along it at points across the
                     // torus, decides.
-                    Err(_) => (fit, false),
+                    (fit, false)
                 }
             }
             Err(_) => (fit, false),

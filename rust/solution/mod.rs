@@ -355,10 +355,15 @@ impl Solution {
     /// other right-hand sides (the curve, the divisor and the quotients depend
     /// on `a` and `l0` only). For the solution's own `c4` this is `U`.
     pub fn rates(&self, c4s: &[[f64; 6]]) -> Result<Vec<([C; 2], f64)>> {
+        let sys = self.velocity_system()?;
+        c4s.iter().map(|c4| sys.rate(c4, "U'")).collect()
+    }
+
+    /// The quotients' velocity equations at `v0` ([`Solution::rates`]).
+    fn velocity_system(&self) -> Result<VelocitySystem> {
         let v0 = [self.u0[0] + self.rc[0], self.u0[1] + self.rc[1]];
         let jet = self.plan.jet(&v0, 1)?;
-        let sys = VelocitySystem::at(&jet, &self.idx, &self.num, &self.den)?;
-        c4s.iter().map(|c4| sys.rate(c4, "U'")).collect()
+        VelocitySystem::at(&jet, &self.idx, &self.num, &self.den)
     }
 
     /// The velocity of the flow with coefficients `c4` fitted as in
@@ -372,9 +377,7 @@ impl Solution {
         c4: &[f64; 6],
         candidate: &[C; 2],
     ) -> Result<(([C; 2], f64), f64)> {
-        let v0 = [self.u0[0] + self.rc[0], self.u0[1] + self.rc[1]];
-        let jet = self.plan.jet(&v0, 1)?;
-        let sys = VelocitySystem::at(&jet, &self.idx, &self.num, &self.den)?;
+        let sys = self.velocity_system()?;
         Ok((sys.rate(c4, "U'")?, sys.residual_at(candidate, c4)))
     }
 

@@ -236,7 +236,7 @@ pub fn real_torus_with_rates(
     }
     let g = Metric::new(tau).ok_or(TorusFailure::ImagTauNotPositive)?;
     let p1 = real4(u);
-    let (n1, [_, _, q1, q2]) = plane_basis(&g, &p1, &real4(u2))?;
+    let [_, _, q1, q2] = plane_basis(&g, &p1, &real4(u2))?;
     let k = Kernel::new(tau, &g, &q1, &q2)?;
     let (x1, x2) = k.lattice_basis(chars)?;
     let (mut a, mut b) = (
@@ -244,18 +244,13 @@ pub fn real_torus_with_rates(
         (x2, real4(&lattice_point(tau, &x2))),
     );
     gauss_reduce(&g, &mut a, &mut b);
-    // U = ν1 λ1 + ν2 λ2 by the normal equations in the metric.
-    let (g11, g12, g22) = (g.norm2(&a.1), g.dot(&a.1, &b.1), g.norm2(&b.1));
-    let (r1, r2) = (g.dot(&a.1, &p1), g.dot(&b.1, &p1));
-    let gd = g11 * g22 - g12 * g12;
-    let mut nu = [(g22 * r1 - g12 * r2) / gd, (g11 * r2 - g12 * r1) / gd];
-    let fit = axpy(-nu[1], &b.1, &axpy(-nu[0], &a.1, &p1));
-    let residual = g.norm2(&fit).sqrt() / n1;
-    if residual.is_nan() || residual > RESIDUAL_TOL {
-        return Err(TorusFailure::NoRealLattice { residual });
-    }
+    // U = ν1 λ1 + ν2 λ2 by the normal equations in the metric (the plane
+    // contains U by construction: the residual checks it), or in the integer
+    // lattice coordinates where those of U are given.
+    let mut nu = fit_two(|x, y| g.dot(x, y), &a.1, &b.1, &p1)?;
     if let Some(w) = w {
-        nu = rates_in_coords(w, &a.0, &b.0)?;
+        let dot = |x: &[f64; 4], y: &[f64; 4]| (0..4).map(|k| x[k] * y[k]).sum::<f64>();
+        nu = fit_two(dot, &a.0.map(|v| v as f64), &b.0.map(|v| v as f64), w)?;
     }
     for (k, v) in [&mut a, &mut b].into_iter().enumerate() {
         if nu[k] < 0.0 {
@@ -271,30 +266,27 @@ pub fn real_torus_with_rates(
     })
 }
 
-/// `(ν1, ν2)` with `w = ν1 c1 + ν2 c2` by least squares in `R⁴` (`c1`, `c2`
-/// independent integer vectors), with the relative residual against
-/// [`RESIDUAL_TOL`].
-fn rates_in_coords(
-    w: &[f64; 4],
-    c1: &Coords,
-    c2: &Coords,
+/// `(ν1, ν2)` with `p = ν1 x + ν2 y` by least squares in the inner product
+/// `dot`, with the residual relative to `|p|` against [`RESIDUAL_TOL`].
+fn fit_two<D: Fn(&[f64; 4], &[f64; 4]) -> f64>(
+    dot: D,
+    x: &[f64; 4],
+    y: &[f64; 4],
+    p: &[f64; 4],
 ) -> std::result::Result<[f64; 2], TorusFailure> {
-    let (x, y) = (c1.map(|v| v as f64), c2.map(|v| v as f64));
-    let dot = |p: &[f64; 4], q: &[f64; 4]| (0..4).map(|k| p[k] * q[k]).sum::<f64>();
-    let (g11, g12, g22) = (dot(&x, &x), dot(&x, &y), dot(&y, &y));
-    let (r1, r2) = (dot(&x, w), dot(&y, w));
-    // integer vectors: g11 g22 − g12² is an integer, computed exactly
+    let (g11, g12, g22) = (dot(x, x), dot(x, y), dot(y, y));
+    let (r1, r2) = (dot(x, p), dot(y, p));
     let gd = g11 * g22 - g12 * g12;
     let nu = [(g22 * r1 - g12 * r2) / gd, (g11 * r2 - g12 * r1) / gd];
-    let fit: [f64; 4] = std::array::from_fn(|k| w[k] - nu[0] * x[k] - nu[1] * y[k]);
-    let residual = dot(&fit, &fit).sqrt() / dot(w, w).sqrt();
+    let fit = axpy(-nu[1], y, &axpy(-nu[0], x, p));
+    let residual = (dot(&fit, &fit) / dot(p, p)).sqrt();
     if residual.is_nan() || residual > RESIDUAL_TOL {
         return Err(TorusFailure::NoRealLattice { residual });
     }
     Ok(nu)
 }
 
-/// `‖p1‖` and an orthonormal basis `(e1, e2, q1, q2)` of `R⁴` in the metric
+/// An orthonormal basis `(e1, e2, q1, q2)` of `R⁴` in the metric
 /// `g`: `(e1, e2)` of the plane `P` of the flows `p1`, `p2`, `(q1, q2)` of its
 /// complement.
 ///
@@ -303,7 +295,7 @@ fn plane_basis(
     g: &Metric,
     p1: &[f64; 4],
     p2: &[f64; 4],
-) -> std::result::Result<(f64, [[f64; 4]; 4]), TorusFailure> {
+) -> std::result::Result<[[f64; 4]; 4], TorusFailure> {
     let n1 = g.norm2(p1).sqrt();
     let n2 = g.norm2(p2).sqrt();
     if !(n1 > 0.0 && n2 > 0.0) {
@@ -330,7 +322,7 @@ fn plane_basis(
         let nb = g.norm2(&best).sqrt();
         basis.push(best.map(|v| v / nb));
     }
-    Ok((n1, [basis[0], basis[1], basis[2], basis[3]]))
+    Ok([basis[0], basis[1], basis[2], basis[3]])
 }
 
 /// The integer kernel of the projection of `Λ` off the plane: the lattice

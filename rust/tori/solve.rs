@@ -25,7 +25,7 @@ use crate::numeric::cancel::Cancel;
 use crate::riemann::HyperellipticCurve;
 use crate::so4;
 use crate::solution::dubrovin::{
-    check_against_fit, half_period_velocities, lattice_rates_dd, CLOSED_FORM,
+    closed_form_fits, half_period_velocities, lattice_rates_dd, CLOSED_FORM,
 };
 use crate::solution::velocity::algebraic_rates;
 use crate::solution::{a_periods_of, level_set_curve, Solution};
@@ -99,7 +99,7 @@ pub fn flow_data(sol: &Solution, b2: &[f64; 4]) -> Result<FlowData> {
     // and it must agree with the closed form: within CLOSED_VS_FIT_RTOL, or
     // the closed form satisfies the quotients' equations as well as the fit
     // does (next to a pinched curve the fit is undetermined along one
-    // direction; `dubrovin::check_against_fit`, as `Solution::new` does for U).
+    // direction; `dubrovin::closed_form_fits`, as `Solution::new` does for U).
     let candidate = closed
         .as_ref()
         .map_or([C::new(0.0, 0.0); 2], |lat| lat.u[1]);
@@ -130,16 +130,18 @@ pub fn flow_data(sol: &Solution, b2: &[f64; 4]) -> Result<FlowData> {
         .norm()
         .max((u2_closed[1] - u2[1]).norm())
         / u2[0].norm().max(u2[1].norm()).max(f64::MIN_POSITIVE);
-    check_against_fit(dev, res_closed, res).map_err(|_| Error::Singular {
-        what: INCONSISTENT,
-        kind: SingularKind::InconsistentQuotients,
-        reason: format!(
-            "the theta quotients (9)-(10) at v0 move along the second flow at a velocity \
-             {dev:e} (relative) away from the closed form, which leaves a residual \
-             {res_closed:e} in their equations against {res:e} for their own fit: the \
-             solution's set-up is wrong at this state; its frequencies would be too"
-        ),
-    })?;
+    if !closed_form_fits(dev, res_closed, res) {
+        return Err(Error::Singular {
+            what: INCONSISTENT,
+            kind: SingularKind::InconsistentQuotients,
+            reason: format!(
+                "the theta quotients (9)-(10) at v0 move along the second flow at a velocity \
+                 {dev:e} (relative) away from the closed form, which leaves a residual \
+                 {res_closed:e} in their equations against {res:e} for their own fit: the \
+                 solution's set-up is wrong at this state; its frequencies would be too"
+            ),
+        });
+    }
     Ok(FlowData {
         tau: [[t[0], t[1]], [t[2], t[3]]],
         u,
