@@ -136,8 +136,8 @@ class Solution:
         (``h1² = 4h0²`` off the exact sets above, coinciding branch points, a
         repeated root of F (19), the divisor of ``l0`` at infinity), an
         iteration of the reduction that did not converge — or that fails its
-        self-check (:attr:`self_check` above 1e-10). The message names the
-        step; integrate the state instead.
+        self-check (:attr:`self_check` above 1e-10 or :attr:`velocity_check`
+        above 1e-6). The message names the step; integrate the state instead.
 
     Notes
     -----
@@ -276,7 +276,7 @@ class Solution:
         ValueError
             Non-finite ``t``.
         ClosedFormError
-            A genus-2 solution whose self-check defect ``δ`` (``self_check``)
+            A genus-2 solution whose drift defect ``δ`` (:attr:`drift_defect`)
             is above rounding (1e-12), at a ``t`` where the drift
             ``δ |t| |dl/dt| / |l0|`` of its phase exceeds 5e-11: the closed form
             cannot vouch for ``l(t)`` there (integrate instead). Any kind
@@ -370,17 +370,43 @@ class Solution:
 
     @property
     def self_check(self) -> float:
-        """The largest relative defect found by the genus-2 solution's own check when
-        it was built.
+        """The largest relative defect of the quotients' shape found by the genus-2
+        solution's own check when it was built.
 
-        At ``t = 0`` and at three points of the torus the quotients (9)–(10) must give
-        a real state with the integrals (6)–(7) of ``l0``, whose velocity along ``U``
-        is Frahm's (1), and ``l(0) = l0``; defects are relative to ``|l0|``, to the
-        largest speed ``|dl/dt|`` met at those points and to the scales of the
-        integrals. A solution is only returned when this is at most 1e-10
-        (correct set-ups leave ~1e-15 … 1e-11). Checked on the normalized data.
+        At ``t = 0`` and at points spread over the torus the quotients (9)–(10) must
+        give a real state with the integrals (6)–(7) of ``l0``, and ``l(0) = l0``;
+        defects are relative to ``|l0|`` and to the scales of the integrals. A
+        solution is only returned when this is at most 1e-10 (correct set-ups leave
+        ~1e-15 … 1e-11). Checked on the normalized data. Their motion is checked by
+        :attr:`velocity_check`.
         """
         return float(self._genus2("self_check").self_check)
+
+    @property
+    def velocity_check(self) -> float:
+        """The largest defect of Frahm's equations (1) for the quotients moving along
+        ``U``, at the points of :attr:`self_check`, relative to the largest speed
+        ``|dl/dt|`` met there.
+
+        A solution is only returned when this is at most 1e-6. Generic states leave
+        ~1e-15 … 1e-12; near an equilibrium or an so(3) block, where the motion is
+        slow, up to ~1e-7 (the rounding of (1) at a state accurate to rounding,
+        relative to a small speed). A wrong constant leaves O(1).
+        """
+        return float(self._genus2("velocity_check").velocity_check)
+
+    @property
+    def drift_defect(self) -> float:
+        """The relative defect ``δ`` whose drift ``δ |t| |dl/dt| / |l0|`` :meth:`l`
+        bounds (docs/degenerate.md, "The drift check").
+
+        Where ``U`` is the closed form it is :attr:`velocity_check`: the phase runs at
+        the frequencies of ``l0``'s own torus, so a defect of the quotients' shape
+        stays where it is, while one of their motion drifts. Where ``U`` is the
+        quotients' fit it is the larger of :attr:`self_check` and
+        :attr:`velocity_check`.
+        """
+        return float(self._genus2("drift_defect").drift_defect)
 
     @property
     def torus(self) -> Torus:

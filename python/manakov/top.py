@@ -864,8 +864,8 @@ class ManakovTop(FrahmTop):
             A valid state whose closed form could not be built (a level set on
             which the Theorem's coordinates are singular to working precision;
             the message names the step) or that fails its self-check
-            (``Solution.self_check`` above 1e-10; docs/degenerate.md): integrate
-            it instead.
+            (``Solution.self_check`` above 1e-10 or ``Solution.velocity_check``
+            above 1e-6; docs/degenerate.md): integrate it instead.
         """
         self._require_so4("solve")
         return Solution(self.a, self.b, l0)

@@ -126,6 +126,16 @@ impl SolutionCore {
         self.sol.self_check()
     }
 
+    #[getter]
+    fn velocity_check(&self) -> f64 {
+        self.sol.velocity_check()
+    }
+
+    #[getter]
+    fn drift_defect(&self) -> f64 {
+        self.sol.drift_defect()
+    }
+
     /// `(idx (8,), num (6, 8), den (8,))` of `l_q = N_q/D`.
     fn quotient<'py>(&self, py: Python<'py>) -> PyResult<Quotient<'py>> {
         let (idx, num, den) = self.sol.quotient();

@@ -3,6 +3,7 @@
 //! `C_L` (37) with the signs `l0` decides; `U` in closed form; every undecided
 //! sign pattern built and self-checked; the phase in lattice coordinates.
 
+use super::check::Defect;
 use super::*;
 
 /// The level set of `l0`, its divisor and the theta data at `v0`: what every
@@ -114,7 +115,7 @@ pub(super) struct Candidates<'a> {
 impl Candidates<'_> {
     /// The quotients (9)-(10) with the constants `cl` and their self-check
     /// defect.
-    fn build(&self, cl: [C; 7]) -> Result<(f64, Built)> {
+    fn build(&self, cl: [C; 7]) -> Result<(Defect, Built)> {
         let d = self.d;
         let big_g = self.at_v0.big_g(&d.state0, &self.sc, &cl, self.eps);
         let (num, den) = quotient_weights(&d.kotter, &self.sc, self.eps, big_g, &cl);
@@ -161,17 +162,19 @@ impl Candidates<'_> {
     /// Every sign pattern of the constants that l0 leaves undecided, built and
     /// checked (check.rs): the one that passes the self-check best, refused
     /// above [`SELF_CHECK_RTOL`].
-    pub(super) fn best(&self, cl0: &[C; 7], calibration: &[f64; 7]) -> Result<(f64, Built)> {
-        let mut best: Option<(f64, Built)> = None;
+    pub(super) fn best(&self, cl0: &[C; 7], calibration: &[f64; 7]) -> Result<(Defect, Built)> {
+        let mut best: Option<(Defect, Built)> = None;
         let mut last_err: Option<Error> = None;
         for cl in sign_patterns(cl0, calibration) {
             match self.build(cl) {
-                Ok((d, b)) if best.as_ref().is_none_or(|(bd, _)| d < *bd) => best = Some((d, b)),
+                Ok((d, b)) if best.as_ref().is_none_or(|(bd, _)| d.worst() < bd.worst()) => {
+                    best = Some((d, b))
+                }
                 Ok(_) => {}
                 Err(e) => last_err = Some(e),
             }
         }
-        let (self_check, built) = match (best, last_err) {
+        let (defect, built) = match (best, last_err) {
             (Some(b), _) => b,
             (None, Some(e)) => return Err(e),
             (None, None) => {
@@ -181,17 +184,29 @@ impl Candidates<'_> {
                 })
             }
         };
-        if self_check.is_nan() || self_check > SELF_CHECK_RTOL {
+        if defect.shape.is_nan() || defect.shape > SELF_CHECK_RTOL {
             return Err(Error::Unverified {
                 what: "solution of l0",
                 reason: format!(
                     "the theta quotients (9)-(10) fail the self-check: relative defect \
-                     {self_check:e} > {SELF_CHECK_RTOL:e} in Frahm's equations (1), the \
-                     integrals (6)-(7) or l(0) = l0 at points of the torus"
+                     {:e} > {SELF_CHECK_RTOL:e} in the integrals (6)-(7), a real l or \
+                     l(0) = l0 at points of the torus",
+                    defect.shape
                 ),
             });
         }
-        Ok((self_check, built))
+        if defect.velocity > VELOCITY_CHECK_RTOL {
+            return Err(Error::Unverified {
+                what: "solution of l0",
+                reason: format!(
+                    "the theta quotients (9)-(10) fail the self-check: they move along U \
+                     against Frahm's equations (1) by {:e} > {VELOCITY_CHECK_RTOL:e} of \
+                     the largest speed at points of the torus",
+                    defect.velocity
+                ),
+            });
+        }
+        Ok((defect, built))
     }
 }
 

@@ -63,6 +63,7 @@ pub mod velocity;
 
 pub use check::{
     DRIFT_DEFECT_FLOOR, DRIFT_RTOL, HORIZON_RTOL, PHASE_ROUNDING_RTOL, SELF_CHECK_RTOL,
+    VELOCITY_CHECK_RTOL,
 };
 pub use level_set::{a_periods_of, level_set_curve, LevelSetCurve};
 pub use setup::{INCONSISTENT, QUOTIENT_RESIDUAL_RTOL};
@@ -161,8 +162,14 @@ pub struct Solution {
     num: [[C; 8]; 6],
     den: [C; 8],
     calibration: [f64; 7],
-    /// The largest relative defect of the self-check ([`check::SelfCheck`]).
+    /// The self-check's defect of the quotients' shape ([`check::Defect`]).
     self_check: f64,
+    /// The self-check's defect of the quotients' motion along `U`.
+    velocity_check: f64,
+    /// The relative defect `δ` whose drift `δ |t| |l̇|` [`Solution::l_batch`]
+    /// bounds: the self-check's larger part where `U` is the quotients' fit,
+    /// its velocity part where it is the closed form ([`check::drift_defect`]).
+    drift_defect: f64,
     /// `|l0|` (`Σ l_ij²` is a Casimir of (1): `|l(t)| = |l0|`).
     size: f64,
     /// `4 max|c_ij| |l0|²`, a bound of `|l̇|` by (1) for the phase horizon
@@ -249,7 +256,7 @@ impl Solution {
             check: SelfCheck::new(a, l0, &c4),
         };
         let (
-            self_check,
+            defect,
             Built {
                 cl,
                 num,
@@ -258,7 +265,6 @@ impl Solution {
                 closed: closed_used,
             },
         ) = cands.best(&cl0, &calibration)?;
-        let (x0, y0) = d.curve.lattice_coordinates(&d.v0);
         // the phase of the closed form where the checked pattern took it, else
         // of the fit
         let closed = if closed_used {
@@ -269,6 +275,7 @@ impl Solution {
                 reason: "the closed form misses the theta quotients' equations at v0".into(),
             })
         };
+        let (x0, y0) = d.curve.lattice_coordinates(&d.v0);
         let phase = Phase::new(&d.curve, &closed, rate);
         let Divisor0 {
             kotter,
@@ -305,7 +312,9 @@ impl Solution {
             num,
             den,
             calibration,
-            self_check,
+            self_check: defect.shape,
+            velocity_check: defect.velocity,
+            drift_defect: check::drift_defect(&defect, closed_used),
             size: l0.iter().map(|x| x * x).sum::<f64>().sqrt(),
             speed_bound: 4.0
                 * c4.iter().fold(0.0f64, |m, v| m.max(v.abs()))
@@ -489,11 +498,24 @@ impl Solution {
         self.calibration
     }
 
-    /// The largest relative defect the solution showed at its self-check
-    /// points when it was built (`l(0) = l0`, the integrals (6)–(7), Frahm's
-    /// equations (1) along `U`, a real `l`); at most [`SELF_CHECK_RTOL`].
+    /// The largest relative defect of the quotients' shape the solution
+    /// showed at its self-check points when it was built (`l(0) = l0`, the
+    /// integrals (6)–(7), a real `l`); at most [`SELF_CHECK_RTOL`].
     pub fn self_check(&self) -> f64 {
         self.self_check
+    }
+
+    /// The largest defect of Frahm's equations (1) along `U` at the
+    /// self-check points, relative to the largest speed there; at most
+    /// [`VELOCITY_CHECK_RTOL`].
+    pub fn velocity_check(&self) -> f64 {
+        self.velocity_check
+    }
+
+    /// The relative defect `δ` of the drift bound of [`Solution::l_batch`]
+    /// ([`check::drift_defect`]).
+    pub fn drift_defect(&self) -> f64 {
+        self.drift_defect
     }
 
     /// Coefficients of (9)–(10) as they read: `l_q = N_q/D`,
@@ -653,8 +675,8 @@ impl Solution {
     /// double `U` (at `|U t| ~ 1e16` not even its integer part is), and the
     /// value would be arbitrary.
     fn check_drift(&self, t: &[f64], out: &[f64]) -> Result<()> {
-        let gated = self.self_check > DRIFT_DEFECT_FLOOR;
-        let delta = self.self_check.max(PHASE_ROUNDING_RTOL);
+        let gated = self.drift_defect > DRIFT_DEFECT_FLOOR;
+        let delta = self.drift_defect.max(PHASE_ROUNDING_RTOL);
         if !gated {
             // One comparison per block on the generic path, with the bound
             // `speed_bound` of |l̇| (|l| = |l0|: Σ l² is conserved).
@@ -679,7 +701,7 @@ impl Solution {
                         "at t = {tk:e} the relative defect {:e} left by the self-check may \
                          move l(t) by {drift:e} |l0| > {DRIFT_RTOL:e} (the drift \
                          delta |t| |dl/dt| of the phase); evaluate nearer t = 0",
-                        self.self_check
+                        self.drift_defect
                     ),
                 });
             }
