@@ -498,11 +498,18 @@ def test_roots_of_f_clustered_at_a_branch_point_are_solved(case) -> None:
 @pytest.mark.parametrize("case", SLOW_STATES[:3])
 def test_the_velocity_part_of_the_self_check_has_its_own_bound(case) -> None:
     """The slow states' velocity defect is above the shape's bound and within its
-    own; the drift check takes it (U is the closed form there)."""
+    own; the drift check takes it (U is the closed form there). Their frequencies,
+    which U would carry that defect into, are refused, by the solution and by the
+    frequency map alike."""
     a, b, l0, _ = case
-    sol = manakov.ManakovTop(a, b).solve(l0)
+    top = manakov.ManakovTop(a, b)
+    sol = top.solve(l0)
     assert sol.self_check <= SHAPE_CHECK_BOUND < sol.velocity_check <= VELOCITY_CHECK_BOUND
     assert sol.drift_defect == sol.velocity_check
+    with pytest.raises(manakov.ClosedFormError, match="frequencies"):
+        _ = sol.frequencies
+    fm = manakov.frequency_map(top, np.asarray([l0]))
+    assert int(fm.status[0]) != manakov.tori.OK and np.isnan(fm.nu[0]).all()
 
 
 #: States of the harsh draw (seed 5) whose branch points spread over 1e18 and

@@ -62,6 +62,13 @@ pub fn needs_dd(curve: &HyperellipticCurve) -> bool {
     spread.is_nan() || spread > DD_SPREAD
 }
 
+/// Largest velocity defect of a solution's self-check
+/// ([`Solution::velocity_check`]) for which its frequencies are given: the
+/// self-check's bound on the quotients' shape, the accuracy the frequencies
+/// are vouched for to (a velocity defect `δ` can put `U`, hence `ν`, off by
+/// `δ` relative).
+pub const FREQUENCY_VELOCITY_RTOL: f64 = crate::solution::SELF_CHECK_RTOL;
+
 /// The six `c_ij` (`i < j`, state order) of `ManakovTop(a, b)` (2).
 pub fn c_pairs(a: &[f64; 4], b: &[f64; 4]) -> Result<[f64; 6]> {
     // manakov_c returns the full 4×4 matrix, row-major.
@@ -72,6 +79,21 @@ pub fn c_pairs(a: &[f64; 4], b: &[f64; 4]) -> Result<[f64; 6]> {
 /// `τ`, `U`, `U'` (the flow of `ManakovTop(a, b2)` by [`rate_for`]) and the
 /// characteristics of a solution, in the layout of this module.
 pub fn flow_data(sol: &Solution, b2: &[f64; 4]) -> Result<FlowData> {
+    // The frequencies come from U: where its self-check left a velocity
+    // defect above the shape's bound (slow motions, which l(t) bounds by its
+    // drift check instead), U is not vouched for to that accuracy, and
+    // neither would the frequencies be.
+    if sol.velocity_check() > FREQUENCY_VELOCITY_RTOL {
+        return Err(Error::Unverified {
+            what: "frequencies",
+            reason: format!(
+                "the theta quotients move along U against Frahm's equations (1) by {:e} of \
+                 the largest speed (> {FREQUENCY_VELOCITY_RTOL:e}), which U's frequencies \
+                 would inherit",
+                sol.velocity_check()
+            ),
+        });
+    }
     let t = sol.tau();
     let chars: Vec<Char> = sol
         .characteristics()
