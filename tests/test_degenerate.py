@@ -175,6 +175,8 @@ def test_kinds_and_attributes() -> None:
         if kind == "genus2":
             assert sol.U.shape == (2,)
             assert 0.0 <= sol.self_check <= 1e-10
+            assert 0.0 <= sol.velocity_check <= 1e-6
+            assert sol.drift_defect <= max(sol.self_check, sol.velocity_check)
             with pytest.raises(AttributeError, match="kind 'genus2'"):
                 _ = sol.euler
         else:
@@ -187,6 +189,8 @@ def test_kinds_and_attributes() -> None:
                 "constants",
                 "calibration",
                 "self_check",
+                "velocity_check",
+                "drift_defect",
             ):
                 with pytest.raises(AttributeError, match=f"kind '{kind}'"):
                     getattr(sol, attr)

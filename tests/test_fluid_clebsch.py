@@ -186,6 +186,7 @@ def test_closed_form_matches_integration_on_0_100(name):
     err = max(np.max(np.abs(M - tr.M)), np.max(np.abs(p - tr.p))) / scale
     assert err <= CLOSED_FORM_RTOL, err
     assert sol.solution.self_check <= SELF_CHECK_MAX, sol.solution.self_check
+    assert sol.solution.velocity_check <= SELF_CHECK_MAX, sol.solution.velocity_check
     np.testing.assert_allclose(sol.M(0.0), pr.M0, rtol=0, atol=1e-14 * scale)
     assert sol.M(t).shape == (201, 3) and sol.p(2.5).shape == (3,)
     # (M, p) is a quotient of theta functions of v0 + U t (the explicit form).

@@ -932,8 +932,8 @@ class KirchhoffBody:
         ClosedFormError
             A valid state whose conjugate top's closed form could not be built
             (the message names the step, as :meth:`manakov.ManakovTop.solve`) or
-            did not pass its own check (:attr:`manakov.Solution.self_check`); no
-            solution is returned.
+            did not pass its own check (:attr:`manakov.Solution.self_check`,
+            :attr:`manakov.Solution.velocity_check`); no solution is returned.
         """
         self._require_clebsch("solve")
         y, lead = _states(M0, p0, ("M0", "p0"))

@@ -424,8 +424,10 @@ class Solution:
         ------
         ClosedFormError
             The torus of this (valid) state could not be verified: the theta
-            quotients' second flow disagrees with its closed form, or no real
-            lattice fits. The message names the step.
+            quotients' second flow disagrees with its closed form, no real
+            lattice fits, or the self-check's velocity defect
+            (:attr:`velocity_check`) is above 1e-10, which ``U`` and the
+            frequencies would carry. The message names the step.
         """
         self._genus2("torus")
         if self._torus is None:

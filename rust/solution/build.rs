@@ -160,14 +160,15 @@ impl Candidates<'_> {
     }
 
     /// Every sign pattern of the constants that l0 leaves undecided, built and
-    /// checked (check.rs): the one that passes the self-check best, refused
-    /// above [`SELF_CHECK_RTOL`].
+    /// checked (check.rs): the one that passes the self-check best (each part
+    /// relative to its bound), refused above [`SELF_CHECK_RTOL`] in its shape
+    /// or [`VELOCITY_CHECK_RTOL`] in its velocity.
     pub(super) fn best(&self, cl0: &[C; 7], calibration: &[f64; 7]) -> Result<(Defect, Built)> {
         let mut best: Option<(Defect, Built)> = None;
         let mut last_err: Option<Error> = None;
         for cl in sign_patterns(cl0, calibration) {
             match self.build(cl) {
-                Ok((d, b)) if best.as_ref().is_none_or(|(bd, _)| d.worst() < bd.worst()) => {
+                Ok((d, b)) if best.as_ref().is_none_or(|(bd, _)| d.rank() < bd.rank()) => {
                     best = Some((d, b))
                 }
                 Ok(_) => {}

@@ -24,24 +24,25 @@ type C = Complex64;
 /// self-check ([`SelfCheck`]).
 pub(super) const SIGN_DECIDED_RTOL: f64 = 1e-3;
 
-/// Largest relative defect of a solution at its self-check points
-/// ([`SelfCheck::defect`]) that is accepted. Correct set-ups leave 1e-15 …
-/// 6e-12 (the four shared tops; 1000 random states with normal entries:
-/// median 1.3e-14, max 6e-12); a wrong sign of one constant leaves 1e-3 … 1.
-/// Near degenerate sets (a harsh random draw, docs/degenerate.md) solutions
-/// whose error over their window exceeds 1e-10 show defects from 1e-13 to 1e-8,
-/// those within it up to 5e-10: this bound refuses about half of the former and
-/// 2 % of the latter; the rest of the former is a drift of the phase that no
-/// check at a few points can see.
+/// Largest relative defect of the quotients' shape at the self-check points
+/// ([`Defect::shape`]) that is accepted. Correct set-ups leave 1e-15 … 6e-12
+/// (the four shared tops; 1000 random states with normal entries: median
+/// 1.3e-14, max 6e-12, measured when the velocity part was held to the same
+/// bound); a wrong sign of one constant leaves 1e-3 … 1. Near degenerate sets
+/// (a harsh random draw, docs/degenerate.md) solutions whose error over their
+/// window exceeds 1e-10 showed defects from 1e-13 to 1e-8, those within it up
+/// to 5e-10; what no check at a few points can see, a drift of the phase, the
+/// drift check bounds ([`drift_defect`], [`DRIFT_RTOL`]).
 pub const SELF_CHECK_RTOL: f64 = 1e-10;
 
 /// Largest defect of Frahm's equations (1) along `U` at the self-check
 /// points, relative to the largest speed met there, that is accepted. Far
 /// looser than [`SELF_CHECK_RTOL`]: near an equilibrium or an so(3) block the
 /// motion is slow, and the velocity (1) of a state accurate to rounding is
-/// itself only accurate to ~ε (max c − min c)|l|², which relative to a speed
-/// of 1e-7 of that scale is 1e-9 (a harsh draw of 2000 states: defects up to
-/// 1e-7 on solutions accurate to 1e-15 over their window). A wrong constant or
+/// itself only accurate to ~ε (max c − min c)|l|², 1e-9 relative to a speed of
+/// 1e-7 of that scale, 1e-7 relative to one of 1e-9 (a harsh draw of 2000
+/// states: defects up to 1e-7 on solutions accurate to 1e-15 over their
+/// window). A wrong constant or
 /// sign leaves an O(1) defect; the drift a moderate one could cause is what
 /// [`drift_defect`] and [`DRIFT_RTOL`] bound. On the harsh draw of 10⁴ states
 /// (`tests/data/every_state_harsh.py`) this bound instead of
@@ -72,8 +73,9 @@ pub(super) fn drift_defect(d: &Defect, closed: bool) -> f64 {
 }
 
 /// Largest first-order drift `δ |t| |l̇(t)| / |l0|` of `l(t)` that
-/// [`super::Solution::l_batch`] returns, `δ` the relative defect of the
-/// self-check ([`SelfCheck::defect`]). A relative error `δ` of `U` evaluates
+/// [`super::Solution::l_batch`] returns, `δ` the relative defect the
+/// self-check leaves ([`drift_defect`]; before the self-check had two parts,
+/// its single defect, to which the measurements below refer). A relative error `δ` of `U` evaluates
 /// `l` at the phase of time `(1 + δ) t`; a defect `δ` of `l(0)` or of the
 /// integrals puts `l(t)` on a neighbouring torus, whose frequencies differ by
 /// `O(δ)`: either way an error `~δ t |l̇(t)|` that grows with `t` and peaks
@@ -86,8 +88,8 @@ pub(super) fn drift_defect(d: &Defect, closed: bool) -> f64 {
 /// (a quarter would refuse half again as many correct ones).
 pub const DRIFT_RTOL: f64 = SELF_CHECK_RTOL / 2.0;
 
-/// Self-check defects up to this are taken as rounding, not as a measure of
-/// the drift, and [`DRIFT_RTOL`] is not applied. A calibrated gate, not a
+/// Drift defects ([`drift_defect`]) up to this are taken as rounding, not as a
+/// measure of the drift, and [`DRIFT_RTOL`] is not applied. A calibrated gate, not a
 /// derived one: generic states leave 1e-15 … 6e-12 ('wide' has 3e-13 and
 /// meets 1e-9 at `t = 1e4`, where `δ t |l̇|` would claim 4e-9); the solutions
 /// of two harsh draws and the sweeps wrong by more than 1e-10 over their window
@@ -149,6 +151,13 @@ impl Defect {
     /// The larger part (the `δ` of the drift estimate).
     pub(super) fn worst(&self) -> f64 {
         self.shape.max(self.velocity)
+    }
+
+    /// The larger part relative to its bound: the sign pattern of the
+    /// constants with the smallest is the one checked ([`SELF_CHECK_RTOL`] and
+    /// [`VELOCITY_CHECK_RTOL`] differ 1e4-fold, so the raw parts do not compare).
+    pub(super) fn rank(&self) -> f64 {
+        (self.shape / SELF_CHECK_RTOL).max(self.velocity / VELOCITY_CHECK_RTOL)
     }
 }
 
@@ -226,11 +235,13 @@ impl SelfCheck {
         }
     }
 
-    /// The largest relative defect over the check points (0 is perfect; NaN
-    /// counts as infinite): `|l(0) − l0|/|l0|`, `|Im l|/|l0|`, the integrals
-    /// (6)–(7) of `Re l` against those of `l0`, and `|dl/dt − (1)|` relative to
-    /// [`SelfCheck::rate_scale`], with `dl/dt = (∇N − l ∇D)·U / D` from the theta
-    /// jet (`jet0` that at `v0`, of order 1).
+    /// The largest relative defects over the check points (0 is perfect; NaN
+    /// counts as infinite), in two parts ([`Defect`]): the shape,
+    /// `|l(0) − l0|/|l0|`, `|Im l|/|l0|`, `|Im dl/dt|` relative to
+    /// [`SelfCheck::rate_scale`] and the integrals (6)–(7) of `Re l` against
+    /// those of `l0`; the velocity, `|dl/dt − (1)|` relative to the largest
+    /// speed met, with `dl/dt = (∇N − l ∇D)·U / D` from the theta jet (`jet0`
+    /// that at `v0`, of order 1).
     pub(super) fn defect(
         &self,
         plan: &ThetaPlan,
@@ -318,7 +329,9 @@ impl SelfCheck {
             }
             let f = so4::vector_field4(&self.c4, &l);
             for q in 0..6 {
-                ode_res = ode_res.max((ldot[q] - f[q]).abs());
+                // a NaN at one point is an infinite defect, not one f64::max drops
+                let r = (ldot[q] - f[q]).abs();
+                ode_res = ode_res.max(if r.is_nan() { f64::INFINITY } else { r });
                 speed = speed.max(f[q].abs());
                 if k == 0 {
                     note((l[q] - self.l0[q]).abs() / self.size);

@@ -665,7 +665,8 @@ impl Solution {
         self.check_drift(t, out)
     }
 
-    /// Refuses `l(t)` where the relative defect `δ` the self-check leaves may
+    /// Refuses `l(t)` where the relative defect `δ` the self-check leaves
+    /// ([`Solution::drift_defect`]) may
     /// have moved it by more than [`DRIFT_RTOL`] `|l0|`: the first-order drift
     /// `δ |t| |l̇(t)|`, `l̇` Frahm's (1) at the computed `l(t)`; not where `δ`
     /// is at rounding level ([`DRIFT_DEFECT_FLOOR`]). Beyond the phase horizon
