@@ -46,7 +46,7 @@ pub const SELF_CHECK_RTOL: f64 = 1e-10;
 /// sign leaves an O(1) defect; the drift a moderate one could cause is what
 /// [`drift_defect`] and [`DRIFT_RTOL`] bound. On the harsh draw of 10⁴ states
 /// (`tests/data/every_state_harsh.py`) this bound instead of
-/// [`SELF_CHECK_RTOL`] took the self-check's refusals from 420 to 151, none
+/// [`SELF_CHECK_RTOL`] took the self-check's refusals from 420 to 149, none
 /// returned wrong.
 pub const VELOCITY_CHECK_RTOL: f64 = 1e-6;
 
