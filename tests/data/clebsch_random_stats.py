@@ -5,8 +5,9 @@ first 100): ``A_i ~ U(0.2, 2)``, ``θ ~ U(−1, 1)``, ``C_i = κ + θ A_j A_k`` 
 ``κ = |θ| max A_j A_k + U(0.2, 1)``
 (so ``C > 0``), ``M, p`` standard normal. Error: ``max_t |y_theta − y_int| / max|y0|``
 over 101 times in [0, T], ``y_int`` gauss16 at a quarter of the default step
-(its own error ~1e-14 there); with the largest ``Solution.self_check`` of
-the conjugate top's solutions (a draw refused by it, ``ClosedFormError``, is
+(its own error ~1e-14 there); with the largest ``Solution.self_check`` and
+``Solution.velocity_check`` of the conjugate top's solutions (a draw refused by
+them or by the drift check of ``l(t)``, ``ClosedFormError``, is
 counted as raised). Without arguments: T = 100 and T = 20, written to
 ``clebsch_random_stats.txt`` next to this file (about 4 s); with arguments
 only printed:
@@ -36,8 +37,11 @@ def draw(rng: np.random.Generator):
     return A, C, rng.normal(size=3), rng.normal(size=3)
 
 
-def error_and_check(A, C, M0, p0, T: float, samples: int = 101) -> tuple[float, float]:
-    """The error on [0, T] and the conjugate top's ``Solution.self_check``."""
+def error_and_check(
+    A, C, M0, p0, T: float, samples: int = 101
+) -> tuple[float, tuple[float, float]]:
+    """The error on [0, T] and the conjugate top's ``Solution.self_check`` and
+    ``Solution.velocity_check``."""
     body = manakov.KirchhoffBody.clebsch(A, C)
     sol = body.solve(M0, p0)
     t = np.linspace(0.0, T, samples)
@@ -45,7 +49,7 @@ def error_and_check(A, C, M0, p0, T: float, samples: int = 101) -> tuple[float, 
     M, p = sol.state(t)
     scale = max(np.max(np.abs(M0)), np.max(np.abs(p0)))
     err = float(max(np.max(np.abs(M - tr.M)), np.max(np.abs(p - tr.p))) / scale)
-    return err, sol.solution.self_check
+    return err, (sol.solution.self_check, sol.solution.velocity_check)
 
 
 def error(A, C, M0, p0, T: float, samples: int = 101) -> float:
@@ -76,8 +80,10 @@ def run(n: int, T: float) -> str:
         f"<= 1e-10: {np.mean(e <= 1e-10) * 100:.1f} % ({int(np.sum(e <= 1e-10))} of {n}); "
         f"<= 1e-12: {np.mean(e <= 1e-12) * 100:.1f} %",
         f"worst draws: {', '.join(str(int(i)) for i in np.argsort(e)[::-1][:5])}",
-        f"self_check of the conjugate top's solution: median {np.median(c):.2e}, "
-        f"max {c.max():.2e} (refused above 1e-10 with ClosedFormError)",
+        f"self_check of the conjugate top's solution: median {np.median(c[:, 0]):.2e}, "
+        f"max {c[:, 0].max():.2e} (refused above 1e-10 with ClosedFormError); "
+        f"velocity_check: median {np.median(c[:, 1]):.2e}, max {c[:, 1].max():.2e} "
+        f"(refused above 1e-6)",
         f"time {el:.1f} s",
     ]
     lines += [f"raised at draw {i}: {m}" for i, m in failed]
