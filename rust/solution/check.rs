@@ -42,12 +42,11 @@ pub const SELF_CHECK_RTOL: f64 = 1e-10;
 /// itself only accurate to ~ε (max c − min c)|l|², 1e-9 relative to a speed of
 /// 1e-7 of that scale, 1e-7 relative to one of 1e-9 (a harsh draw of 2000
 /// states: defects up to 1e-7 on solutions accurate to 1e-15 over their
-/// window). A wrong constant or
-/// sign leaves an O(1) defect; the drift a moderate one could cause is what
-/// [`drift_defect`] and [`DRIFT_RTOL`] bound. On the harsh draw of 10⁴ states
-/// (`tests/data/every_state_harsh.py`) this bound instead of
-/// [`SELF_CHECK_RTOL`] took the self-check's refusals from 420 to 149, none
-/// returned wrong.
+/// window). A wrong constant or sign leaves an O(1) defect; the drift a
+/// moderate one could cause is what [`drift_defect`] and [`DRIFT_RTOL`]
+/// bound. On the harsh draw of 10⁴ states (`tests/data/every_state_harsh.py`)
+/// this bound instead of [`SELF_CHECK_RTOL`] took the self-check's refusals
+/// from 420 to 149, none returned wrong.
 pub const VELOCITY_CHECK_RTOL: f64 = 1e-6;
 
 /// The relative defect `δ` whose drift `δ |t| |l̇(t)|` the solution bounds
@@ -75,8 +74,8 @@ pub(super) fn drift_defect(d: &Defect, closed: bool) -> f64 {
 /// Largest first-order drift `δ |t| |l̇(t)| / |l0|` of `l(t)` that
 /// [`super::Solution::l_batch`] returns, `δ` the relative defect the
 /// self-check leaves ([`drift_defect`]; before the self-check had two parts,
-/// its single defect, to which the measurements below refer). A relative error `δ` of `U` evaluates
-/// `l` at the phase of time `(1 + δ) t`; a defect `δ` of `l(0)` or of the
+/// its single defect, to which the measurements below refer). A relative
+/// error `δ` of `U` evaluates `l` at the phase of time `(1 + δ) t`; a defect `δ` of `l(0)` or of the
 /// integrals puts `l(t)` on a neighbouring torus, whose frequencies differ by
 /// `O(δ)`: either way an error `~δ t |l̇(t)|` that grows with `t` and peaks
 /// where the motion is fast, which no check at a few points of the torus
@@ -88,9 +87,9 @@ pub(super) fn drift_defect(d: &Defect, closed: bool) -> f64 {
 /// (a quarter would refuse half again as many correct ones).
 pub const DRIFT_RTOL: f64 = SELF_CHECK_RTOL / 2.0;
 
-/// Drift defects ([`drift_defect`]) up to this are taken as rounding, not as a
-/// measure of the drift, and [`DRIFT_RTOL`] is not applied. A calibrated gate, not a
-/// derived one: generic states leave 1e-15 … 6e-12 ('wide' has 3e-13 and
+/// Drift defects ([`drift_defect`]) up to this are taken as rounding, not as
+/// a measure of the drift, and [`DRIFT_RTOL`] is not applied. A calibrated
+/// gate, not a derived one: generic states leave 1e-15 … 6e-12 ('wide' has 3e-13 and
 /// meets 1e-9 at `t = 1e4`, where `δ t |l̇|` would claim 4e-9); the solutions
 /// of two harsh draws and the sweeps wrong by more than 1e-10 over their window
 /// had defects from 1e-12 to 7e-11 — but one (seed 2) with 4e-13, which drifts
@@ -137,6 +136,16 @@ const CHECK_PHASES: [f64; 3] = [0.29, 0.71, 1.37];
 /// orders of magnitude, not so far that the rounding of `U` (~1e-14 relative,
 /// growing linearly in `t`) is what it measures.
 const SLOW_CHECK_CAP: f64 = 50.0;
+
+/// `m.max(x)` with a NaN `x` taken as an infinite defect (`f64::max` would
+/// drop it).
+fn max_defect(m: f64, x: f64) -> f64 {
+    if x.is_nan() {
+        f64::INFINITY
+    } else {
+        m.max(x)
+    }
+}
 
 /// The self-check's relative defects ([`SelfCheck::defect`]), in two parts.
 #[derive(Debug, Clone, Copy)]
@@ -294,13 +303,7 @@ impl SelfCheck {
         // large relative error of the velocity, hence of the phase.
         let (mut ode_res, mut speed) = (0.0f64, 0.0f64);
         let mut worst = 0.0f64;
-        let mut note = |x: f64| {
-            worst = if x.is_nan() {
-                f64::INFINITY
-            } else {
-                worst.max(x)
-            };
-        };
+        let mut note = |x: f64| worst = max_defect(worst, x);
         for (k, &t) in times.iter().enumerate() {
             // the set-up's own jet at v0 for t = 0
             let owned;
@@ -329,9 +332,7 @@ impl SelfCheck {
             }
             let f = so4::vector_field4(&self.c4, &l);
             for q in 0..6 {
-                // a NaN at one point is an infinite defect, not one f64::max drops
-                let r = (ldot[q] - f[q]).abs();
-                ode_res = ode_res.max(if r.is_nan() { f64::INFINITY } else { r });
+                ode_res = max_defect(ode_res, (ldot[q] - f[q]).abs());
                 speed = speed.max(f[q].abs());
                 if k == 0 {
                     note((l[q] - self.l0[q]).abs() / self.size);
@@ -345,11 +346,7 @@ impl SelfCheck {
         let velocity = ode_res / speed.max(1e-30 * self.rate_scale);
         Ok(Defect {
             shape: worst,
-            velocity: if velocity.is_nan() {
-                f64::INFINITY
-            } else {
-                velocity
-            },
+            velocity: max_defect(0.0, velocity),
         })
     }
 }
