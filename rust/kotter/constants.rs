@@ -197,6 +197,11 @@ fn den_from_state(m: &[f64; 3], n: &[f64; 3]) -> f64 {
     dm * dp
 }
 
+/// Relative distance above which two DD-polished roots of `F` are distinct
+/// ([`resolved_in_dd`]): a thousand times the double rounding of `s`, far above
+/// the DD accuracy of the roots.
+const DD_DISTINCT_RTOL: f64 = 1e-13;
+
 /// [`kotter_constants`] and [`constants_from_h`]: the roots of `F` (19)
 /// polished on their branches, then everything else from `(s_p, σ_p, F'(s_p))`.
 fn constants_impl(
@@ -316,11 +321,42 @@ fn roots_of_f(
     // A cluster at a branch point of √G is found in the local parameter there;
     // a pair at a root of P = h1 s^2 - h2 s + h3 whose split 2 h0 √G/P' is
     // small though h0 is not, by the pair route (pairs.rs checks the split and
-    // the polish); else a repeated root.
+    // the polish); else the roots as polished if DD resolves them; else a
+    // repeated root.
+    let resolved = if resolved_in_dd(&roots) {
+        Some(roots.clone())
+    } else {
+        // The two polishes may have found the same root of f: the other root
+        // of F next to it is then the root of f on the other branch of √G
+        // (F = f f̃/(h1² − 4h0²), f̃ being f with −√G).
+        let mut alt = roots.clone();
+        alt[j] = polish_root(lv, p_at_a, z[j], Some(-roots[i].sigma.to_c()));
+        resolved_in_dd(&alt).then_some(alt)
+    };
     pairs::branch_point_cluster(lv, p_at_a, roots, (i, j))
         .or_else(|| pairs::pair_roots(lv, p_at_a))
         .map(|(r, partner, side)| (r.into(), Some(PairStructure { partner, side })))
+        .or_else(|| resolved.map(|r| (r, None)))
         .ok_or_else(|| repeated_root_error(at, i, j))
+}
+
+/// Two roots of `F` closer than [`REPEATED_ROOT_RTOL`] that neither the cluster
+/// nor the pair route takes are still distinct roots when each was polished on
+/// its own branch of `√G` to double-double accuracy ([`PolishedRoot::dd_converged`])
+/// and they stay apart by more than [`DD_DISTINCT_RTOL`]: on different branches
+/// `f'(s_p)` is not small, so each root is located to DD however close the other
+/// lies (`F'(s_p)`, proportional to their distance, is then accurate in DD too).
+/// Two polishes that ended on the same root, or one that did not converge,
+/// leave the pair refused as repeated.
+fn resolved_in_dd(roots: &[PolishedRoot]) -> bool {
+    if !roots.iter().all(|r| r.dd_converged) {
+        return false;
+    }
+    let scale = roots.iter().fold(0.0f64, |m, r| m.max(r.s.modulus()));
+    (0..roots.len()).all(|p| {
+        ((p + 1)..roots.len())
+            .all(|q| (roots[p].s - roots[q].s).modulus() > DD_DISTINCT_RTOL * scale)
+    })
 }
 
 /// What the pair route knows of its roots ([`pairs::pair_roots`]): which is

@@ -145,6 +145,7 @@ fn sqrt_g_near(x: &[C; 4], prev: C) -> C {
 }
 
 /// A root of `F` (19) polished on its own branch, with what (20) needs there.
+#[derive(Clone)]
 pub(super) struct PolishedRoot {
     pub(super) s: C,
     /// `s − a_m` in DD (exact sums from the root's offset to its nearest `a_i`).
@@ -156,6 +157,9 @@ pub(super) struct PolishedRoot {
     pub(super) fprime: C,
     /// `√(F'(s)/|h0|)`, principal.
     pub(super) sqrt_fprime: Cdd,
+    /// Newton's method in DD ([`refine_dd`]) ended on a step below DD
+    /// resolution: `s` is a root of `f` to DD accuracy, not only to double.
+    pub(super) dd_converged: bool,
 }
 
 impl PolishedRoot {
@@ -175,6 +179,7 @@ impl PolishedRoot {
             sigma: self.sigma.conj(),
             fprime: self.fprime.conj(),
             sqrt_fprime,
+            dd_converged: self.dd_converged,
         }
     }
 }
@@ -236,6 +241,7 @@ pub(super) fn polish_root_at(
         sigma: Cdd::new(sigma),
         fprime,
         sqrt_fprime: Cdd::new(sqrt_principal(fprime)),
+        dd_converged: false,
     };
     refine_dd(lv, best, t, sigma, df).unwrap_or(plain)
 }
@@ -342,10 +348,26 @@ fn newton_on_branch(lv: &Level, best: usize, t: C, x0: [C; 4], mut sigma: C) -> 
     best_state
 }
 
+/// At most this many Newton steps in DD in [`refine_dd`].
+const DD_NEWTON_STEPS: usize = 6;
+/// The last Newton step in DD (with the DD `f'`) below this fraction of the
+/// offset: the root is converged in DD ([`PolishedRoot::dd_converged`]).
+const DD_CONVERGED_RTOL: f64 = 1e-20;
+/// A step below this fraction of the offset leaves nothing to gain in DD.
+const DD_STEP_RTOL: f64 = 1e-31;
+/// A step not below this fraction of the one before has stalled at the
+/// rounding of `f` in DD (1e-29 … 1e-27 of the offset where the terms of `f`
+/// cancel, measured), and ends the iteration. Not smaller: near a double root
+/// of `f` Newton's method converges only linearly, by a factor of about 2 per
+/// step (stopping at a ratio of 1e-3 left 20 more states of the harsh draw
+/// unresolved).
+const DD_STALL_RATIO: f64 = 0.9;
+
 /// The root, `σ`, the offsets `s − a_m` and `√F'(s)` to double-double
-/// accuracy: one Newton step on `f` evaluated in DD from the double root
-/// (`t = s − a_i`), then `σ`, `f'` and `F' = −4h0 σ f'/(h1² − 4h0²)` in DD at
-/// the new root.
+/// accuracy: Newton's method on `f` evaluated in DD from the double root
+/// (`t = s − a_i`), the first step with the double `f'`, the next with `f'` in
+/// DD until a step is below [`DD_CONVERGED_RTOL`], then `σ`, `f'` and
+/// `F' = −4h0 σ f'/(h1² − 4h0²)` in DD at the new root.
 ///
 /// Why: `l^(p)`, `Δ`, `d_j` and `α_j … δ_j` are all built from `(s_p, σ_p, F'(s_p))`,
 /// and the third quadric (11) of the rounded constants holds only as well as
@@ -353,6 +375,14 @@ fn newton_on_branch(lv: &Level, best: usize, t: C, x0: [C; 4], mut sigma: C) -> 
 /// large branch point: `F'` in double (a few ulps off) left a round trip of
 /// 3.5e-12 at `|d_1| = 1.2e7`, DD constants 5e-16 (docs/kotter.md §3). `None`
 /// when a DD value is not finite (then the double values stand).
+///
+/// Why more than one step: where `f'` cancels (a root of `F` a few 1e-9 from
+/// its neighbour on the other branch of `√G`, both near an `a_i`), the double
+/// `f'` is good to ~1e-4 only, and one step left the offsets 1e-20 off; the
+/// normalisations `√F'(s_p)` of a conjugate pair were then off by a phase of
+/// 2e-15, which (22) turns into an error of `φ η_j` in `ξ_j`: 8e-10 relative in
+/// the small components, and no pair of points on the curve reproduced them
+/// (states near `l_ij E_ij + l_kl E_kl`, docs/degenerate.md §11).
 fn refine_dd(lv: &Level, i: usize, t: C, sigma: C, df: C) -> Option<PolishedRoot> {
     let (h0, den) = match lv.mn {
         Some((m, n)) => {
@@ -374,15 +404,35 @@ fn refine_dd(lv: &Level, i: usize, t: C, sigma: C, df: C) -> Option<PolishedRoot
             )
         }
     };
-    let (x, sg) = offsets_dd(lv.a, i, Cdd::new(t), sigma);
-    let f = f_dd(lv, h0, &x, sg);
-    let step = f.to_c() / df;
-    if !(step.re.is_finite() && step.im.is_finite()) {
-        return None;
+    // Newton's method in DD: the first step with the double f', then with the
+    // DD f'.
+    let mut t_dd = Cdd::new(t);
+    let mut dfc = df;
+    let (mut x, mut sg) = offsets_dd(lv.a, i, t_dd, sigma);
+    let mut dfd = df_dd(lv, h0, &x, sg);
+    let mut converged = false;
+    let mut prev_rel = f64::INFINITY;
+    for k in 0..DD_NEWTON_STEPS {
+        let f = f_dd(lv, h0, &x, sg);
+        let step = f.to_c() / dfc;
+        if !(step.re.is_finite() && step.im.is_finite()) {
+            if k == 0 {
+                return None;
+            }
+            break;
+        }
+        t_dd = t_dd.sub(Cdd::new(step));
+        (x, sg) = offsets_dd(lv.a, i, t_dd, sigma);
+        dfd = df_dd(lv, h0, &x, sg);
+        dfc = dfd.to_c();
+        let rel = step.modulus() / t_dd.to_c().modulus();
+        converged = rel <= DD_STEP_RTOL || (k >= 1 && rel <= DD_CONVERGED_RTOL);
+        // at DD resolution, or stalled at the rounding of f in DD
+        if rel <= DD_STEP_RTOL || (k >= 1 && rel > DD_STALL_RATIO * prev_rel) {
+            break;
+        }
+        prev_rel = rel;
     }
-    let t_dd = Cdd::new(t).sub(Cdd::new(step));
-    let (x, sg) = offsets_dd(lv.a, i, t_dd, sigma);
-    let dfd = df_dd(lv, h0, &x, sg);
     let fp = dfd.mul(sg).mul_f64(-4.0 * lv.h0_sign()).div_dd(den);
     let sq = fp.sqrt();
     let s = t_dd.add_f64(lv.a[i]);
@@ -392,6 +442,7 @@ fn refine_dd(lv: &Level, i: usize, t: C, sigma: C, df: C) -> Option<PolishedRoot
         sigma: sg,
         fprime: fp.to_c(),
         sqrt_fprime: sq,
+        dd_converged: converged,
     };
     let finite = |z: Cdd| {
         let (hi, lo) = (z.to_c(), C::new(z.re.lo, z.im.lo));
