@@ -426,10 +426,23 @@ fn refine_dd(lv: &Level, i: usize, t: C, sigma: C, df: C) -> Option<PolishedRoot
         dfd = df_dd(lv, h0, &x, sg);
         dfc = dfd.to_c();
         let rel = step.modulus() / t_dd.to_c().modulus();
-        converged = rel <= DD_STEP_RTOL || (k >= 1 && rel <= DD_CONVERGED_RTOL);
-        // at DD resolution, or stalled at the rounding of f in DD
-        if rel <= DD_STEP_RTOL || (k >= 1 && rel > DD_STALL_RATIO * prev_rel) {
-            break;
+        if k == 0 {
+            // The first step took the double f': its error leaves the new
+            // offset off by about |step| times the relative error of that f',
+            // which the DD f' at the new root shows. Where f' kept its digits
+            // (every generic root) that is below DD resolution and the one
+            // step stands, as it always did.
+            let df_err = (dfc - df).modulus() / dfc.modulus();
+            if rel * df_err <= DD_STEP_RTOL || rel <= DD_STEP_RTOL {
+                converged = true;
+                break;
+            }
+        } else {
+            converged = rel <= DD_CONVERGED_RTOL;
+            // at DD resolution, or stalled at the rounding of f in DD
+            if rel <= DD_STEP_RTOL || rel > DD_STALL_RATIO * prev_rel {
+                break;
+            }
         }
         prev_rel = rel;
     }
