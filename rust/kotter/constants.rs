@@ -276,6 +276,171 @@ fn roots_of_f(
     p_at_a: &[f64; 4],
     f: &[f64; 5],
 ) -> Result<(Vec<PolishedRoot>, Option<PairStructure>)> {
+    match roots_by_route(lv, p_at_a, f) {
+        Ok((roots, pair)) => {
+            if roots.iter().all(|r| r.dd_converged) {
+                return Ok((roots, pair));
+            }
+            match hidden_conjugate_pair(lv, p_at_a, &roots)
+                .or_else(|| hidden_real_pair(lv, p_at_a, &roots))
+            {
+                Some(fixed) => Ok((fixed, None)),
+                None => Ok((roots, pair)),
+            }
+        }
+        Err(e) => Err(e),
+    }
+}
+
+/// Two real roots of `F`, close to each other, whose polish in DD did not
+/// converge, are taken for a conjugate pair `s, s̄` with an imaginary part below
+/// what the quartic resolves (the iterate locates a near-double root only to
+/// `√u` relative, and its imaginary part, 1e-11 … 1e-7 of the root on the
+/// harsh draw, was snapped to the real axis): Newton's method in real
+/// arithmetic from a real start cannot leave the axis, and each of the two
+/// ended near `Re s`, neither a root. The pair is polished again from
+/// `mid + i half` (`mid`, `half` the midpoint and half the distance of the two
+/// reals) on its own branch; if that converges in DD to a non-real root, the
+/// two are replaced by it and its conjugate, in the documented order. `None`
+/// when there is no such pair or the polish does not resolve it
+/// ([`resolved_in_dd`]); the roots then stand as they were.
+fn hidden_conjugate_pair(
+    lv: &Level,
+    p_at_a: &[f64; 4],
+    roots: &[PolishedRoot],
+) -> Option<Vec<PolishedRoot>> {
+    let scale = roots.iter().fold(0.0f64, |m, r| m.max(r.s.modulus()));
+    let mut best: Option<(usize, usize, f64)> = None;
+    for p in 0..roots.len() {
+        for q in (p + 1)..roots.len() {
+            let (rp, rq) = (&roots[p], &roots[q]);
+            if rp.s.im != 0.0 || rq.s.im != 0.0 || (rp.dd_converged && rq.dd_converged) {
+                continue;
+            }
+            let dist = (rp.s - rq.s).modulus();
+            if dist <= HIDDEN_PAIR_RTOL * scale && best.is_none_or(|(_, _, b)| dist < b) {
+                best = Some((p, q, dist));
+            }
+        }
+    }
+    let (p, q, _) = best?;
+    conjugate_pair_from(lv, p_at_a, roots, p, q, roots[p].s, roots[q].s)
+}
+
+/// [`hidden_conjugate_pair`] for the roots `p`, `q` of `roots`, seeded from
+/// `zp`, `zq` (their polished values, or the quartic's iterate where the two
+/// polishes ended on one root).
+fn conjugate_pair_from(
+    lv: &Level,
+    p_at_a: &[f64; 4],
+    roots: &[PolishedRoot],
+    p: usize,
+    q: usize,
+    zp: C,
+    zq: C,
+) -> Option<Vec<PolishedRoot>> {
+    let scale = roots.iter().fold(0.0f64, |m, r| m.max(r.s.modulus()));
+    let mid = (zp + zq) * 0.5;
+    let half = (0.5 * (zp - zq).modulus()).max(f64::EPSILON * mid.modulus());
+    let r = polish_root(lv, p_at_a, C::new(mid.re, half), None);
+    if !r.dd_converged || r.s.im.abs() <= DD_DISTINCT_RTOL * scale {
+        return None;
+    }
+    let r = if r.s.im > 0.0 { r } else { r.conj() };
+    let others: Vec<PolishedRoot> = (0..roots.len())
+        .filter(|&k| k != p && k != q)
+        .map(|k| roots[k].clone())
+        .collect();
+    let rc = r.conj();
+    let out: Vec<PolishedRoot> = if others.iter().all(|o| o.s.im == 0.0) {
+        // s1 = r, s2 = its conjugate, then the real roots descending
+        let (a, b) = (&others[0], &others[1]);
+        let (hi, lo) = if a.s.re >= b.s.re { (a, b) } else { (b, a) };
+        vec![r, rc, hi.clone(), lo.clone()]
+    } else {
+        // the other pair is conjugate: s1 the member of larger imaginary part
+        let o = if others[0].s.im > 0.0 {
+            &others[0]
+        } else {
+            &others[1]
+        };
+        let (oc, o) = (o.conj(), o.clone());
+        if o.s.im > r.s.im {
+            vec![o, oc, r, rc]
+        } else {
+            vec![r, rc, o, oc]
+        }
+    };
+    resolved_in_dd(&out).then_some(out)
+}
+
+/// The converse of [`hidden_conjugate_pair`]: a conjugate pair `s, s̄` of the
+/// iterate whose polish did not converge, with `|Im s|` below
+/// [`HIDDEN_PAIR_RTOL`] of the largest root, is taken for two real roots the
+/// quartic did not resolve (they may lie on different branches of `√G`, where
+/// Newton's method on one branch from a non-real start has no root to reach).
+/// Each is polished from `Re s ± |Im s|`; if both converge in DD to distinct
+/// real roots, they replace the pair, in the documented order.
+fn hidden_real_pair(
+    lv: &Level,
+    p_at_a: &[f64; 4],
+    roots: &[PolishedRoot],
+) -> Option<Vec<PolishedRoot>> {
+    let scale = roots.iter().fold(0.0f64, |m, r| m.max(r.s.modulus()));
+    let p = (0..roots.len().saturating_sub(1)).find(|&p| {
+        let (rp, rq) = (&roots[p], &roots[p + 1]);
+        rp.s.im != 0.0
+            && rq.s == rp.s.conj()
+            && !(rp.dd_converged && rq.dd_converged)
+            && rp.s.im.abs() <= HIDDEN_PAIR_RTOL * scale
+    })?;
+    let (re, im) = (roots[p].s.re, roots[p].s.im.abs());
+    // the second on the other branch of √G if the first seed's branch gave
+    // both polishes the same root (F = f f̃/(h1² − 4h0²))
+    let r1 = polish_root(lv, p_at_a, C::new(re + im, 0.0), None);
+    let mut r2 = polish_root(lv, p_at_a, C::new(re - im, 0.0), None);
+    if (r2.s - r1.s).modulus() <= DD_DISTINCT_RTOL * scale {
+        r2 = polish_root(lv, p_at_a, C::new(re - im, 0.0), Some(-r1.sigma.to_c()));
+    }
+    if r1.s.im != 0.0 || r2.s.im != 0.0 {
+        return None;
+    }
+    let others: Vec<PolishedRoot> = (0..roots.len())
+        .filter(|&k| k != p && k != p + 1)
+        .map(|k| roots[k].clone())
+        .collect();
+    let mut reals = vec![r1, r2];
+    let out: Vec<PolishedRoot> = if others.iter().all(|o| o.s.im == 0.0) {
+        reals.extend(others);
+        reals.sort_by(|x, y| {
+            y.s.re
+                .partial_cmp(&x.s.re)
+                .unwrap_or(std::cmp::Ordering::Equal)
+        });
+        reals
+    } else {
+        reals.sort_by(|x, y| {
+            y.s.re
+                .partial_cmp(&x.s.re)
+                .unwrap_or(std::cmp::Ordering::Equal)
+        });
+        let mut v = others;
+        v.extend(reals);
+        v
+    };
+    resolved_in_dd(&out).then_some(out)
+}
+
+/// Two real roots of `F` this close (relative to the largest root) whose polish
+/// did not converge are tried as a conjugate pair ([`hidden_conjugate_pair`]).
+const HIDDEN_PAIR_RTOL: f64 = 1e-4;
+
+/// The roots of `F` by the routes below ([`roots_of_f`]).
+fn roots_by_route(
+    lv: &Level,
+    p_at_a: &[f64; 4],
+    f: &[f64; 5],
+) -> Result<(Vec<PolishedRoot>, Option<PairStructure>)> {
     let h = lv.h;
     if h[0].abs() <= PAIR_ROUTE_RTOL * h[1] {
         if let Some((r, partner, side)) = pairs::pair_roots(lv, p_at_a) {
@@ -323,6 +488,13 @@ fn roots_of_f(
     // small though h0 is not, by the pair route (pairs.rs checks the split and
     // the polish); else the roots as polished if DD resolves them; else a
     // repeated root.
+    // or, two real roots of the iterate being a conjugate pair whose imaginary
+    // part the quartic did not resolve, that pair ([`conjugate_pair_from`])
+    let hidden = if z[i].im == 0.0 && z[j].im == 0.0 {
+        conjugate_pair_from(lv, p_at_a, &roots, i, j, z[i], z[j])
+    } else {
+        None
+    };
     let resolved = if resolved_in_dd(&roots) {
         Some(roots.clone())
     } else {
@@ -337,6 +509,7 @@ fn roots_of_f(
         .or_else(|| pairs::pair_roots(lv, p_at_a))
         .map(|(r, partner, side)| (r.into(), Some(PairStructure { partner, side })))
         .or_else(|| resolved.map(|r| (r, None)))
+        .or_else(|| hidden.map(|r| (r, None)))
         .ok_or_else(|| repeated_root_error(at, i, j))
 }
 

@@ -791,3 +791,76 @@ fn roots_of_f_next_to_their_partner_are_polished_to_double_double() {
         assert_reproduces_the_state(&st, &l);
     }
 }
+
+/// A conjugate pair of roots of `F` with an imaginary part below what the
+/// quartic resolves (4e-11, 1e-8 and 2.2e-7 of the root here): the iterate
+/// snapped it to two real roots, from which Newton's method in real arithmetic
+/// cannot reach it, and the reduction failed ("xi, eta: no pair of points
+/// reproduces them"). It is polished again from a non-real start. States of the
+/// harsh random draw of tests/data/every_state_harsh.py (seed 20261125, draws
+/// 317, 225, 599).
+#[test]
+fn a_conjugate_pair_below_the_quartics_resolution_is_found() {
+    let cases: [([f64; 4], [f64; 6]); 3] = [
+        (
+            [
+                0.7511183459828488,
+                0.8081761075663758,
+                0.8108800680579439,
+                0.8144588832279281,
+            ],
+            [
+                0.0004503581176048301,
+                16757.72640635625,
+                -0.0006048699760775133,
+                0.02881781805311546,
+                136271.95242541938,
+                -1.4802339324998651e-05,
+            ],
+        ),
+        (
+            [
+                -0.5787697432903434,
+                76.961060519663,
+                77.20113517393013,
+                82.62650531547678,
+            ],
+            [
+                3.580050298371845e-06,
+                -6.187113479678102e-06,
+                694621.0787459919,
+                381.91378918569666,
+                -0.017049222527580992,
+                -2.3135835382460585e-05,
+            ],
+        ),
+        (
+            [
+                -0.33368729132985075,
+                -0.3323174583330585,
+                7.18052978634803,
+                7.352361734913826,
+            ],
+            [
+                -3.738314233554319,
+                -0.0001803238603155464,
+                0.10841891058455651,
+                -0.00029902573295593376,
+                0.722229045411303,
+                63144.89343358348,
+            ],
+        ),
+    ];
+    for (a, l) in cases {
+        let st = kotter(&a, &l).unwrap();
+        let s = st.constants.s;
+        // two conjugate pairs, one of them within 1e-6 of the real axis
+        assert!(s.iter().all(|x| x.im != 0.0) || s.iter().filter(|x| x.im != 0.0).count() == 2);
+        assert!(
+            s.iter()
+                .any(|x| x.im != 0.0 && x.im.abs() < 1e-6 * x.norm()),
+            "{s:?}"
+        );
+        assert_reproduces_the_state(&st, &l);
+    }
+}
