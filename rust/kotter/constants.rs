@@ -12,8 +12,8 @@ use super::roots::{
 };
 use super::{check_a, integrals, l_from_m_n, m_n, C, CYCLIC, ONE, ZERO};
 use crate::error::{check_finite, cnum, Error, Result, SingularKind};
-use crate::numeric::complex::Modulus;
-use crate::numeric::dd::Cdd;
+use crate::numeric::complex::{sqrt_principal, Modulus};
+use crate::numeric::dd::{Cdd, Dd};
 
 /// Residual (relative to the size of the terms) above which the existence
 /// conditions of (38)–(39) (`Σ c_j q_j = 0`, `Σ c_j (p_j + r_j) = 0`) and the
@@ -278,18 +278,147 @@ fn roots_of_f(
 ) -> Result<(Vec<PolishedRoot>, Option<PairStructure>)> {
     match roots_by_route(lv, p_at_a, f) {
         Ok((roots, pair)) => {
-            if roots.iter().all(|r| r.dd_converged) {
+            if roots.iter().all(|r| r.dd_converged) && resolved_in_dd(&roots) {
                 return Ok((roots, pair));
             }
             match hidden_conjugate_pair(lv, p_at_a, &roots)
                 .or_else(|| hidden_real_pair(lv, p_at_a, &roots))
+                .or_else(|| root_census(lv, p_at_a, f, &roots))
             {
                 Some(fixed) => Ok((fixed, None)),
                 None => Ok((roots, pair)),
             }
         }
+        Err(
+            e @ Error::Singular {
+                kind: SingularKind::RepeatedRoot,
+                ..
+            },
+        ) => match root_census(lv, p_at_a, f, &[]) {
+            Some(found) => Ok((found, None)),
+            None => Err(e),
+        },
         Err(e) => Err(e),
     }
+}
+
+/// The four roots of `F` found afresh where the routes left two of them on one
+/// root, unconverged, or refused a repeated root that is none: every seed (the
+/// quartic's iterate, the roots given, and for each seed near the real axis
+/// the non-real seeds `Re z ± i δ` and the real ones `Re z ± |Im z|`, `δ` the
+/// distance to the nearest other seed) is polished on each branch of `√G`
+/// (a root of `F = f f̃/(h1² − 4h0²)` is a root of `f` on one of them), the
+/// polishes that converged in DD are merged within [`DD_DISTINCT_RTOL`], and
+/// the conjugate of each non-real root added. Exactly four distinct roots,
+/// each converged, are the result, in the documented order; anything else
+/// (a true double root, a root no seed reaches) is `None`.
+fn root_census(
+    lv: &Level,
+    p_at_a: &[f64; 4],
+    f: &[f64; 5],
+    given: &[PolishedRoot],
+) -> Option<Vec<PolishedRoot>> {
+    let (z, _, _) = quartic_roots_unordered(f).ok()?;
+    let mut seeds: Vec<C> = z.to_vec();
+    seeds.extend(given.iter().map(|r| r.s));
+    let base = seeds.clone();
+    let scale = base.iter().fold(0.0f64, |m, x| m.max(x.modulus()));
+    for (k, x) in base.iter().enumerate() {
+        let near = base
+            .iter()
+            .enumerate()
+            .filter(|&(q, y)| q != k && (y - x).modulus() > 0.0)
+            .map(|(_, y)| (y - x).modulus())
+            .fold(f64::INFINITY, f64::min);
+        if x.im.abs() <= HIDDEN_PAIR_RTOL * scale {
+            if near.is_finite() && near <= HIDDEN_PAIR_RTOL * scale {
+                seeds.push(C::new(x.re, near));
+            }
+            // a stagnated iterate can sit on the axis far from a pair with a
+            // small imaginary part: non-real seeds at a few scales
+            for rel in [1e-3, 1e-5, 1e-7] {
+                seeds.push(C::new(x.re, rel * x.modulus()));
+            }
+            if x.im != 0.0 {
+                seeds.push(C::new(x.re + x.im.abs(), 0.0));
+                seeds.push(C::new(x.re - x.im.abs(), 0.0));
+            }
+        }
+    }
+    let mut found: Vec<PolishedRoot> = Vec::new();
+    let add = |r: PolishedRoot, found: &mut Vec<PolishedRoot>| {
+        if r.dd_converged
+            && r.s.re.is_finite()
+            && r.s.im.is_finite()
+            && found
+                .iter()
+                .all(|q| (q.s - r.s).modulus() > DD_DISTINCT_RTOL * scale)
+        {
+            found.push(r);
+        }
+    };
+    for &s0 in &seeds {
+        let g0 = sqrt_principal(lv.a.iter().map(|&am| s0 - am).product());
+        for branch in [g0, -g0] {
+            if g0 == ZERO {
+                continue;
+            }
+            let mut r = polish_root(lv, p_at_a, s0, Some(branch));
+            // an imaginary part below DD resolution (left by a start off the
+            // axis) is a real root
+            if r.s.im != 0.0 && r.s.im.abs() <= 1e-30 * r.s.modulus() {
+                r.s.im = 0.0;
+                for xm in &mut r.x {
+                    xm.im = Dd::ZERO;
+                }
+            }
+            if r.s.im != 0.0 {
+                let rc = r.conj();
+                add(r, &mut found);
+                add(rc, &mut found);
+            } else {
+                add(r, &mut found);
+            }
+        }
+        if found.len() > 4 {
+            return None;
+        }
+    }
+    if found.len() != 4 {
+        return None;
+    }
+    let out = documented_roots(found)?;
+    resolved_in_dd(&out).then_some(out)
+}
+
+/// Four distinct roots in the documented order: the non-real root of largest
+/// imaginary part, its conjugate, the remaining root of larger imaginary part
+/// (then real part), the last; all real: descending. A non-real root is
+/// followed by its exact conjugate. `None` if a non-real root has no conjugate
+/// among them.
+fn documented_roots(mut r: Vec<PolishedRoot>) -> Option<Vec<PolishedRoot>> {
+    use std::cmp::Ordering;
+    let key = |x: &PolishedRoot, y: &PolishedRoot| {
+        x.s.im
+            .partial_cmp(&y.s.im)
+            .unwrap_or(Ordering::Equal)
+            .then(x.s.re.partial_cmp(&y.s.re).unwrap_or(Ordering::Equal))
+    };
+    let mut out = Vec::with_capacity(4);
+    while !r.is_empty() {
+        if r.iter().any(|x| x.s.im != 0.0) {
+            let i = (0..r.len()).max_by(|&i, &j| key(&r[i], &r[j]))?;
+            let top = r.remove(i);
+            let j = (0..r.len()).find(|&j| r[j].s == top.s.conj())?;
+            let partner = r.remove(j);
+            out.push(top);
+            out.push(partner);
+        } else {
+            r.sort_by(|x, y| y.s.re.partial_cmp(&x.s.re).unwrap_or(Ordering::Equal));
+            out.append(&mut r);
+        }
+    }
+    Some(out)
 }
 
 /// Two real roots of `F`, close to each other, whose polish in DD did not

@@ -864,3 +864,73 @@ fn a_conjugate_pair_below_the_quartics_resolution_is_found() {
         assert_reproduces_the_state(&st, &l);
     }
 }
+
+/// Roots of `F` that the quartic's iterate loses (it stagnated between them,
+/// and two polishes ended on one root: "F(s) (19) has a repeated root" though
+/// the four roots are 1e-5 … 1e-2 apart) are found again by polishing seeds
+/// around the iterate on both branches of `√G`. States of the harsh random
+/// draw of tests/data/every_state_harsh.py (seed 20261125, draws 576, 933, 935).
+#[test]
+fn roots_of_f_the_quartic_loses_are_found_again() {
+    let cases: [([f64; 4], [f64; 6]); 3] = [
+        (
+            [
+                -0.1810746258372773,
+                18.662385126848346,
+                655.5772937786562,
+                655.6500986328452,
+            ],
+            [
+                2.605840517836271,
+                6.4520306453830074e-06,
+                -0.0010271662978344432,
+                -1.3606159728694799e-05,
+                -1.4785408914981298e-06,
+                -0.0008632490759808399,
+            ],
+        ),
+        (
+            [
+                -0.015105293901801486,
+                144.36579804653454,
+                144.36867187115956,
+                144.37119839848364,
+            ],
+            [
+                511.4754680212693,
+                201.32608146193007,
+                -0.01448009257969307,
+                0.00029580486142612763,
+                -0.0024955786173868895,
+                0.07841100356299988,
+            ],
+        ),
+        (
+            [
+                -0.9900070354364403,
+                -0.9822865368281716,
+                15.145220595478994,
+                15.148164499511031,
+            ],
+            [
+                -425.33088681462925,
+                0.4179225500569707,
+                0.05626518312653583,
+                -2.4106587394326915e-06,
+                -5.948384773161858,
+                -1.1780621545653091e-05,
+            ],
+        ),
+    ];
+    for (a, l) in cases {
+        let st = kotter(&a, &l).unwrap();
+        let s = st.constants.s;
+        let scale = s.iter().fold(0.0f64, |m, x| m.max(x.norm()));
+        for p in 0..4 {
+            for q in p + 1..4 {
+                assert!((s[p] - s[q]).norm() > 1e-12 * scale, "{s:?}");
+            }
+        }
+        assert_reproduces_the_state(&st, &l);
+    }
+}
