@@ -1443,3 +1443,31 @@ def test_top_kotter_requires_so4():
     top = manakov.ManakovTop([0.1, 0.7, 1.3, 2.0, 2.9], [1.0, -0.5, 0.3, 0.8, 0.2])
     with pytest.raises(ValueError, match="so\\(4\\) only"):
         top.kotter(np.ones(10))
+
+
+# Componentwise relative error of xi, eta (22) against the 60-digit reduction:
+# a few ulps of each component, however small against the largest.
+XI_ETA_COMPONENT_RTOL = 1e-14
+
+
+@pytest.mark.parametrize("draw", [316, 29, 225])
+def test_small_components_of_xi_eta_keep_their_own_digits(draw) -> None:
+    """Near an equilibrium l_ij E_ij + l_kl E_kl the components of xi, eta span
+    nine orders of magnitude, and the inverse map of (37) needs each to its own
+    digits. Against an independent 60-digit mpmath reduction of the same state
+    (tests/data/kotter_mpmath_state.py), each component is within a few ulps of
+    itself; one Newton step in double-double on the roots of F left the small
+    ones 1e-9 off, and the state was refused."""
+    pytest.importorskip("mpmath")
+    import kotter_mpmath_state as ref
+
+    a, b, l0 = ref.state(draw)
+    s, d, xi, eta = ref.reduce_mp(a, l0)
+    k = manakov.kotter(a, b, l0)
+    for p in range(4):
+        assert ref.rel(k.s[p], s[p]) <= XI_ETA_COMPONENT_RTOL
+    sizes = [abs(complex(x)) for x in xi + eta]
+    assert min(sizes) < 1e-7 * max(sizes)
+    for j in range(3):
+        assert ref.rel(k.xi[j], xi[j]) <= XI_ETA_COMPONENT_RTOL
+        assert ref.rel(k.eta[j], eta[j]) <= XI_ETA_COMPONENT_RTOL
