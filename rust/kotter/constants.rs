@@ -438,7 +438,7 @@ fn hidden_conjugate_pair(
     p_at_a: &[f64; 4],
     roots: &[PolishedRoot],
 ) -> Option<Vec<PolishedRoot>> {
-    let scale = roots.iter().fold(0.0f64, |m, r| m.max(r.s.modulus()));
+    let scale = root_scale(roots);
     let mut best: Option<(usize, usize, f64)> = None;
     for p in 0..roots.len() {
         for q in (p + 1)..roots.len() {
@@ -468,7 +468,7 @@ fn conjugate_pair_from(
     zp: C,
     zq: C,
 ) -> Option<Vec<PolishedRoot>> {
-    let scale = roots.iter().fold(0.0f64, |m, r| m.max(r.s.modulus()));
+    let scale = root_scale(roots);
     let mid = (zp + zq) * 0.5;
     let half = (0.5 * (zp - zq).modulus()).max(f64::EPSILON * mid.modulus());
     let r = polish_root(lv, p_at_a, C::new(mid.re, half), None);
@@ -515,7 +515,7 @@ fn hidden_real_pair(
     p_at_a: &[f64; 4],
     roots: &[PolishedRoot],
 ) -> Option<Vec<PolishedRoot>> {
-    let scale = roots.iter().fold(0.0f64, |m, r| m.max(r.s.modulus()));
+    let scale = root_scale(roots);
     let p = (0..roots.len().saturating_sub(1)).find(|&p| {
         let (rp, rq) = (&roots[p], &roots[p + 1]);
         rp.s.im != 0.0
@@ -642,6 +642,12 @@ fn roots_by_route(
         .ok_or_else(|| repeated_root_error(at, i, j))
 }
 
+/// The largest `|s_p|`: the scale the distances between roots are taken
+/// relative to.
+fn root_scale(roots: &[PolishedRoot]) -> f64 {
+    roots.iter().fold(0.0f64, |m, r| m.max(r.s.modulus()))
+}
+
 /// Two roots of `F` closer than [`REPEATED_ROOT_RTOL`] that neither the cluster
 /// nor the pair route takes are still distinct roots when each was polished on
 /// its own branch of `√G` to double-double accuracy ([`PolishedRoot::dd_converged`])
@@ -654,7 +660,7 @@ fn resolved_in_dd(roots: &[PolishedRoot]) -> bool {
     if !roots.iter().all(|r| r.dd_converged) {
         return false;
     }
-    let scale = roots.iter().fold(0.0f64, |m, r| m.max(r.s.modulus()));
+    let scale = root_scale(roots);
     (0..roots.len()).all(|p| {
         ((p + 1)..roots.len())
             .all(|q| (roots[p].s - roots[q].s).modulus() > DD_DISTINCT_RTOL * scale)
