@@ -325,3 +325,74 @@ fn the_velocity_defect_of_a_slow_motion_has_its_own_bound() {
     let norm = l.iter().map(|x| x * x).sum::<f64>().sqrt();
     assert!((norm - size).abs() <= 1e-14 * size);
 }
+
+/// The Abel map of a divisor point takes the best of its routes (from `∞` or
+/// from a nearby branch point); on these states that route's path ran within
+/// rounding of another branch point (a segment planned onto a singularity,
+/// refused as "an integration path passes within rounding distance of a
+/// branch point"), and the solution was refused. The next best route is taken
+/// instead: every route is exact to the target. States of the harsh random
+/// draw of tests/data/every_state_harsh.py (seed 20261125, draws 552, 698).
+#[test]
+fn a_divisor_point_whose_best_path_meets_a_branch_point_takes_another() {
+    let cases: [([f64; 4], [f64; 4], [f64; 6]); 2] = [
+        (
+            [
+                -0.9479421052733823,
+                -0.9137787295931648,
+                439.50265100841017,
+                439.517177934697,
+            ],
+            [
+                0.25941476644521644,
+                -51.27674881122249,
+                -50.48109195207876,
+                -51.696159267227884,
+            ],
+            [
+                0.0006887092141711479,
+                909584.2253935185,
+                14.556442056552884,
+                -0.06335417290716316,
+                -0.0007251840590396934,
+                0.00020125046940058387,
+            ],
+        ),
+        (
+            [
+                -0.7127525807024242,
+                -0.5652677554727837,
+                179.23171784072213,
+                179.28217800206536,
+            ],
+            [
+                -0.3926118762312092,
+                -0.9452326692758961,
+                -36.38049332897673,
+                -36.97575400897377,
+            ],
+            [
+                0.002339890265673215,
+                -0.0007511781839966859,
+                -837053.5117501998,
+                1.7475781455656604e-05,
+                56.571120795681665,
+                0.00023578461162305784,
+            ],
+        ),
+    ];
+    for (a, b, l0) in cases {
+        let s = Solution::new(&a, &b, &l0).unwrap();
+        assert!(s.self_check() <= 1e-12, "{:e}", s.self_check());
+        let l = s.l(0.0).unwrap();
+        let size = l0.iter().map(|x| x * x).sum::<f64>().sqrt();
+        for q in 0..6 {
+            assert!(
+                (l[q] - l0[q]).abs() <= 1e-12 * size,
+                "{q}: {} vs {}",
+                l[q],
+                l0[q]
+            );
+        }
+    }
+}
