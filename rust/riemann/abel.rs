@@ -423,57 +423,79 @@ impl HyperellipticCurve {
                 near[i] = (d, k);
             }
         }
-        let mut routes = [(Route::Infinity, f64::NEG_INFINITY); ROUTE_CANDIDATES + 1];
-        routes[0] = (Route::Infinity, self.infinity_quality(x, dist));
-        let mut nr = 1;
+        let mut best = (Route::Infinity, self.infinity_quality(x, dist));
         for &(d, k) in &near {
             if d.is_finite() {
-                routes[nr] = (Route::Branch(k), self.branch_quality(k, dist));
-                nr += 1;
+                let q = self.branch_quality(k, dist);
+                if q > best.1 {
+                    best = (Route::Branch(k), q);
+                }
             }
         }
-        // The best route first (the first of equal ones, as the single choice
-        // was); where its path passes within rounding of another branch point
-        // (a segment planned onto a singularity), the next best: every route
-        // is exact to the target, so a fallback changes nothing but the path.
-        let routes = &mut routes[..nr];
-        routes.sort_by(|p, q| q.1.partial_cmp(&p.1).unwrap_or(std::cmp::Ordering::Equal));
-        let mut first_err = None;
-        for &(route, quality) in routes.iter() {
-            let done = match route {
-                Route::Branch(k) => {
-                    self.path_from_branch(k, x, y, Some((dist, quality)))
-                        .map(|v| {
-                            for i in 0..g {
-                                out[i] = self.u_branch[k][i] + v[i];
-                            }
-                        })
-                }
-                Route::Infinity => self
-                    .to_infinity(self.center, x, y, Some((dist, quality)))
-                    .map(|(v, lam)| {
-                        let s = if self.e.len() % 2 == 1 || lam.re > 0.0 {
-                            1.0
-                        } else {
-                            -1.0
-                        };
-                        for i in 0..g {
-                            out[i] = s * self.u_inf[i] - v[i];
-                        }
-                    }),
-            };
-            match done {
+        let first = match self.route_into(best.0, best.1, x, y, dist, &mut out) {
+            Ok(()) => return Ok(out),
+            Err(e @ Error::InvalidArgument { what: "path", .. }) => e,
+            Err(e) => return Err(e),
+        };
+        // The best route's path runs within rounding of another branch point
+        // (a segment planned onto a singularity): the others, best first.
+        // Every route is exact to the target, so a fallback changes nothing
+        // but the path.
+        let mut others = [(Route::Infinity, f64::NEG_INFINITY); ROUTE_CANDIDATES];
+        let mut no = 0;
+        if !matches!(best.0, Route::Infinity) {
+            others[no] = (Route::Infinity, self.infinity_quality(x, dist));
+            no += 1;
+        }
+        for &(d, k) in &near {
+            if d.is_finite() && !matches!(best.0, Route::Branch(b) if b == k) {
+                others[no] = (Route::Branch(k), self.branch_quality(k, dist));
+                no += 1;
+            }
+        }
+        let others = &mut others[..no];
+        others.sort_by(|p, q| q.1.partial_cmp(&p.1).unwrap_or(std::cmp::Ordering::Equal));
+        for &(route, quality) in others.iter() {
+            match self.route_into(route, quality, x, y, dist, &mut out) {
                 Ok(()) => return Ok(out),
-                Err(e @ Error::InvalidArgument { what: "path", .. }) => {
-                    first_err.get_or_insert(e);
-                }
+                Err(Error::InvalidArgument { what: "path", .. }) => {}
                 Err(e) => return Err(e),
             }
         }
-        Err(first_err.unwrap_or_else(|| Error::InvalidArgument {
-            what: "path",
-            reason: "no route to the point".into(),
-        }))
+        Err(first)
+    }
+
+    /// The Abel integral over one route (see [`Self::abel_raw`]) into `out`.
+    fn route_into(
+        &self,
+        route: Route,
+        quality: f64,
+        x: C,
+        y: C,
+        dist: &[f64],
+        out: &mut Row,
+    ) -> Result<()> {
+        let g = self.g;
+        match route {
+            Route::Branch(k) => {
+                let v = self.path_from_branch(k, x, y, Some((dist, quality)))?;
+                for i in 0..g {
+                    out[i] = self.u_branch[k][i] + v[i];
+                }
+            }
+            Route::Infinity => {
+                let (v, lam) = self.to_infinity(self.center, x, y, Some((dist, quality)))?;
+                let s = if self.e.len() % 2 == 1 || lam.re > 0.0 {
+                    1.0
+                } else {
+                    -1.0
+                };
+                for i in 0..g {
+                    out[i] = s * self.u_inf[i] - v[i];
+                }
+            }
+        }
+        Ok(())
     }
 
     /// The integral `∫_{(x0,y0)}^{(x, y)} ω` (unnormalised) along a path
