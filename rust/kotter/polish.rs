@@ -355,6 +355,13 @@ const DD_NEWTON_STEPS: usize = 6;
 const DD_CONVERGED_RTOL: f64 = 1e-20;
 /// A step below this fraction of the offset leaves nothing to gain in DD.
 const DD_STEP_RTOL: f64 = 1e-31;
+/// The first step (with the double `f'`) stands when its estimated error, the
+/// step times the relative error of that `f'`, is below this fraction of the
+/// offset: twelve digits beyond double, far more than the cancellations of
+/// (22) take near an equilibrium (a phase error of the normalisations `√F'`
+/// turns into ~1e9 times that relative error in the smallest `ξ_j`, measured
+/// at 1e-20 → 8e-10). Generic roots leave 1e-32 … 1e-30 and take one step.
+const DD_FIRST_STEP_RTOL: f64 = 1e-28;
 /// A step not below this fraction of the one before has stalled at the
 /// rounding of `f` in DD (1e-29 … 1e-27 of the offset where the terms of `f`
 /// cancel, measured), and ends the iteration. Not smaller: near a double root
@@ -433,7 +440,7 @@ fn refine_dd(lv: &Level, i: usize, t: C, sigma: C, df: C) -> Option<PolishedRoot
             // (every generic root) that is below DD resolution and the one
             // step stands, as it always did.
             let df_err = (dfc - df).modulus() / dfc.modulus();
-            if rel * df_err <= DD_STEP_RTOL || rel <= DD_STEP_RTOL {
+            if rel * df_err <= DD_FIRST_STEP_RTOL || rel <= DD_STEP_RTOL {
                 converged = true;
                 break;
             }
