@@ -278,7 +278,7 @@ fn roots_of_f(
 ) -> Result<(Vec<PolishedRoot>, Option<PairStructure>)> {
     match roots_by_route(lv, p_at_a, f) {
         Ok((roots, pair)) => {
-            if roots.iter().all(|r| r.dd_converged) && resolved_in_dd(&roots) {
+            if resolved_in_dd(&roots) {
                 return Ok((roots, pair));
             }
             match hidden_conjugate_pair(lv, p_at_a, &roots)
@@ -619,26 +619,29 @@ fn roots_by_route(
     // repeated root.
     // or, two real roots of the iterate being a conjugate pair whose imaginary
     // part the quartic did not resolve, that pair ([`conjugate_pair_from`])
-    let hidden = if z[i].im == 0.0 && z[j].im == 0.0 {
-        conjugate_pair_from(lv, p_at_a, &roots, i, j, z[i], z[j])
-    } else {
-        None
-    };
-    let resolved = if resolved_in_dd(&roots) {
-        Some(roots.clone())
-    } else {
+    // (each tried only where the routes before it failed)
+    let polished = roots.clone();
+    let resolved = || {
+        if resolved_in_dd(&polished) {
+            return Some(polished.clone());
+        }
         // The two polishes may have found the same root of f: the other root
         // of F next to it is then the root of f on the other branch of √G
         // (F = f f̃/(h1² − 4h0²), f̃ being f with −√G).
-        let mut alt = roots.clone();
-        alt[j] = polish_root(lv, p_at_a, z[j], Some(-roots[i].sigma.to_c()));
+        let mut alt = polished.clone();
+        alt[j] = polish_root(lv, p_at_a, z[j], Some(-polished[i].sigma.to_c()));
         resolved_in_dd(&alt).then_some(alt)
+    };
+    let hidden = || {
+        (z[i].im == 0.0 && z[j].im == 0.0)
+            .then(|| conjugate_pair_from(lv, p_at_a, &polished, i, j, z[i], z[j]))
+            .flatten()
     };
     pairs::branch_point_cluster(lv, p_at_a, roots, (i, j))
         .or_else(|| pairs::pair_roots(lv, p_at_a))
         .map(|(r, partner, side)| (r.into(), Some(PairStructure { partner, side })))
-        .or_else(|| resolved.map(|r| (r, None)))
-        .or_else(|| hidden.map(|r| (r, None)))
+        .or_else(|| resolved().map(|r| (r, None)))
+        .or_else(|| hidden().map(|r| (r, None)))
         .ok_or_else(|| repeated_root_error(at, i, j))
 }
 
