@@ -135,8 +135,28 @@ impl KotterCurve {
             }
         }
         let target: [Complex64; 6] = [x[0], x[1], x[2], yv[0], yv[1], yv[2]];
-        let best = self.best_branch(&target, &sc, g, (z1, zd1), (z2, zd2));
+        let cands = self.branches(&target, &sc, g, (z1, zd1), (z2, zd2));
+        let best = best_of(&cands);
         let mut b = self.refine(best, &target, &sc, lmap);
+        if b.residual.is_nan() || b.residual > rtol {
+            // Where the start is off by more than the smallest components
+            // (a point near one of two close branch points of a curve that
+            // spans 1e15 and more), several branches reproduce the large
+            // components equally well and the nearest need not be the one
+            // the polish can reach: the others are polished in turn, nearest
+            // first.
+            let mut order: Vec<&WurzelPoints> = cands.iter().collect();
+            order.sort_by(|p, q| p.residual.total_cmp(&q.residual));
+            for c in order.into_iter().filter(|c| **c != best) {
+                let next = self.refine(*c, &target, &sc, lmap);
+                if next.residual < b.residual || b.residual.is_nan() {
+                    b = next;
+                }
+                if b.residual <= rtol {
+                    break;
+                }
+            }
+        }
         b.g *= scale;
         b.residual *= scale;
         // A polish from a far start may end on the involution image of the
@@ -202,24 +222,24 @@ impl KotterCurve {
         Ok((g2, z, zd))
     }
 
-    /// Of the 32 sheets and branches (`y_i = ±` the canonical sheet, the 8
-    /// admissible `eps` with `eps_4 = +1`) the one whose `g P_kl`, `g P_j4`
-    /// are nearest the scaled data `target`.
-    fn best_branch(
+    /// The 32 sheets and branches (`y_i = ±` the canonical sheet, the 8
+    /// admissible `eps` with `eps_4 = +1`) at the start, each with the
+    /// distance of its `g P_kl`, `g P_j4` from the scaled data `target`.
+    fn branches(
         &self,
         target: &[Complex64; 6],
         sc: &[Complex64; 3],
         g: Complex64,
         (z1, zd1): (Complex64, [Complex64; 5]),
         (z2, zd2): (Complex64, [Complex64; 5]),
-    ) -> WurzelPoints {
+    ) -> [WurzelPoints; 32] {
         let canonical_y = |zd: &[Complex64; 5]| {
             zd.iter()
                 .fold(Complex64::new(1.0, 0.0), |acc, &v| acc * sqrt_principal(v))
         };
         let yc1 = canonical_y(&zd1);
         let yc2 = canonical_y(&zd2);
-        let mut best = WurzelPoints {
+        let mut all = [WurzelPoints {
             z1,
             y1: yc1,
             z2,
@@ -229,7 +249,8 @@ impl KotterCurve {
             residual: f64::INFINITY,
             zd1,
             zd2,
-        };
+        }; 32];
+        let mut n = 0;
         for s1 in [1.0, -1.0] {
             for s2 in [1.0, -1.0] {
                 let (y1, y2) = (yc1 * s1, yc2 * s2);
@@ -246,24 +267,41 @@ impl KotterCurve {
                         resid = nan_max(resid, ((target[i] - pkl) * sc[i]).norm());
                         resid = nan_max(resid, ((target[i + 3] - pj4) * sc[i]).norm());
                     }
-                    if resid < best.residual {
-                        best = WurzelPoints {
-                            z1,
-                            y1,
-                            z2,
-                            y2,
-                            g,
-                            eps: eps.map(|v| v as i8),
-                            residual: resid,
-                            zd1,
-                            zd2,
-                        };
-                    }
+                    all[n] = WurzelPoints {
+                        z1,
+                        y1,
+                        z2,
+                        y2,
+                        g,
+                        eps: eps.map(|v| v as i8),
+                        residual: resid,
+                        zd1,
+                        zd2,
+                    };
+                    n += 1;
                 }
             }
         }
-        best
+        all
     }
+}
+
+/// The candidate of [`KotterCurve::branches`] nearest the data (the first of
+/// the smallest residual; the canonical sheets with `eps = +1` if no residual
+/// is a number).
+fn best_of(cands: &[WurzelPoints; 32]) -> WurzelPoints {
+    // the first candidate is the canonical sheets with eps = +1
+    let canonical = WurzelPoints {
+        residual: f64::INFINITY,
+        ..cands[0]
+    };
+    cands.iter().fold(canonical, |best, c| {
+        if c.residual < best.residual {
+            *c
+        } else {
+            best
+        }
+    })
 }
 
 /// The polished pair if it reproduces the data to `rtol · scale` and its

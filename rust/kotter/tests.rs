@@ -934,3 +934,85 @@ fn roots_of_f_the_quartic_loses_are_found_again() {
         assert_reproduces_the_state(&st, &l);
     }
 }
+
+/// Curves spanning 1e15 and more (`d_4` ~ 1e28 … 1e30 against points ~1e2)
+/// with a point next to one of two close branch points: the start of the
+/// inverse map of (37) is off by more than the smallest components of
+/// `(ξ, η)`, several of the 32 branches fit the large ones alike, and the
+/// nearest is not the one the polish reaches; the others are polished in
+/// turn. The reduction failed ("xi, eta: no pair of points reproduces them").
+/// States of the harsh random draw of tests/data/every_state_harsh.py (seed
+/// 20261125, draws 298, 660, 1336, 2020).
+#[test]
+fn a_start_that_fits_several_branches_alike_tries_each() {
+    let cases: [([f64; 4], [f64; 6]); 4] = [
+        (
+            [
+                0.35373521244298356,
+                578.7826171486493,
+                700.002780934054,
+                707.7653058104896,
+            ],
+            [
+                0.29887536145154225,
+                -103455.3840879568,
+                0.0007447578631322591,
+                9.791359041236636e-06,
+                -933.1214715736231,
+                1.4415401951142599e-05,
+            ],
+        ),
+        (
+            [
+                -0.5755243230772489,
+                -0.5684907222283266,
+                0.03389132832985298,
+                62.652897623305314,
+            ],
+            [
+                -16976.51503023214,
+                -0.00019069229469214724,
+                1.4109113980765645e-06,
+                -0.0032610418243460234,
+                4.481961855342908e-05,
+                6196.485553037745,
+            ],
+        ),
+        (
+            [
+                -0.09595861470757727,
+                0.45747316734067967,
+                3.511327159365195,
+                7.184984594464307,
+            ],
+            [
+                280475.78799669625,
+                -1.199610658246718e-05,
+                8.699660207245205e-05,
+                0.003439229516677476,
+                5.493492449094212e-06,
+                18855.52944230415,
+            ],
+        ),
+        (
+            [
+                0.8827456971406389,
+                2.229165651799252,
+                13.55194583788183,
+                13.554532867244186,
+            ],
+            [
+                2.31457633833934e-05,
+                9005.73368271989,
+                7.817326743619633e-05,
+                0.0010858048425853428,
+                370411.0722692807,
+                0.00011015528015456114,
+            ],
+        ),
+    ];
+    for (a, l) in cases {
+        let st = kotter(&a, &l).unwrap();
+        assert_reproduces_the_state(&st, &l);
+    }
+}
