@@ -713,6 +713,54 @@ XI_ETA_BRANCH_STATES = [
     ),
 ]
 
+# Roots of F (19) in close pairs (1e-9 ... 1e-8 of the root apart) next to
+# a_i ~ a_j: the quartic's iterates are off by more than the separation, and
+# Newton's method on f from there does not converge in double-double; each pair
+# is split about its centre (f' = 0). The earlier code refused each as "F(s)
+# (19) has a repeated root". Draws 1610, 2991, 3329 of every_state_harsh.py
+# (seed 20261125).
+CLOSE_PAIR_STATES = [
+    (
+        [0.5079344065020241, 8.015248318569185, 8.016520326726225, 8.019156301414943],
+        [-0.07863720785623629, -0.05828106551490426, -0.05667798921801885, 5.031955315846943],
+        [
+            0.0791401202579148,
+            -35.27079917415693,
+            -121572.71821492231,
+            366.1540184266514,
+            -2.713347715452463,
+            3.789038397424228e-06,
+        ],
+        4.260912094266089e-06,
+    ),
+    (
+        [0.7714529084283865, 78.57423513721652, 78.9694884940369, 78.97211378934028],
+        [0.15416112703357565, 130.3937942370338, 131.01437828487357, -79.5871349092146],
+        [
+            1.7414177584327468e-05,
+            -1162.27789999505,
+            0.0038506202274633267,
+            -1.632114043348959e-05,
+            150.05531822724757,
+            0.0004844446426445424,
+        ],
+        1.0636728159412926e-05,
+    ),
+    (
+        [-0.7911831761588897, 221.95488500101757, 222.00476288372718, 222.136752263782],
+        [-0.02373605012473412, -0.03012534400400084, -587.9486418138757, -587.9469674170066],
+        [
+            -7550.178149608005,
+            -0.08670732197111754,
+            -0.21750901033914172,
+            -0.0004536074519602519,
+            0.004665604729971405,
+            -444.36441185603763,
+        ],
+        1.1217144896891489e-05,
+    ),
+]
+
 @pytest.mark.parametrize(
     "case",
     CLUSTER_STATES
@@ -721,7 +769,8 @@ XI_ETA_BRANCH_STATES = [
     + PINCHED_FIT_STATES
     + SLOW_STATES
     + DD_ROOT_STATES
-    + XI_ETA_BRANCH_STATES,
+    + XI_ETA_BRANCH_STATES
+    + CLOSE_PAIR_STATES,
 )
 def test_roots_of_f_clustered_at_a_branch_point_are_solved(case) -> None:
     """Solved to HARSH_BOUND against the long-double reference over the harsh

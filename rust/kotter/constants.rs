@@ -5,7 +5,7 @@
 //! carried in double-double and rounded once (docs/kotter.md §3).
 
 use super::pairs::{self, PAIR_ROUTE_RTOL};
-use super::polish::{polish_root, Level, PolishedRoot};
+use super::polish::{polish_root, split_pair, Level, PolishedRoot};
 use super::roots::{
     check_converged, documented_order, quartic_f_den, quartic_roots_unordered, repeated_pair,
     repeated_root_error,
@@ -357,28 +357,46 @@ fn root_census(
             found.push(r);
         }
     };
+    // an imaginary part below DD resolution (left by a start off the axis)
+    // is a real root
+    let take = |mut r: PolishedRoot, found: &mut Vec<PolishedRoot>| {
+        if r.s.im != 0.0 && r.s.im.abs() <= 1e-30 * r.s.modulus() {
+            r.s.im = 0.0;
+            for xm in &mut r.x {
+                xm.im = Dd::ZERO;
+            }
+        }
+        if r.s.im != 0.0 {
+            let rc = r.conj();
+            add(r, found);
+            add(rc, found);
+        } else {
+            add(r, found);
+        }
+    };
     for &s0 in &seeds {
         let g0 = sqrt_principal(lv.a.iter().map(|&am| s0 - am).product());
         for branch in [g0, -g0] {
             if g0 == ZERO {
                 continue;
             }
-            let mut r = polish_root(lv, p_at_a, s0, Some(branch));
-            // an imaginary part below DD resolution (left by a start off the
-            // axis) is a real root
-            if r.s.im != 0.0 && r.s.im.abs() <= 1e-30 * r.s.modulus() {
-                r.s.im = 0.0;
-                for xm in &mut r.x {
-                    xm.im = Dd::ZERO;
+            let r = polish_root(lv, p_at_a, s0, Some(branch));
+            if !r.dd_converged {
+                // two roots of this branch closer than the seed: split the
+                // pair about its centre (from where the polish stopped, which
+                // is nearer it than the seed)
+                let from = if r.s.re.is_finite() && r.s.im.is_finite() {
+                    r.s
+                } else {
+                    s0
+                };
+                if let Some(pair) = split_pair(lv, from, branch) {
+                    for q in pair {
+                        take(q, &mut found);
+                    }
                 }
             }
-            if r.s.im != 0.0 {
-                let rc = r.conj();
-                add(r, &mut found);
-                add(rc, &mut found);
-            } else {
-                add(r, &mut found);
-            }
+            take(r, &mut found);
         }
         if found.len() > 4 {
             return None;

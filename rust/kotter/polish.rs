@@ -391,7 +391,14 @@ const DD_STALL_RATIO: f64 = 0.9;
 /// the small components, and no pair of points on the curve reproduced them
 /// (states near `l_ij E_ij + l_kl E_kl`, docs/degenerate.md §11).
 fn refine_dd(lv: &Level, i: usize, t: C, sigma: C, df: C) -> Option<PolishedRoot> {
-    let (h0, den) = match lv.mn {
+    let (h0, den) = h0_den_dd(lv);
+    refine_dd_with(lv, h0, den, i, Cdd::new(t), sigma, df)
+}
+
+/// `h0` and `h1² − 4h0²` in DD: from the state's `m, n` where given
+/// (`h1² − 4h0² = |m − n|² |m + n|²`, no cancellation), else from `h`.
+fn h0_den_dd(lv: &Level) -> (Dd, Dd) {
+    match lv.mn {
         Some((m, n)) => {
             let mut h0 = Dd::ZERO;
             let (mut dm, mut dp) = (Dd::ZERO, Dd::ZERO);
@@ -410,10 +417,22 @@ fn refine_dd(lv: &Level, i: usize, t: C, sigma: C, df: C) -> Option<PolishedRoot
                 Dd::prod(h1, h1).sub(Dd::prod(h0, h0).mul_f64(4.0)),
             )
         }
-    };
+    }
+}
+
+/// [`refine_dd`] from a start `t` given in DD.
+fn refine_dd_with(
+    lv: &Level,
+    h0: Dd,
+    den: Dd,
+    i: usize,
+    t: Cdd,
+    sigma: C,
+    df: C,
+) -> Option<PolishedRoot> {
     // Newton's method in DD: the first step with the double f', then with the
     // DD f'.
-    let mut t_dd = Cdd::new(t);
+    let mut t_dd = t;
     let mut dfc = df;
     let (mut x, mut sg) = offsets_dd(lv.a, i, t_dd, sigma);
     let mut dfd = df_dd(lv, h0, &x, sg);
@@ -547,4 +566,63 @@ fn df_dd(lv: &Level, h0: Dd, x: &[Cdd; 4], sg: Cdd) -> Cdd {
     let (a, b) = (x[0].mul(x[1]), x[2].mul(x[3]));
     let dg = x[0].add(x[1]).mul(b).add(a.mul(x[2].add(x[3])));
     dp_dd(lv, x).add(dg.mul_dd(h0).div(sg))
+}
+
+/// Newton steps on `f'` for the centre of a close pair ([`split_pair`]).
+const PAIR_CENTRE_STEPS: usize = 12;
+
+/// Step of the central difference of `f'` (relative to the offset `t`) that
+/// gives `f''` for [`split_pair`]: `f'` in DD keeps ~1e-30 of its terms, so
+/// 1e-9 leaves `f''` good to ~1e-21, and the pairs it is for are 1e-10 … 1e-6
+/// of the offset apart, so the difference stays inside the pair's disc.
+const PAIR_FD_RTOL: f64 = 1e-9;
+
+/// Two roots of `f` on the branch `√G ≈ branch` that lie closer together than
+/// the quartic resolves, from a seed `s0` next to them: the centre `c` of the
+/// pair (`f'(c) = 0`, Newton's method on `f'` in DD, `f''` by a central
+/// difference of the DD `f'`), the roots `c ± √(−2 f(c)/f''(c))` of the local
+/// quadratic, each then polished by Newton's method in DD. From a seed farther
+/// than the pair's separation Newton's method on `f` itself creeps like on a
+/// double root (its steps halve), and six DD steps do not converge. `None`
+/// unless both roots converge in DD.
+pub(super) fn split_pair(lv: &Level, s0: C, branch: C) -> Option<[PolishedRoot; 2]> {
+    let a = lv.a;
+    let i = (1..4).fold(0, |b, m| {
+        if (s0 - a[m]).modulus() < (s0 - a[b]).modulus() {
+            m
+        } else {
+            b
+        }
+    });
+    let (h0, den) = h0_den_dd(lv);
+    let df_at = |t: Cdd| {
+        let (x, sg) = offsets_dd(a, i, t, branch);
+        df_dd(lv, h0, &x, sg)
+    };
+    let finite = |v: C| v.re.is_finite() && v.im.is_finite();
+    let mut t = Cdd::new(s0 - a[i]);
+    let mut d2 = C::new(f64::NAN, 0.0);
+    for _ in 0..PAIR_CENTRE_STEPS {
+        let h = PAIR_FD_RTOL * t.to_c().modulus();
+        if !(h > 0.0 && h.is_finite()) {
+            return None;
+        }
+        let dh = Cdd::new(C::new(h, 0.0));
+        d2 = df_at(t.add(dh)).sub(df_at(t.sub(dh))).to_c() / (2.0 * h);
+        let step = df_at(t).to_c() / d2;
+        if !finite(step) {
+            return None;
+        }
+        t = t.sub(Cdd::new(step));
+        if step.modulus() <= DD_STEP_RTOL * t.to_c().modulus() {
+            break;
+        }
+    }
+    let (x, sg) = offsets_dd(a, i, t, branch);
+    let u = f_dd(lv, h0, &x, sg).mul_f64(-2.0).div(Cdd::new(d2)).sqrt();
+    let root = |t: Cdd| -> Option<PolishedRoot> {
+        let r = refine_dd_with(lv, h0, den, i, t, branch, df_at(t).to_c())?;
+        r.dd_converged.then_some(r)
+    };
+    Some([root(t.add(u))?, root(t.sub(u))?])
 }

@@ -1016,3 +1016,73 @@ fn a_start_that_fits_several_branches_alike_tries_each() {
         assert_reproduces_the_state(&st, &l);
     }
 }
+
+/// A conjugate pair and a real pair of roots of `F`, the real pair 5e-9 and
+/// 1.5e-8 of the root apart, next to `a_3 ≈ a_4` (near an equilibrium
+/// `l_ij E_ij + l_kl E_kl`): the quartic's iterates are off by more than the
+/// pair's separation, Newton's method on `f` from there creeps as on a double root and did
+/// not converge in DD, and the state was refused as "F(s) (19) has a repeated
+/// root". Each pair is now split about its centre (`f' = 0`) by the local
+/// quadratic and polished in DD; the roots agree with a 60-digit mpmath
+/// reduction (tests/data/kotter_mpmath_state.py). States of the harsh random
+/// draw of tests/data/every_state_harsh.py (seed 20261125, draws 2991, 1376).
+#[test]
+fn roots_of_f_in_close_pairs_are_split_about_their_centre() {
+    let cases: [([f64; 4], [f64; 6], [C; 3]); 2] = [
+        (
+            [
+                0.7714529084283865,
+                78.57423513721652,
+                78.9694884940369,
+                78.97211378934028,
+            ],
+            [
+                1.7414177584327468e-05,
+                -1162.27789999505,
+                0.0038506202274633267,
+                -1.632114043348959e-05,
+                150.05531822724757,
+                0.0004844446426445424,
+            ],
+            [
+                C::new(79.8968392932, 1.3793871248e-5),
+                C::new(78.968350775, 0.0),
+                C::new(78.9683503848, 0.0),
+            ],
+        ),
+        (
+            [
+                0.5026187222972605,
+                463.4039102885333,
+                464.1410137246508,
+                464.1703796694803,
+            ],
+            [
+                355469.4275589352,
+                -2.0269353086185666,
+                -5.394293805473568,
+                0.16740305852890275,
+                8.909014192931055e-05,
+                -561.2809667766602,
+            ],
+            [
+                C::new(464.18921459, 1.56267198435e-6),
+                C::new(464.123340202, 0.0),
+                C::new(464.123333113, 0.0),
+            ],
+        ),
+    ];
+    for (a, l, mp) in cases {
+        let st = kotter(&a, &l).unwrap();
+        let s = st.constants.s;
+        // the mpmath roots are quoted to 12 digits
+        for (p, r) in [(0, mp[0]), (1, mp[0].conj()), (2, mp[1]), (3, mp[2])] {
+            assert!((s[p] - r).norm() <= 1e-9 * r.norm(), "{s:?}");
+            assert!(
+                (s[p].im - r.im).abs() <= 1e-3 * r.im.abs().max(1e-300),
+                "{s:?}"
+            );
+        }
+        assert_reproduces_the_state(&st, &l);
+    }
+}
