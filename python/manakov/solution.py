@@ -278,8 +278,13 @@ class Solution:
         ClosedFormError
             A genus-2 solution whose drift defect ``δ`` (:attr:`drift_defect`)
             is above rounding (1e-12), at a ``t`` where the drift
-            ``δ |t| |dl/dt| / |l0|`` of its phase exceeds 5e-11: the closed form
-            cannot vouch for ``l(t)`` there (integrate instead). Any kind
+            ``δ |t| |dl/dt| / |l0|`` of its phase may exceed 5e-11 and an
+            integration of (1) from ``l0`` (Gauss–Legendre order 16 at its
+            default step) does not certify it: it differs from the closed form by
+            more than 5e-11 ``|l0|``, or would take more than 2e6 steps. Where it
+            certifies ``l(t)`` the closed form's values are returned (the first
+            such call integrates; later calls within the certified ``|t|`` do
+            not). Any kind
             with a moving phase, beyond its phase horizon: where the rounding
             of the velocity alone (4 ulp) moves ``l(t)`` by more than 1e-6
             ``|l0|`` (e.g. ``|t| ~ 1e12`` on a top and state of unit size),

@@ -60,6 +60,7 @@ pub mod normalize;
 mod setup;
 pub mod transverse;
 pub mod velocity;
+pub mod verify;
 
 pub use check::{
     DRIFT_DEFECT_FLOOR, DRIFT_RTOL, HORIZON_RTOL, PHASE_ROUNDING_RTOL, SELF_CHECK_RTOL,
@@ -175,6 +176,10 @@ pub struct Solution {
     /// `4 max|c_ij| |l0|²`, a bound of `|l̇|` by (1) for the phase horizon
     /// (`‖[L, Ω]‖_F ≤ 2 ‖L‖_F ‖Ω‖_F`, `‖Ω‖_F ≤ max|c_ij| ‖L‖_F`, `‖L‖_F² = 2|l|²`).
     speed_bound: f64,
+    /// The largest `|t|` for `t < 0` and for `t > 0` up to which an
+    /// integration of (1) has certified `l(t)` where the drift check could
+    /// not ([`verify`]).
+    certified: std::sync::Mutex<[f64; 2]>,
 }
 
 fn singular(kind: SingularKind, reason: String) -> Error {
@@ -319,6 +324,7 @@ impl Solution {
             speed_bound: 4.0
                 * c4.iter().fold(0.0f64, |m, v| m.max(v.abs()))
                 * l0.iter().map(|x| x * x).sum::<f64>(),
+            certified: std::sync::Mutex::new([0.0; 2]),
         })
     }
 
@@ -655,14 +661,75 @@ impl Solution {
         }
     }
 
-    fn eval_serial(&self, t: &[f64], out: &mut [f64]) -> Result<()> {
+    /// The rows `l(t_k)` without the drift check.
+    fn eval_rows(&self, t: &[f64], out: &mut [f64]) -> Result<()> {
         self.plan.eval_selected_g2_lattice_lanes(
             t.len(),
             |first, m, lanes| self.lattice_lanes(&t[first..first + m], lanes),
             &self.idx,
             |first, blk| self.combine(blk, &mut out[6 * first..6 * (first + blk.len)]),
-        )?;
+        )
+    }
+
+    fn eval_serial(&self, t: &[f64], out: &mut [f64]) -> Result<()> {
+        self.eval_rows(t, out)?;
         self.check_drift(t, out)
+    }
+
+    /// Whether the drift check applies its bound [`DRIFT_RTOL`] (the defect
+    /// above [`DRIFT_DEFECT_FLOOR`]).
+    fn gated(&self) -> bool {
+        self.drift_defect > DRIFT_DEFECT_FLOOR
+    }
+
+    /// The drift check of a gated solution ([`Solution::check_drift`]) with
+    /// the certificate of [`verify`]: the times where the drift estimate
+    /// exceeds [`DRIFT_RTOL`] beyond what is already certified are checked
+    /// against an integration of (1), once per direction of time, and pass
+    /// where the two agree to [`verify::VERIFY_RTOL`].
+    fn check_drift_certified(&self, t: &[f64], out: &[f64], cancel: &Cancel) -> Result<()> {
+        let certified = *self.certified.lock().unwrap_or_else(|e| e.into_inner());
+        let side = |t: f64| usize::from(t > 0.0);
+        let delta = self.drift_defect;
+        let mut failing: [Vec<f64>; 2] = [Vec::new(), Vec::new()];
+        let mut reason = None;
+        for (&tk, lk) in t.iter().zip(out.chunks_exact(6)) {
+            let l: &[f64; 6] = lk.try_into().expect("rows of 6");
+            let f = so4::vector_field4(&self.c4, l);
+            let speed = f.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+            let drift = delta * tk.abs() * speed / self.size;
+            if drift > DRIFT_RTOL && tk.abs() > certified[side(tk)] {
+                failing[side(tk)].push(tk);
+                reason.get_or_insert_with(|| drift_reason(tk, self.drift_defect, drift));
+            }
+        }
+        let Some(reason) = reason else {
+            return Ok(());
+        };
+        for (s, times) in failing.iter().enumerate() {
+            if times.is_empty() {
+                continue;
+            }
+            let sign = if s == 1 { 1.0 } else { -1.0 };
+            let outcome = verify::certify(
+                &self.c4,
+                &self.l0,
+                self.size,
+                sign,
+                times,
+                |ts, o| self.eval_rows(ts, o),
+                cancel,
+            )?;
+            match outcome {
+                verify::Outcome::Agree => {
+                    let reach = times.iter().fold(0.0f64, |m, t| m.max(t.abs()));
+                    let mut c = self.certified.lock().unwrap_or_else(|e| e.into_inner());
+                    c[s] = c[s].max(reach);
+                }
+                other => return Err(verify::refusal(reason, &other)),
+            }
+        }
+        Ok(())
     }
 
     /// Refuses `l(t)` where the relative defect `δ` the self-check leaves
@@ -698,12 +765,7 @@ impl Solution {
             if gated && drift > DRIFT_RTOL {
                 return Err(Error::Unverified {
                     what: "l(t)",
-                    reason: format!(
-                        "at t = {tk:e} the relative defect {:e} left by the self-check may \
-                         move l(t) by {drift:e} |l0| > {DRIFT_RTOL:e} (the drift \
-                         delta |t| |dl/dt| of the phase); evaluate nearer t = 0",
-                        self.drift_defect
-                    ),
+                    reason: drift_reason(tk, self.drift_defect, drift),
                 });
             }
         }
@@ -723,6 +785,12 @@ impl Solution {
             });
         }
         crate::error::check_finite("t", t)?;
+        if self.gated() {
+            rows_in_parallel(t, out, cancel, CHUNK, PAR_PIECE, |tp, op| {
+                self.eval_rows(tp, op)
+            })?;
+            return self.check_drift_certified(t, out, cancel);
+        }
         rows_in_parallel(t, out, cancel, CHUNK, PAR_PIECE, |tp, op| {
             self.eval_serial(tp, op)
         })
@@ -739,9 +807,17 @@ impl Solution {
             });
         }
         crate::error::check_finite("t", t)?;
+        let gated = self.gated();
         for (tc, oc) in t.chunks(CHUNK).zip(out.chunks_mut(6 * CHUNK)) {
             cancel.check()?;
-            self.eval_serial(tc, oc)?;
+            if gated {
+                self.eval_rows(tc, oc)?;
+            } else {
+                self.eval_serial(tc, oc)?;
+            }
+        }
+        if gated {
+            return self.check_drift_certified(t, out, cancel);
         }
         Ok(())
     }
@@ -752,6 +828,15 @@ impl Solution {
         self.l_batch(&[t], &mut out, &Cancel::never())?;
         Ok(out)
     }
+}
+
+/// The drift check's reason for refusing `l(t)` at `t`.
+fn drift_reason(t: f64, defect: f64, drift: f64) -> String {
+    format!(
+        "at t = {t:e} the relative defect {defect:e} left by the self-check may \
+         move l(t) by {drift:e} |l0| > {DRIFT_RTOL:e} (the drift \
+         delta |t| |dl/dt| of the phase); evaluate nearer t = 0"
+    )
 }
 
 #[cfg(test)]

@@ -1,0 +1,142 @@
+//! The certificate of `l(t)` by an independent integration where the drift
+//! check cannot vouch for the phase.
+//!
+//! The drift check bounds the error the self-check's relative defect `δ` may
+//! cause, `δ |t| |l̇(t)|` ([`super::check::DRIFT_RTOL`]). The bound is a
+//! worst case: on a harsh random draw of 10⁴ states it refused 352 solutions,
+//! of which 338 were within the accuracy bound over their whole window
+//! against a long-double reference (docs/degenerate.md). No check at a few
+//! points of the torus can tell those from the 14 that did drift: a drift of
+//! the phase is a global property of the motion. An integration of Frahm's
+//! equations (1) over the same times is: where the closed form and Gauss–Legendre
+//! order 16 at its default step agree to [`VERIFY_RTOL`] `|l0|` at every sample,
+//! both are accurate to about that (they share no step of their computation),
+//! and the closed form's values are returned. Where they disagree, or the
+//! integration would exceed [`VERIFY_MAX_STEPS`], `l(t)` is refused as before.
+
+use crate::error::{Error, Result};
+use crate::integrate::{integrate_with, Method, Options};
+use crate::numeric::cancel::Cancel;
+use crate::so4::FrahmTop;
+
+/// Largest disagreement `max_k |l(t_k) − l_int(t_k)| / |l0|` between the closed
+/// form and the integration that certifies `l(t)`: the bound the drift check
+/// holds the solution to ([`super::check::DRIFT_RTOL`]).
+pub const VERIFY_RTOL: f64 = super::check::DRIFT_RTOL;
+
+/// Most steps the certifying integration may take per direction of time
+/// (Gauss–Legendre order 16 on so(4): ~1 µs a step, so ~2 s); beyond it
+/// `l(t)` is refused with the drift check's reason.
+pub const VERIFY_MAX_STEPS: f64 = 2e6;
+
+/// Samples of the certifying integration on `(0, T]` besides the requested
+/// times: the error of a phase drift grows with `|t|`, and a grid sees it
+/// between requested times too.
+const VERIFY_GRID: usize = 64;
+
+/// The default step of Gauss–Legendre order 16 for this top and state,
+/// `1/((max c − min c) |l0|)` (as `FrahmTop.default_dt`, `DT_SCALE = 1`).
+fn default_dt(c4: &[f64; 6], size: f64) -> f64 {
+    let (lo, hi) = c4
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &c| {
+            (lo.min(c), hi.max(c))
+        });
+    1.0 / ((hi - lo) * size)
+}
+
+/// The top with coefficients `sign · c4` (the time-reversed flow for
+/// `sign = −1`: (1) is linear in `c`).
+fn top(c4: &[f64; 6], sign: f64) -> Result<FrahmTop> {
+    let mut c = [0.0; 16];
+    let pairs = [(0, 1), (0, 2), (0, 3), (1, 2), (1, 3), (2, 3)];
+    for (q, &(i, j)) in pairs.iter().enumerate() {
+        c[4 * i + j] = sign * c4[q];
+        c[4 * j + i] = sign * c4[q];
+    }
+    FrahmTop::new(4, &c)
+}
+
+/// What a certifying integration found on `[0, T]` (one direction of time).
+pub(super) enum Outcome {
+    /// Closed form and integration agree to [`VERIFY_RTOL`] `|l0|`.
+    Agree,
+    /// They disagree by this much (relative to `|l0|`), at this time.
+    Disagree(f64, f64),
+    /// The integration would take this many steps (over [`VERIFY_MAX_STEPS`]).
+    OverBudget(f64),
+}
+
+/// Integrates (1) from `l0` over `|times|` (all of one sign, `T` the largest
+/// modulus) and the grid of [`VERIFY_GRID`] points on `(0, T]`, and compares
+/// with `closed` at the same times.
+pub(super) fn certify(
+    c4: &[f64; 6],
+    l0: &[f64; 6],
+    size: f64,
+    sign: f64,
+    times: &[f64],
+    closed: impl Fn(&[f64], &mut [f64]) -> Result<()>,
+    cancel: &Cancel,
+) -> Result<Outcome> {
+    let t_end = times.iter().fold(0.0f64, |m, t| m.max(t.abs()));
+    if t_end == 0.0 {
+        return Ok(Outcome::Agree);
+    }
+    let dt = default_dt(c4, size);
+    let steps = t_end / dt;
+    if steps.is_nan() || steps > VERIFY_MAX_STEPS {
+        return Ok(Outcome::OverBudget(steps));
+    }
+    let mut s: Vec<f64> = times.iter().map(|t| t.abs()).collect();
+    s.extend((1..=VERIFY_GRID).map(|k| t_end * k as f64 / VERIFY_GRID as f64));
+    s.sort_by(f64::total_cmp);
+    s.dedup();
+    let opts = Options {
+        method: Method::Gauss16,
+        dt,
+        rtol: 0.0,
+        atol: 0.0,
+        max_steps: (steps.ceil() as u64).saturating_add(s.len() as u64 + 16),
+    };
+    let tr = integrate_with(&top(c4, sign)?, l0, 0.0, &s, &opts, cancel)?;
+    let signed: Vec<f64> = s.iter().map(|t| sign * t).collect();
+    let mut out = vec![0.0; 6 * signed.len()];
+    closed(&signed, &mut out)?;
+    let mut worst = (0.0f64, 0.0f64);
+    for (k, (a, b)) in out.chunks_exact(6).zip(tr.y.chunks_exact(6)).enumerate() {
+        let d = a
+            .iter()
+            .zip(b)
+            .fold(0.0f64, |m, (x, y)| m.max((x - y).abs()))
+            / size;
+        if d.is_nan() || d > worst.0 {
+            worst = (if d.is_nan() { f64::INFINITY } else { d }, signed[k]);
+        }
+    }
+    Ok(if worst.0 <= VERIFY_RTOL {
+        Outcome::Agree
+    } else {
+        Outcome::Disagree(worst.0, worst.1)
+    })
+}
+
+/// The refusal of `l(t)` where the certificate failed: the drift check's
+/// reason and what the integration found.
+pub(super) fn refusal(reason: String, outcome: &Outcome) -> Error {
+    let found = match outcome {
+        Outcome::Agree => String::new(),
+        Outcome::Disagree(d, t) => format!(
+            "; an integration of (1) (Gauss-Legendre order 16) differs from it by \
+             {d:.1e} |l0| at t = {t:e}"
+        ),
+        Outcome::OverBudget(steps) => format!(
+            "; an integration of (1) to certify it would take {steps:.1e} steps \
+             (more than {VERIFY_MAX_STEPS:e})"
+        ),
+    };
+    Error::Unverified {
+        what: "l(t)",
+        reason: format!("{reason}{found}"),
+    }
+}
