@@ -311,6 +311,16 @@ impl Motion {
                 // The generic path, unchanged.
                 return sol.l_batch(t, out, cancel);
             }
+            // In the normalized frame: the same rows as chunk by chunk, with a
+            // certifying integration (where the drift check needs one) run once
+            // over all the times and interruptible.
+            let ts: Vec<f64> = t.iter().map(|&x| self.time_scale * x).collect();
+            crate::error::check_finite("t x time scale", &ts)?;
+            sol.l_batch(&ts, out, cancel)?;
+            if self.scale != 1.0 {
+                out.iter_mut().for_each(|v| *v *= self.scale);
+            }
+            return Ok(());
         }
         rows_in_parallel(t, out, cancel, CHUNK, PAR_PIECE, |tp, op| {
             self.eval_serial(tp, op)
