@@ -135,8 +135,19 @@ impl KotterCurve {
             }
         }
         let target: [Complex64; 6] = [x[0], x[1], x[2], yv[0], yv[1], yv[2]];
-        let cands = self.branches(&target, &sc, g, (z1, zd1), (z2, zd2));
-        let best = best_of(&cands);
+        let start = ((z1, zd1), (z2, zd2));
+        let mut best: Option<WurzelPoints> = None;
+        self.for_each_branch(&target, &sc, g, start, |c| {
+            // the first candidate is the canonical sheets with eps = +1
+            let cur = best.get_or_insert(WurzelPoints {
+                residual: f64::INFINITY,
+                ..c
+            });
+            if c.residual < cur.residual {
+                *cur = c;
+            }
+        });
+        let best = best.expect("32 candidates");
         let mut b = self.refine(best, &target, &sc, lmap);
         if b.residual.is_nan() || b.residual > rtol {
             // Where the start is off by more than the smallest components
@@ -145,10 +156,11 @@ impl KotterCurve {
             // components equally well and the nearest need not be the one
             // the polish can reach: the others are polished in turn, nearest
             // first.
-            let mut order: Vec<&WurzelPoints> = cands.iter().collect();
+            let mut order: Vec<WurzelPoints> = Vec::with_capacity(32);
+            self.for_each_branch(&target, &sc, g, start, |c| order.push(c));
             order.sort_by(|p, q| p.residual.total_cmp(&q.residual));
-            for c in order.into_iter().filter(|c| **c != best) {
-                let next = self.refine(*c, &target, &sc, lmap);
+            for c in order.into_iter().filter(|c| *c != best) {
+                let next = self.refine(c, &target, &sc, lmap);
                 if next.residual < b.residual || b.residual.is_nan() {
                     b = next;
                 }
@@ -222,35 +234,24 @@ impl KotterCurve {
         Ok((g2, z, zd))
     }
 
-    /// The 32 sheets and branches (`y_i = ±` the canonical sheet, the 8
-    /// admissible `eps` with `eps_4 = +1`) at the start, each with the
-    /// distance of its `g P_kl`, `g P_j4` from the scaled data `target`.
-    fn branches(
+    /// Each of the 32 sheets and branches (`y_i = ±` the canonical sheet, the 8
+    /// admissible `eps` with `eps_4 = +1`) at the start, with the distance of
+    /// its `g P_kl`, `g P_j4` from the scaled data `target`, handed to `each`
+    /// in a fixed order (the canonical sheets with `eps = +1` first).
+    fn for_each_branch(
         &self,
         target: &[Complex64; 6],
         sc: &[Complex64; 3],
         g: Complex64,
-        (z1, zd1): (Complex64, [Complex64; 5]),
-        (z2, zd2): (Complex64, [Complex64; 5]),
-    ) -> [WurzelPoints; 32] {
+        ((z1, zd1), (z2, zd2)): ((Complex64, [Complex64; 5]), (Complex64, [Complex64; 5])),
+        mut each: impl FnMut(WurzelPoints),
+    ) {
         let canonical_y = |zd: &[Complex64; 5]| {
             zd.iter()
                 .fold(Complex64::new(1.0, 0.0), |acc, &v| acc * sqrt_principal(v))
         };
         let yc1 = canonical_y(&zd1);
         let yc2 = canonical_y(&zd2);
-        let mut all = [WurzelPoints {
-            z1,
-            y1: yc1,
-            z2,
-            y2: yc2,
-            g,
-            eps: [1; 5],
-            residual: f64::INFINITY,
-            zd1,
-            zd2,
-        }; 32];
-        let mut n = 0;
         for s1 in [1.0, -1.0] {
             for s2 in [1.0, -1.0] {
                 let (y1, y2) = (yc1 * s1, yc2 * s2);
@@ -267,7 +268,7 @@ impl KotterCurve {
                         resid = nan_max(resid, ((target[i] - pkl) * sc[i]).norm());
                         resid = nan_max(resid, ((target[i + 3] - pj4) * sc[i]).norm());
                     }
-                    all[n] = WurzelPoints {
+                    each(WurzelPoints {
                         z1,
                         y1,
                         z2,
@@ -277,31 +278,11 @@ impl KotterCurve {
                         residual: resid,
                         zd1,
                         zd2,
-                    };
-                    n += 1;
+                    });
                 }
             }
         }
-        all
     }
-}
-
-/// The candidate of [`KotterCurve::branches`] nearest the data (the first of
-/// the smallest residual; the canonical sheets with `eps = +1` if no residual
-/// is a number).
-fn best_of(cands: &[WurzelPoints; 32]) -> WurzelPoints {
-    // the first candidate is the canonical sheets with eps = +1
-    let canonical = WurzelPoints {
-        residual: f64::INFINITY,
-        ..cands[0]
-    };
-    cands.iter().fold(canonical, |best, c| {
-        if c.residual < best.residual {
-            *c
-        } else {
-            best
-        }
-    })
 }
 
 /// The polished pair if it reproduces the data to `rtol · scale` and its
