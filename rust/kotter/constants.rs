@@ -307,7 +307,9 @@ fn roots_of_f(
 /// quartic's iterate, the roots given, and for each seed near the real axis
 /// the non-real seeds `Re z ± i δ` and the real ones `Re z ± |Im z|`, `δ` the
 /// distance to the nearest other seed) is polished on each branch of `√G`
-/// (a root of `F = f f̃/(h1² − 4h0²)` is a root of `f` on one of them), the
+/// (a root of `F = f f̃/(h1² − 4h0²)` is a root of `f` on one of them; where
+/// the polish does not converge, the two roots of that branch closer than the
+/// seed are split about their centre, [`split_pair`]), the
 /// polishes that converged in DD are merged within [`DD_DISTINCT_RTOL`], and
 /// the conjugate of each non-real root added. Exactly four distinct roots,
 /// each converged, are the result, in the documented order; anything else

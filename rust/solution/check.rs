@@ -72,7 +72,8 @@ pub(super) fn drift_defect(d: &Defect, closed: bool) -> f64 {
 }
 
 /// Largest first-order drift `δ |t| |l̇(t)| / |l0|` of `l(t)` that
-/// [`super::Solution::l_batch`] returns, `δ` the relative defect the
+/// [`super::Solution::l_batch`] returns without the certificate of an
+/// integration of (1) ([`super::verify`]), `δ` the relative defect the
 /// self-check leaves ([`drift_defect`]; before the self-check had two parts,
 /// its single defect, to which the measurements below refer). A relative
 /// error `δ` of `U` evaluates `l` at the phase of time `(1 + δ) t`; a defect `δ` of `l(0)` or of the

@@ -682,11 +682,12 @@ impl Solution {
         self.drift_defect > DRIFT_DEFECT_FLOOR
     }
 
-    /// The drift check of a gated solution ([`Solution::check_drift`]) with
-    /// the certificate of [`verify`]: the times where the drift estimate
-    /// exceeds [`DRIFT_RTOL`] beyond what is already certified are checked
-    /// against an integration of (1), once per direction of time, and pass
-    /// where the two agree to [`verify::VERIFY_RTOL`].
+    /// The drift check of a solution whose defect `δ` ([`Solution::drift_defect`])
+    /// is above rounding ([`DRIFT_DEFECT_FLOOR`]): where the first-order drift
+    /// `δ |t| |l̇(t)|` may exceed [`DRIFT_RTOL`] `|l0|` (and `|t|` is beyond
+    /// what is already certified), an integration of (1), once per direction
+    /// of time, certifies `l(t)` where the two agree to
+    /// [`verify::VERIFY_RTOL`] ([`verify`]); else `l(t)` is refused.
     fn check_drift_certified(&self, t: &[f64], out: &[f64], cancel: &Cancel) -> Result<()> {
         let certified = *self.certified.lock().unwrap_or_else(|e| e.into_inner());
         let side = |t: f64| usize::from(t > 0.0);
@@ -732,26 +733,21 @@ impl Solution {
         Ok(())
     }
 
-    /// Refuses `l(t)` where the relative defect `δ` the self-check leaves
-    /// ([`Solution::drift_defect`]) may
-    /// have moved it by more than [`DRIFT_RTOL`] `|l0|`: the first-order drift
-    /// `δ |t| |l̇(t)|`, `l̇` Frahm's (1) at the computed `l(t)`; not where `δ`
-    /// is at rounding level ([`DRIFT_DEFECT_FLOOR`]). Beyond the phase horizon
-    /// every solution refuses: where even a rounding-level `δ`
-    /// (`max(δ, PHASE_ROUNDING_RTOL)`) drifts `l(t)` by more than
-    /// [`HORIZON_RTOL`] `|l0|`, the phase `U t` is no longer determined by the
-    /// double `U` (at `|U t| ~ 1e16` not even its integer part is), and the
-    /// value would be arbitrary.
+    /// The phase horizon of a solution whose defect `δ` is at rounding level
+    /// ([`DRIFT_DEFECT_FLOOR`]; above it [`Solution::check_drift_certified`]
+    /// applies the drift check's bound [`DRIFT_RTOL`]): `l(t)` is refused where
+    /// even a rounding-level `δ` (`max(δ, PHASE_ROUNDING_RTOL)`) drifts it by
+    /// more than [`HORIZON_RTOL`] `|l0|` — the first-order drift `δ |t| |l̇(t)|`,
+    /// `l̇` Frahm's (1) at the computed `l(t)` — where the phase `U t` is no
+    /// longer determined by the double `U` (at `|U t| ~ 1e16` not even its
+    /// integer part is), and the value would be arbitrary.
     fn check_drift(&self, t: &[f64], out: &[f64]) -> Result<()> {
-        let gated = self.drift_defect > DRIFT_DEFECT_FLOOR;
         let delta = self.drift_defect.max(PHASE_ROUNDING_RTOL);
-        if !gated {
-            // One comparison per block on the generic path, with the bound
-            // `speed_bound` of |l̇| (|l| = |l0|: Σ l² is conserved).
-            let t_max = t.iter().fold(0.0f64, |m, v| m.max(v.abs()));
-            if delta * t_max * self.speed_bound / self.size <= HORIZON_RTOL {
-                return Ok(());
-            }
+        // One comparison per block on the generic path, with the bound
+        // `speed_bound` of |l̇| (|l| = |l0|: Σ l² is conserved).
+        let t_max = t.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        if delta * t_max * self.speed_bound / self.size <= HORIZON_RTOL {
+            return Ok(());
         }
         for (&tk, lk) in t.iter().zip(out.chunks_exact(6)) {
             let l: &[f64; 6] = lk.try_into().expect("rows of 6");
@@ -759,14 +755,8 @@ impl Solution {
             let speed = f.iter().fold(0.0f64, |m, v| m.max(v.abs()));
             let drift = delta * tk.abs() * speed / self.size;
             // NaN (a non-finite l) passes here: the quotient's own checks own it
-            if !gated && drift > HORIZON_RTOL {
+            if drift > HORIZON_RTOL {
                 return Err(check::beyond_horizon(tk, drift, "the velocity U"));
-            }
-            if gated && drift > DRIFT_RTOL {
-                return Err(Error::Unverified {
-                    what: "l(t)",
-                    reason: drift_reason(tk, self.drift_defect, drift),
-                });
             }
         }
         Ok(())

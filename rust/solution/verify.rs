@@ -16,6 +16,7 @@
 
 use crate::error::{Error, Result};
 use crate::integrate::{integrate_with, Method, Options};
+use crate::numeric::alloc::try_vec;
 use crate::numeric::cancel::Cancel;
 use crate::so4::FrahmTop;
 
@@ -33,6 +34,10 @@ pub const VERIFY_MAX_STEPS: f64 = 2e6;
 /// times: the error of a phase drift grows with `|t|`, and a grid sees it
 /// between requested times too.
 const VERIFY_GRID: usize = 64;
+
+/// Most requested times compared one by one with the certifying integration;
+/// beyond it the grid of [`VERIFY_GRID`] points and the largest time do.
+const VERIFY_MAX_TIMES: usize = 1 << 16;
 
 /// The default step of Gauss–Legendre order 16 for this top and state,
 /// `1/((max c − min c) |l0|)` (as `FrahmTop.default_dt`, `DT_SCALE = 1`).
@@ -88,7 +93,13 @@ pub(super) fn certify(
     if steps.is_nan() || steps > VERIFY_MAX_STEPS {
         return Ok(Outcome::OverBudget(steps));
     }
-    let mut s: Vec<f64> = times.iter().map(|t| t.abs()).collect();
+    // The requested times themselves where they are not too many; beyond that
+    // the grid (and the largest) stand for them.
+    let mut s: Vec<f64> = if times.len() <= VERIFY_MAX_TIMES {
+        times.iter().map(|t| t.abs()).collect()
+    } else {
+        vec![t_end]
+    };
     s.extend((1..=VERIFY_GRID).map(|k| t_end * k as f64 / VERIFY_GRID as f64));
     s.sort_by(f64::total_cmp);
     s.dedup();
@@ -101,7 +112,7 @@ pub(super) fn certify(
     };
     let tr = integrate_with(&top(c4, sign)?, l0, 0.0, &s, &opts, cancel)?;
     let signed: Vec<f64> = s.iter().map(|t| sign * t).collect();
-    let mut out = vec![0.0; 6 * signed.len()];
+    let mut out = try_vec("samples", 6 * signed.len(), 0.0)?;
     closed(&signed, &mut out)?;
     let mut worst = (0.0f64, 0.0f64);
     for (k, (a, b)) in out.chunks_exact(6).zip(tr.y.chunks_exact(6)).enumerate() {
