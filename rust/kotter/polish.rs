@@ -397,6 +397,7 @@ fn refine_dd(lv: &Level, i: usize, t: C, sigma: C, df: C) -> Option<PolishedRoot
 
 /// `h0` and `h1² − 4h0²` in DD: from the state's `m, n` where given
 /// (`h1² − 4h0² = |m − n|² |m + n|²`, no cancellation), else from `h`.
+#[inline(always)]
 fn h0_den_dd(lv: &Level) -> (Dd, Dd) {
     match lv.mn {
         Some((m, n)) => {
@@ -420,7 +421,9 @@ fn h0_den_dd(lv: &Level) -> (Dd, Dd) {
     }
 }
 
-/// [`refine_dd`] from a start `t` given in DD.
+/// [`refine_dd`] from a start `t` given in DD (inlined: the generic path
+/// takes it once per root, as it took the body of `refine_dd` before).
+#[inline(always)]
 fn refine_dd_with(
     lv: &Level,
     h0: Dd,
