@@ -200,14 +200,19 @@ impl PolishedRoot {
 /// there the two roots of a pair are on different branches a distance `~h0`
 /// apart, and `|f|` at the start does not tell them apart (at `h0 = 0` not at all).
 pub(super) fn polish_root(lv: &Level, p_at_a: &[f64; 4], s0: C, branch: Option<C>) -> PolishedRoot {
-    let a = lv.a;
-    let mut best = 0;
-    for i in 1..4 {
-        if (s0 - a[i]).modulus() < (s0 - a[best]).modulus() {
-            best = i;
+    let best = nearest_a(lv.a, s0);
+    polish_root_at(lv, p_at_a, best, s0 - lv.a[best], branch)
+}
+
+/// The index of the `a_i` nearest `s` (the first of equals).
+fn nearest_a(a: &[f64; 4], s: C) -> usize {
+    (1..4).fold(0, |best, i| {
+        if (s - a[i]).modulus() < (s - a[best]).modulus() {
+            i
+        } else {
+            best
         }
-    }
-    polish_root_at(lv, p_at_a, best, s0 - a[best], branch)
+    })
 }
 
 /// [`polish_root`] from the offset `t0 = s0 − a_best` itself (a root within
@@ -590,13 +595,7 @@ const PAIR_FD_RTOL: f64 = 1e-9;
 /// unless both roots converge in DD.
 pub(super) fn split_pair(lv: &Level, s0: C, branch: C) -> Option<[PolishedRoot; 2]> {
     let a = lv.a;
-    let i = (1..4).fold(0, |b, m| {
-        if (s0 - a[m]).modulus() < (s0 - a[b]).modulus() {
-            m
-        } else {
-            b
-        }
-    });
+    let i = nearest_a(a, s0);
     let (h0, den) = h0_den_dd(lv);
     let df_at = |t: Cdd| {
         let (x, sg) = offsets_dd(a, i, t, branch);

@@ -250,7 +250,10 @@ impl Motion {
         }
     }
 
-    fn eval_serial(&self, t: &[f64], out: &mut [f64]) -> Result<()> {
+    /// The rows `l(t_k)` of one block of times: the closed forms of the
+    /// constant and Euler kinds directly, the genus-2 kind through its
+    /// solution's batch (which splits over threads itself).
+    fn rows(&self, t: &[f64], out: &mut [f64], cancel: &Cancel) -> Result<()> {
         match &self.body {
             Body::Constant => {
                 for o in out.chunks_exact_mut(6) {
@@ -280,11 +283,15 @@ impl Motion {
             }
             Body::Genus2(sol) => {
                 if self.time_scale == 1.0 && self.scale == 1.0 {
-                    return sol.l_batch_serial(t, out, &Cancel::never());
+                    // The generic path, unchanged.
+                    return sol.l_batch(t, out, cancel);
                 }
+                // In the normalized frame: the solution's own batch (parallel,
+                // with a certifying integration, where the drift check needs
+                // one, run once over all the times and interruptible).
                 let ts: Vec<f64> = t.iter().map(|&x| self.time_scale * x).collect();
                 crate::error::check_finite("t x time scale", &ts)?;
-                sol.l_batch_serial(&ts, out, &Cancel::never())?;
+                sol.l_batch(&ts, out, cancel)?;
                 if self.scale != 1.0 {
                     out.iter_mut().for_each(|v| *v *= self.scale);
                 }
@@ -306,24 +313,11 @@ impl Motion {
             });
         }
         crate::error::check_finite("t", t)?;
-        if let Body::Genus2(sol) = &self.body {
-            if self.time_scale == 1.0 && self.scale == 1.0 {
-                // The generic path, unchanged.
-                return sol.l_batch(t, out, cancel);
-            }
-            // In the normalized frame: the same rows as chunk by chunk, with a
-            // certifying integration (where the drift check needs one) run once
-            // over all the times and interruptible.
-            let ts: Vec<f64> = t.iter().map(|&x| self.time_scale * x).collect();
-            crate::error::check_finite("t x time scale", &ts)?;
-            sol.l_batch(&ts, out, cancel)?;
-            if self.scale != 1.0 {
-                out.iter_mut().for_each(|v| *v *= self.scale);
-            }
-            return Ok(());
+        if let Body::Genus2(_) = &self.body {
+            return self.rows(t, out, cancel);
         }
         rows_in_parallel(t, out, cancel, CHUNK, PAR_PIECE, |tp, op| {
-            self.eval_serial(tp, op)
+            self.rows(tp, op, cancel)
         })
     }
 

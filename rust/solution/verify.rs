@@ -18,7 +18,7 @@ use crate::error::{Error, Result};
 use crate::integrate::{integrate_with, Method, Options};
 use crate::numeric::alloc::try_vec;
 use crate::numeric::cancel::Cancel;
-use crate::so4::FrahmTop;
+use crate::so4::{FrahmTop, PAIRS4};
 
 /// Largest disagreement `max_k |l(t_k) − l_int(t_k)| / |l0|` between the closed
 /// form and the integration that certifies `l(t)`: the bound the drift check
@@ -54,8 +54,7 @@ fn default_dt(c4: &[f64; 6], size: f64) -> f64 {
 /// `sign = −1`: (1) is linear in `c`).
 fn top(c4: &[f64; 6], sign: f64) -> Result<FrahmTop> {
     let mut c = [0.0; 16];
-    let pairs = [(0, 1), (0, 2), (0, 3), (1, 2), (1, 3), (2, 3)];
-    for (q, &(i, j)) in pairs.iter().enumerate() {
+    for (q, &(i, j)) in PAIRS4.iter().enumerate() {
         c[4 * i + j] = sign * c4[q];
         c[4 * j + i] = sign * c4[q];
     }
