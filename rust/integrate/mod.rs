@@ -57,6 +57,7 @@ mod dopri5;
 mod driver;
 mod explicit;
 mod gauss;
+pub(crate) mod gauss_dd;
 mod options;
 pub mod taylor;
 #[rustfmt::skip]

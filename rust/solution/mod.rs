@@ -132,6 +132,10 @@ pub const LABELS: [&str; 7] = ["P0", "P23", "P31", "P12", "P14", "P24", "P34"];
 pub struct Solution {
     a: [f64; 4],
     c4: [f64; 6],
+    /// The rounding errors of `c4` (`c4 + c4_lo` the top's `c_ij` in
+    /// double-double; zeros where `c4` was given): the top the certificate
+    /// integrates in double-double ([`verify`]).
+    c4_lo: [f64; 6],
     l0: [f64; 6],
     kotter: KotterConstants,
     state0: KotterState,
@@ -297,6 +301,7 @@ impl Solution {
         Ok(Solution {
             a: *a,
             c4,
+            c4_lo: *c4_lo,
             l0: *l0,
             kotter,
             state0,
@@ -714,6 +719,7 @@ impl Solution {
             let sign = if s == 1 { 1.0 } else { -1.0 };
             let outcome = verify::certify(
                 &self.c4,
+                &self.c4_lo,
                 &self.l0,
                 self.size,
                 sign,

@@ -312,11 +312,68 @@ fn drift_of_the_phase_is_certified_where_the_self_check_cannot_vouch() {
 /// Where the integration that would certify `l(t)` disagrees with the closed
 /// form, or would take more than `VERIFY_MAX_STEPS`, `l(t)` is refused and the
 /// message says which. A state of the harsh random draw of
-/// tests/data/every_state_harsh.py (seed 20261125, draw 33): defect 1.0e-11;
-/// at the end of its window (t = 3.6e-4) the closed form and the integration
-/// differ by 4.4e-10 |l0|.
+/// tests/data/every_state_harsh.py (seed 20261125, draw 1611): defect 1.5e-8;
+/// its motion is well conditioned (Gauss–Legendre in double is within 1.4e-15
+/// of a quadruple-precision reference), and the closed form leaves it by
+/// 5.9e-11 |l0| at t = 0.01254, growing to 4.8e-7 |l0| at the end of its
+/// window (t = 0.0202).
 #[test]
 fn drift_of_the_phase_is_refused_where_the_integration_disagrees() {
+    let a = [
+        -0.7644521038761671,
+        541.0089261815298,
+        1476.068816407971,
+        1495.2811015909406,
+    ];
+    let b = [
+        0.9097271307411101,
+        -8.517192004563896,
+        10.399363388769771,
+        24.97789017691334,
+    ];
+    let l0 = [
+        -3.134012066260796e-06,
+        -63716.61780859597,
+        -4.80716204582966,
+        1.7041082439658305e-05,
+        -1.0252553425644443e-05,
+        -55.82163127412442,
+    ];
+    let s = Solution::new(&a, &b, &l0).unwrap();
+    assert!(s.drift_defect() > DRIFT_DEFECT_FLOOR);
+    match s.l(0.02021930789986314) {
+        Err(Error::Unverified {
+            what: "l(t)",
+            reason,
+        }) => {
+            assert!(reason.contains("an integration of (1)"), "{reason}");
+            assert!(
+                reason.contains("in double-double) differs from it"),
+                "{reason}"
+            );
+        }
+        other => panic!("not refused: {other:?}"),
+    }
+    // far beyond the integration's budget
+    match s.l(1e3) {
+        Err(Error::Unverified {
+            what: "l(t)",
+            reason,
+        }) => {
+            assert!(reason.contains("would take"), "{reason}");
+        }
+        other => panic!("not refused: {other:?}"),
+    }
+}
+
+/// Where the integration in double disagrees with the closed form because it
+/// is the one that is off, the one in double-double certifies the closed form.
+/// Draw 33 of the harsh draw (components from 1.5e-5 to 1.1e4): at
+/// t = 2.906e-4 Gauss–Legendre order 16 in double is 1.8e-9 |l0| from the
+/// quadruple-precision reference of tests/data/longdouble_ref.py
+/// (`reference_quad`), the closed form 2.1e-13 |l0|.
+#[test]
+fn drift_of_the_phase_is_certified_in_double_double_where_double_is_off() {
     let a = [
         0.5268621452298337,
         34.88180417046224,
@@ -337,28 +394,35 @@ fn drift_of_the_phase_is_refused_where_the_integration_disagrees() {
         12.753191244708686,
         -0.17673112969106017,
     ];
+    let t = 2.906261456539652e-4;
+    let quad = [
+        986.9959321697294,
+        -2246.625430041134,
+        11111.216623339764,
+        -0.22047182744005084,
+        95.8356609783933,
+        -215.63706521667575,
+    ];
+    let scale = l0.iter().map(|x| x * x).sum::<f64>().sqrt();
     let s = Solution::new(&a, &b, &l0).unwrap();
     assert!(s.drift_defect() > DRIFT_DEFECT_FLOOR);
-    match s.l(3.632826820674566e-4) {
-        Err(Error::Unverified {
-            what: "l(t)",
-            reason,
-        }) => {
-            assert!(reason.contains("an integration of (1)"), "{reason}");
-            assert!(reason.contains("differs from it"), "{reason}");
-        }
-        other => panic!("not refused: {other:?}"),
-    }
-    // far beyond the integration's budget
-    match s.l(1e3) {
-        Err(Error::Unverified {
-            what: "l(t)",
-            reason,
-        }) => {
-            assert!(reason.contains("would take"), "{reason}");
-        }
-        other => panic!("not refused: {other:?}"),
-    }
+    // Gauss–Legendre order 16 in double at its default step
+    // 1/((max c − min c) |l0|), as the certificate takes it.
+    let top = FrahmTop::manakov(&a, &b).unwrap();
+    let c = top.c_upper();
+    let spread =
+        c.iter().cloned().fold(f64::MIN, f64::max) - c.iter().cloned().fold(f64::MAX, f64::min);
+    let opts = Options {
+        method: Method::Gauss16,
+        dt: 1.0 / (spread * scale),
+        rtol: 0.0,
+        atol: 0.0,
+        max_steps: 1_000_000,
+    };
+    let double = integrate(&top, &l0, 0.0, &[t], &opts).unwrap();
+    assert!(max_rel(&double.y, &quad, scale) > 10.0 * DRIFT_RTOL);
+    let lt = s.l(t).expect("certified in double-double");
+    assert!(max_rel(&lt, &quad, scale) <= DRIFT_RTOL);
 }
 
 /// Next to an so(3) block the motion is slow, and the quotients' velocity along

@@ -6,18 +6,28 @@
 //! worst case: on a harsh random draw of 10⁴ states it refused 352 solutions,
 //! of which 338 were within the accuracy bound over their whole window
 //! against a long-double reference (docs/degenerate.md). No check at a few
-//! points of the torus can tell those from the 14 that did drift: a drift of
+//! points of the torus can tell those from the few that did drift: a drift of
 //! the phase is a global property of the motion. An integration of Frahm's
 //! equations (1) over the same times is: where the closed form and Gauss–Legendre
 //! order 16 at its default step agree to [`VERIFY_RTOL`] `|l0|` at every sample,
 //! both are accurate to about that (they share no step of their computation),
-//! and the closed form's values are returned. Where they disagree, or the
-//! integration would exceed [`VERIFY_MAX_STEPS`], `l(t)` is refused as before.
+//! and the closed form's values are returned.
+//!
+//! Where they disagree, the integration in double may be the one that is off:
+//! on states whose components span many orders of magnitude its rounding
+//! (`~1e-16 |l0|` a step) is a large relative change of the small components,
+//! and the motion carries it to the whole state (docs/degenerate.md). The same
+//! method in double-double ([`gauss16_dd_so4`], rounding `~1e-32 |l0|`, the
+//! top's `c_ij` in double-double) then decides, within
+//! [`VERIFY_DD_MAX_STEPS`]. Where it too disagrees, or the integrations would
+//! exceed their budgets, `l(t)` is refused as before.
 
 use crate::error::{Error, Result};
+use crate::integrate::gauss_dd::{gauss16_dd_so4, gauss16_dd_steps};
 use crate::integrate::{integrate_with, Method, Options};
 use crate::numeric::alloc::try_vec;
 use crate::numeric::cancel::Cancel;
+use crate::numeric::dd::Dd;
 use crate::so4::{FrahmTop, PAIRS4};
 
 /// Largest disagreement `max_k |l(t_k) − l_int(t_k)| / |l0|` between the closed
@@ -29,6 +39,10 @@ pub const VERIFY_RTOL: f64 = super::check::DRIFT_RTOL;
 /// (Gauss–Legendre order 16 on so(4): ~1 µs a step, so ~2 s); beyond it
 /// `l(t)` is refused with the drift check's reason.
 pub const VERIFY_MAX_STEPS: f64 = 2e6;
+
+/// Most steps the double-double integration may take per direction of time
+/// where the one in double disagrees (~40 µs a step, so ~2 s).
+pub const VERIFY_DD_MAX_STEPS: f64 = 5e4;
 
 /// Samples of the certifying integration on `(0, T]` besides the requested
 /// times: the error of a phase drift grows with `|t|`, and a grid sees it
@@ -69,13 +83,19 @@ pub(super) enum Outcome {
     Disagree(f64, f64),
     /// The integration would take this many steps (over [`VERIFY_MAX_STEPS`]).
     OverBudget(f64),
+    /// The integration in double disagrees by this much at this time, and
+    /// the one in double-double would take this many steps (over
+    /// [`VERIFY_DD_MAX_STEPS`]).
+    DisagreeDdOverBudget(f64, f64, f64),
 }
 
 /// Integrates (1) from `l0` over `|times|` (all of one sign, `T` the largest
 /// modulus) and the grid of [`VERIFY_GRID`] points on `(0, T]`, and compares
 /// with `closed` at the same times.
+#[allow(clippy::too_many_arguments)]
 pub(super) fn certify(
     c4: &[f64; 6],
+    c4_lo: &[f64; 6],
     l0: &[f64; 6],
     size: f64,
     sign: f64,
@@ -113,22 +133,40 @@ pub(super) fn certify(
     let signed: Vec<f64> = s.iter().map(|t| sign * t).collect();
     let mut out = try_vec("samples", 6 * signed.len(), 0.0)?;
     closed(&signed, &mut out)?;
-    let mut worst = (0.0f64, 0.0f64);
-    for (k, (a, b)) in out.chunks_exact(6).zip(tr.y.chunks_exact(6)).enumerate() {
-        let d = a
-            .iter()
-            .zip(b)
-            .fold(0.0f64, |m, (x, y)| m.max((x - y).abs()))
-            / size;
-        if d.is_nan() || d > worst.0 {
-            worst = (if d.is_nan() { f64::INFINITY } else { d }, signed[k]);
-        }
+    let worst = disagreement(&out, &tr.y, &signed, size);
+    if worst.0 <= VERIFY_RTOL {
+        return Ok(Outcome::Agree);
     }
+    // The double integration may be the one that is off: double-double decides.
+    let dd_steps = gauss16_dd_steps(&s, dt);
+    if dd_steps > VERIFY_DD_MAX_STEPS {
+        return Ok(Outcome::DisagreeDdOverBudget(worst.0, worst.1, dd_steps));
+    }
+    let c: [Dd; 6] = std::array::from_fn(|q| Dd::sum(sign * c4[q], sign * c4_lo[q]));
+    let y = gauss16_dd_so4(&c, l0, &s, dt, cancel)?;
+    let worst = disagreement(&out, &y, &signed, size);
     Ok(if worst.0 <= VERIFY_RTOL {
         Outcome::Agree
     } else {
         Outcome::Disagree(worst.0, worst.1)
     })
+}
+
+/// The largest `max_q |a_q − b_q| / size` over the rows (a NaN counts as
+/// infinite) and the time of its row.
+fn disagreement(a: &[f64], b: &[f64], times: &[f64], size: f64) -> (f64, f64) {
+    let mut worst = (0.0f64, 0.0f64);
+    for (k, (x, y)) in a.chunks_exact(6).zip(b.chunks_exact(6)).enumerate() {
+        let d = x
+            .iter()
+            .zip(y)
+            .fold(0.0f64, |m, (p, q)| m.max((p - q).abs()))
+            / size;
+        if d.is_nan() || d > worst.0 {
+            worst = (if d.is_nan() { f64::INFINITY } else { d }, times[k]);
+        }
+    }
+    worst
 }
 
 /// The refusal of `l(t)` where the certificate failed: the drift check's
@@ -137,8 +175,13 @@ pub(super) fn refusal(reason: String, outcome: &Outcome) -> Error {
     let found = match outcome {
         Outcome::Agree => String::new(),
         Outcome::Disagree(d, t) => format!(
+            "; an integration of (1) (Gauss-Legendre order 16 in double-double) differs \
+             from it by {d:.1e} |l0| at t = {t:e}"
+        ),
+        Outcome::DisagreeDdOverBudget(d, t, steps) => format!(
             "; an integration of (1) (Gauss-Legendre order 16) differs from it by \
-             {d:.1e} |l0| at t = {t:e}"
+             {d:.1e} |l0| at t = {t:e}, and one in double-double to decide would take \
+             {steps:.1e} steps (more than {VERIFY_DD_MAX_STEPS:e})"
         ),
         Outcome::OverBudget(steps) => format!(
             "; an integration of (1) to certify it would take {steps:.1e} steps \

@@ -14,6 +14,10 @@ each pair the entry >= 1/2 is rounded to nearest and its partner is set to
 The predictor E_ij = ell_j(1 + c_i) (Lagrange basis on the nodes, evaluated at
 the next step's nodes) gives the starting guess of the stage iteration.
 Every other number is the double nearest to the mpmath value at 60 digits.
+For the double-double integration of the 8-stage method (the certificate of
+the closed form, ``rust/integrate/gauss_dd.rs``) ``A8_DD`` and ``B8_DD`` hold
+a_ij and b_j as pairs ``[hi, lo]``: hi the nearest double, lo the nearest
+double to the remainder.
 
 Run from the repository root:  python tests/data/gen_gauss_tables.py
 """
@@ -75,6 +79,13 @@ def mu_doubles(b, a):
     return mu
 
 
+def dd(x) -> str:
+    """``[hi, lo]`` of an mpmath number: the nearest double and the nearest double
+    to the remainder (together ~106 bits)."""
+    hi = float(x)
+    return f"[{fmt(hi)}, {fmt(float(x - mp.mpf(hi)))}]"
+
+
 def fmt(x: float) -> str:
     r = repr(float(x))
     return r if ("." in r or "e" in r) else r + ".0"
@@ -113,6 +124,14 @@ def main(path: pathlib.Path | None = None) -> None:
                 row.append(fmt(float(v)))
             out.append(f"    [{', '.join(row)}],")
         out.append("];")
+        if s == 8:
+            out.append("/// `a_ij` of the 8-stage Gauss method in double-double, `[hi, lo]`.")
+            out.append("pub const A8_DD: [[[f64; 2]; 8]; 8] = [")
+            for row in a:
+                out.append(f"    [{', '.join(dd(x) for x in row)}],")
+            out.append("];")
+            out.append("/// `b_j` of the 8-stage Gauss method in double-double, `[hi, lo]`.")
+            out.append(f"pub const B8_DD: [[f64; 2]; 8] = [{', '.join(dd(x) for x in b)}];")
         out.append("")
     if path is None:
         root = pathlib.Path(__file__).resolve().parents[2]
