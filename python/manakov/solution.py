@@ -135,9 +135,13 @@ class Solution:
         which the Theorem's coordinates are singular to working precision
         (``h1² = 4h0²`` off the exact sets above, coinciding branch points, a
         repeated root of F (19), the divisor of ``l0`` at infinity), an
-        iteration of the reduction that did not converge — or that fails its
+        iteration of the reduction that did not converge. The message names
+        the step; integrate the state instead. A closed form that fails its
         self-check (:attr:`self_check` above 1e-10 or :attr:`velocity_check`
-        above 1e-6). The message names the step; integrate the state instead.
+        above 1e-6) is returned marked (:attr:`self_check_passed` is False):
+        its :meth:`l` is then certified by an integration at every call, and
+        what depends on its phase (:attr:`U`, :attr:`u0`, :attr:`torus`,
+        :attr:`frequencies`, :attr:`constants`, the quotients) is refused.
 
     Notes
     -----
@@ -246,14 +250,36 @@ class Solution:
             "lambda": lam,
         }
 
-    def _genus2(self, what: str) -> Any:
+    def _genus2(self, what: str, checked: bool = False) -> Any:
         if self._core is None:
             kind = self.kind
             raise AttributeError(
                 f"{what} exists for a genus-2 solution only; this one is of kind "
                 f"'{kind}' ({_WHY.get(kind, kind)})"
             )
+        if checked and self._core.certify_every is not None:
+            raise _core.ClosedFormError(
+                f"no trustworthy {what}: {self._core.certify_every}; of this solution only "
+                "l(t) is returned, where an integration of (1) certifies it"
+            )
         return self._core
+
+    @property
+    def self_check_passed(self) -> bool:
+        """Whether the closed form passed its self-check (:attr:`self_check` at most
+        1e-10 and :attr:`velocity_check` at most 1e-6); True for the kinds other than
+        ``"genus2"``.
+
+        Where it did not, the solution is kept for its :meth:`l` only: each call
+        integrates (1) from ``l0`` to the requested times (Gauss–Legendre order 16
+        at its default step, in double and, where that disagrees, in double-double)
+        and returns the closed form's values where the two agree to 5e-11
+        ``|l0|`` at every requested time, else raises ``ClosedFormError``. The
+        self-check's points spread over the whole torus, and a closed form that
+        misses some of them can still be right along the part of the motion that is
+        evaluated (docs/degenerate.md, "Solutions that fail the self-check").
+        """
+        return self._core is None or self._core.certify_every is None
 
     def l(self, t: Any) -> np.ndarray:
         """The state at time(s) ``t``.
@@ -280,11 +306,15 @@ class Solution:
             is above rounding (1e-12), at a ``t`` where the drift
             ``δ |t| |dl/dt| / |l0|`` of its phase may exceed 5e-11 and an
             integration of (1) from ``l0`` (Gauss–Legendre order 16 at its
-            default step) does not certify it: it differs from the closed form by
-            more than 5e-11 ``|l0|``, or would take more than 2e6 steps. Where it
-            certifies ``l(t)`` the closed form's values are returned (the first
-            such call integrates; later calls within the certified ``|t|`` do
-            not). Any kind
+            default step, in double and, where that disagrees, in
+            double-double) does not certify it: it differs from the closed form
+            by more than 5e-11 ``|l0|``, or would take more than 2e6 steps (5e4
+            in double-double). Where it certifies ``l(t)`` the closed form's
+            values are returned (the first such call integrates; later calls
+            within the certified ``|t|`` do not). A genus-2 solution that
+            failed its self-check (:attr:`self_check_passed` False), at any
+            requested time where the same integration, run at every call, does
+            not agree with it to 5e-11 ``|l0|``. Any kind
             with a moving phase, beyond its phase horizon: where the rounding
             of the velocity alone (4 ulp) moves ``l(t)`` by more than 1e-6
             ``|l0|`` (e.g. ``|t| ~ 1e12`` on a top and state of unit size),
@@ -327,12 +357,12 @@ class Solution:
     @property
     def u0(self) -> np.ndarray:
         """``u0 = u(P1) + u(P2)`` at ``t = 0`` (Abel map, base point ∞; ``v0 = u0 + K``)."""
-        return _frozen(self._genus2("u0").u0)
+        return _frozen(self._genus2("u0", checked=True).u0)
 
     @property
     def U(self) -> np.ndarray:  # noqa: N802 (the paper's name)
         """``U``: ``u = u0 + U t'`` in the normalized time ``t' = T t``, from (1)."""
-        return _frozen(self._genus2("U").rate)
+        return _frozen(self._genus2("U", checked=True).rate)
 
     @property
     def tau(self) -> np.ndarray:
@@ -365,7 +395,7 @@ class Solution:
     @property
     def constants(self) -> dict[str, complex]:
         """``C_L`` of (34), ``P_L = C_L θ[χ_L](v)/θ(v)``, for :data:`LABELS`."""
-        core = self._genus2("constants")
+        core = self._genus2("constants", checked=True)
         return {lab: complex(c) for lab, c in zip(LABELS, core.constants, strict=True)}
 
     @property
@@ -434,7 +464,7 @@ class Solution:
             (:attr:`velocity_check`) is above 1e-10, which ``U`` and the
             frequencies would carry. The message names the step.
         """
-        self._genus2("torus")
+        self._genus2("torus", checked=True)
         if self._torus is None:
             lam, coords, nu, _ = self._motion.torus()
             self._torus = Torus(_frozen(lam), _frozen(coords), _frozen(nu))
@@ -495,11 +525,16 @@ class Solution:
     def quotient(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """``(idx, num, den)``: ``l_q = Re(Σ_m num[q, m] θ[idx[m]](v) / Σ_m den[m] θ[idx[m]](v))``
         (theta indices in the package's characteristic order; normalized frame)."""
-        return self._genus2("quotient").quotient()
+        return self._genus2("quotient", checked=True).quotient()
 
     def __repr__(self) -> str:
         if self._core is not None:
             d = ", ".join(_show(x, 6) for x in self._core.branch_points)
+            if self._core.certify_every is not None:
+                return (
+                    f"Solution(curve: y^2 = prod (x - d_j), d = [{d}]; self-check failed: "
+                    "l(t) certified by an integration at each call)"
+                )
             u = ", ".join(_show(x, 12) for x in self._core.rate)
             return f"Solution(curve: y^2 = prod (x - d_j), d = [{d}]; U = [{u}])"
         e = self._motion.euler()

@@ -863,9 +863,12 @@ class ManakovTop(FrahmTop):
         manakov.ClosedFormError
             A valid state whose closed form could not be built (a level set on
             which the Theorem's coordinates are singular to working precision;
-            the message names the step) or that fails its self-check
-            (``Solution.self_check`` above 1e-10 or ``Solution.velocity_check``
-            above 1e-6; docs/degenerate.md): integrate it instead.
+            the message names the step): integrate it instead. A closed form
+            that fails its self-check (``Solution.self_check`` above 1e-10 or
+            ``Solution.velocity_check`` above 1e-6) is returned marked
+            (``Solution.self_check_passed`` False): its ``l(t)`` is certified by
+            an integration at every call, its phase is refused
+            (docs/degenerate.md §10).
         """
         self._require_so4("solve")
         return Solution(self.a, self.b, l0)

@@ -136,6 +136,13 @@ impl SolutionCore {
         self.sol.drift_defect()
     }
 
+    /// The self-check's reason where the solution failed it and each `l(t)`
+    /// is certified by an integration, else `None`.
+    #[getter]
+    fn certify_every(&self) -> Option<String> {
+        self.sol.certify_every().map(str::to_string)
+    }
+
     /// `(idx (8,), num (6, 8), den (8,))` of `l_q = N_q/D`.
     fn quotient<'py>(&self, py: Python<'py>) -> PyResult<Quotient<'py>> {
         let (idx, num, den) = self.sol.quotient();

@@ -161,9 +161,13 @@ impl Candidates<'_> {
 
     /// Every sign pattern of the constants that l0 leaves undecided, built and
     /// checked (check.rs): the one that passes the self-check best (each part
-    /// relative to its bound), refused above [`SELF_CHECK_RTOL`] in its shape
-    /// or [`VELOCITY_CHECK_RTOL`] in its velocity.
-    pub(super) fn best(&self, cl0: &[C; 7], calibration: &[f64; 7]) -> Result<(Defect, Built)> {
+    /// relative to its bound), with the self-check's verdict on it
+    /// ([`self_check_verdict`]).
+    pub(super) fn best(
+        &self,
+        cl0: &[C; 7],
+        calibration: &[f64; 7],
+    ) -> Result<(Defect, Built, Result<()>)> {
         let mut best: Option<(Defect, Built)> = None;
         let mut last_err: Option<Error> = None;
         for cl in sign_patterns(cl0, calibration) {
@@ -185,30 +189,37 @@ impl Candidates<'_> {
                 })
             }
         };
-        if defect.shape.is_nan() || defect.shape > SELF_CHECK_RTOL {
-            return Err(Error::Unverified {
-                what: "solution of l0",
-                reason: format!(
-                    "the theta quotients (9)-(10) fail the self-check: relative defect \
-                     {:e} > {SELF_CHECK_RTOL:e} in the integrals (6)-(7), a real l or \
-                     l(0) = l0 at points of the torus",
-                    defect.shape
-                ),
-            });
-        }
-        if defect.velocity > VELOCITY_CHECK_RTOL {
-            return Err(Error::Unverified {
-                what: "solution of l0",
-                reason: format!(
-                    "the theta quotients (9)-(10) fail the self-check: they move along U \
-                     against Frahm's equations (1) by {:e} > {VELOCITY_CHECK_RTOL:e} of \
-                     the largest speed at points of the torus",
-                    defect.velocity
-                ),
-            });
-        }
-        Ok((defect, built))
+        let verdict = self_check_verdict(&defect);
+        Ok((defect, built, verdict))
     }
+}
+
+/// The self-check's verdict: refused above [`SELF_CHECK_RTOL`] in its shape
+/// or [`VELOCITY_CHECK_RTOL`] in its velocity.
+fn self_check_verdict(defect: &Defect) -> Result<()> {
+    if defect.shape.is_nan() || defect.shape > SELF_CHECK_RTOL {
+        return Err(Error::Unverified {
+            what: "solution of l0",
+            reason: format!(
+                "the theta quotients (9)-(10) fail the self-check: relative defect \
+                 {:e} > {SELF_CHECK_RTOL:e} in the integrals (6)-(7), a real l or \
+                 l(0) = l0 at points of the torus",
+                defect.shape
+            ),
+        });
+    }
+    if defect.velocity.is_nan() || defect.velocity > VELOCITY_CHECK_RTOL {
+        return Err(Error::Unverified {
+            what: "solution of l0",
+            reason: format!(
+                "the theta quotients (9)-(10) fail the self-check: they move along U \
+                 against Frahm's equations (1) by {:e} > {VELOCITY_CHECK_RTOL:e} of \
+                 the largest speed at points of the torus",
+                defect.velocity
+            ),
+        });
+    }
+    Ok(())
 }
 
 /// The phase of the solution: `U`, its lattice rates `X, Y` (with their

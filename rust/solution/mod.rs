@@ -175,6 +175,10 @@ pub struct Solution {
     /// bounds: the self-check's larger part where `U` is the quotients' fit,
     /// its velocity part where it is the closed form ([`check::drift_defect`]).
     drift_defect: f64,
+    /// Where the theta quotients failed the self-check (its reason) and the
+    /// solution was set up anyway ([`Solution::with_c4_lo_certifying`]):
+    /// every `l(t)` is then certified by an integration of (1), at every call.
+    certify_every: Option<String>,
     /// `|l0|` (`Σ l_ij²` is a Casimir of (1): `|l(t)| = |l0|`).
     size: f64,
     /// `4 max|c_ij| |l0|²`, a bound of `|l̇|` by (1) for the phase horizon
@@ -239,6 +243,32 @@ impl Solution {
         c4_lo: &[f64; 6],
         l0: &[f64; 6],
     ) -> Result<Self> {
+        Self::set_up(a, c4, c4_lo, l0, false)
+    }
+
+    /// [`Solution::with_c4_lo`], except that a solution whose theta quotients
+    /// fail the self-check (with a finite defect) is returned rather than
+    /// refused, marked ([`Solution::certify_every`]) so that its `l(t)` is
+    /// returned only where an integration of (1) certifies it, at every call
+    /// ([`verify`]): the self-check's points spread over the whole torus, and
+    /// a solution that misses them may still be right where it is evaluated
+    /// (docs/degenerate.md, "Solutions that fail the self-check").
+    pub fn with_c4_lo_certifying(
+        a: &[f64; 4],
+        c4: &[f64; 6],
+        c4_lo: &[f64; 6],
+        l0: &[f64; 6],
+    ) -> Result<Self> {
+        Self::set_up(a, c4, c4_lo, l0, true)
+    }
+
+    fn set_up(
+        a: &[f64; 4],
+        c4: &[f64; 6],
+        c4_lo: &[f64; 6],
+        l0: &[f64; 6],
+        certifying: bool,
+    ) -> Result<Self> {
         crate::error::check_finite("l0", l0)?;
         crate::error::check_finite("c", c4)?;
         crate::error::check_finite("c_lo", c4_lo)?;
@@ -273,7 +303,17 @@ impl Solution {
                 rate,
                 closed: closed_used,
             },
+            verdict,
         ) = cands.best(&cl0, &calibration)?;
+        let certify_every = match verdict {
+            Ok(()) => None,
+            Err(Error::Unverified { reason, .. })
+                if certifying && defect.shape.is_finite() && defect.velocity.is_finite() =>
+            {
+                Some(reason)
+            }
+            Err(e) => return Err(e),
+        };
         // the phase of the closed form where the checked pattern took it, else
         // of the fit
         let closed = if closed_used {
@@ -330,6 +370,7 @@ impl Solution {
                 * c4.iter().fold(0.0f64, |m, v| m.max(v.abs()))
                 * l0.iter().map(|x| x * x).sum::<f64>(),
             certified: std::sync::Mutex::new([0.0; 2]),
+            certify_every,
         })
     }
 
@@ -684,7 +725,59 @@ impl Solution {
     /// Whether the drift check applies its bound [`DRIFT_RTOL`] (the defect
     /// above [`DRIFT_DEFECT_FLOOR`]).
     fn gated(&self) -> bool {
-        self.drift_defect > DRIFT_DEFECT_FLOOR
+        self.certify_every.is_some() || self.drift_defect > DRIFT_DEFECT_FLOOR
+    }
+
+    /// Where the theta quotients failed the self-check and the solution was
+    /// set up to be certified at every call
+    /// ([`Solution::with_c4_lo_certifying`]): the self-check's reason.
+    pub fn certify_every(&self) -> Option<&str> {
+        self.certify_every.as_deref()
+    }
+
+    /// `l(t)` of a solution that failed its self-check: the closed form's
+    /// values (in `out`) stand only where an integration of (1) from `l0`
+    /// agrees with them at every requested time (`t = 0`: `l0` itself), to
+    /// [`verify::VERIFY_RTOL`]; else refused, with the self-check's reason
+    /// and what the integration found. Nothing is cached: the closed form may
+    /// be right at some times and not at others.
+    fn check_every_time(&self, why: &str, t: &[f64], out: &[f64], cancel: &Cancel) -> Result<()> {
+        for (&tk, lk) in t.iter().zip(out.chunks_exact(6)) {
+            if tk == 0.0 {
+                let d = lk
+                    .iter()
+                    .zip(&self.l0)
+                    .fold(0.0f64, |m, (x, y)| m.max((x - y).abs()))
+                    / self.size;
+                if d.is_nan() || d > verify::VERIFY_RTOL {
+                    return Err(verify::refusal_unchecked(
+                        why,
+                        &verify::Outcome::Disagree(d, 0.0),
+                    ));
+                }
+            }
+        }
+        for sign in [1.0, -1.0] {
+            let times: Vec<f64> = t.iter().copied().filter(|&x| x * sign > 0.0).collect();
+            if times.is_empty() {
+                continue;
+            }
+            let outcome = verify::certify(
+                &self.c4,
+                &self.c4_lo,
+                &self.l0,
+                self.size,
+                sign,
+                &times,
+                false,
+                |ts, o| self.eval_rows(ts, o),
+                cancel,
+            )?;
+            if !matches!(outcome, verify::Outcome::Agree) {
+                return Err(verify::refusal_unchecked(why, &outcome));
+            }
+        }
+        Ok(())
     }
 
     /// The drift check of a solution whose defect `δ` ([`Solution::drift_defect`])
@@ -694,6 +787,9 @@ impl Solution {
     /// of time, certifies `l(t)` where the two agree to
     /// [`verify::VERIFY_RTOL`] ([`verify`]); else `l(t)` is refused.
     fn check_drift_certified(&self, t: &[f64], out: &[f64], cancel: &Cancel) -> Result<()> {
+        if let Some(why) = &self.certify_every {
+            return self.check_every_time(why, t, out, cancel);
+        }
         let certified = *self.certified.lock().unwrap_or_else(|e| e.into_inner());
         let side = |t: f64| usize::from(t > 0.0);
         let delta = self.drift_defect;
@@ -724,6 +820,7 @@ impl Solution {
                 self.size,
                 sign,
                 times,
+                true,
                 |ts, o| self.eval_rows(ts, o),
                 cancel,
             )?;

@@ -175,7 +175,8 @@ impl Motion {
                 }
             }
             Kind::Genus2 => Body::Genus2(Arc::new(
-                Solution::with_c4_lo(&frame.a, &frame.c4, &frame.c4_lo, &ln).map_err(refusal)?,
+                Solution::with_c4_lo_certifying(&frame.a, &frame.c4, &frame.c4_lo, &ln)
+                    .map_err(refusal)?,
             )),
         };
         Ok(Motion {

@@ -228,8 +228,9 @@ pub(super) fn check_velocity_fit(res: f64) -> Result<()> {
             kind: SingularKind::InconsistentQuotients,
             reason: format!(
                 "the theta quotients (9)-(10) at v0 satisfy Frahm's equations (1) for no \
-                 velocity (least-squares residual {res:e} > {QUOTIENT_RESIDUAL_RTOL:e}): a \
-                 constant or branch of the set-up is wrong at this state; please report it"
+                 velocity (least-squares residual {res:e} > {QUOTIENT_RESIDUAL_RTOL:e}): the \
+                 set-up lost too many digits at this state (or took a wrong constant or \
+                 branch), and its l(t) would be wrong"
             ),
         });
     }

@@ -425,6 +425,106 @@ fn drift_of_the_phase_is_certified_in_double_double_where_double_is_off() {
     assert!(max_rel(&lt, &quad, scale) <= DRIFT_RTOL);
 }
 
+/// A closed form that fails its self-check is kept for `l(t)` only, certified
+/// by an integration of (1) at every call. Draws 857 and 163 of the harsh draw
+/// of tests/data/every_state_harsh.py: both fail it (shape defects 1.1e-8 and
+/// 7.5e-9), and `Solution::new` refuses both; the dispatcher keeps them. Over
+/// its window the first is within 7.3e-14 of the long-double reference and is
+/// certified (here against Dormand–Prince 8(5,3) at `rtol = 1e-13`); the
+/// second is not, and is refused, with the self-check's reason.
+#[test]
+fn a_closed_form_that_fails_its_self_check_is_certified_at_every_call() {
+    let cases = [
+        (
+            [
+                -0.9118629977757504,
+                398.46492300776555,
+                398.4661794162518,
+                402.2344698630952,
+            ],
+            [
+                -0.6924817531222192,
+                -54.46600839696644,
+                -54.51103569771819,
+                -54.41828642986967,
+            ],
+            [
+                0.018997883532578353,
+                0.00021057036746834466,
+                -1898.4149743225153,
+                -3.6092012359165507e-06,
+                -4.252067728897787,
+                -0.00041695687671992014,
+            ],
+            0.014688063554244504,
+            true,
+        ),
+        (
+            [
+                0.7871471108199299,
+                0.7882267353305348,
+                174.0290173375445,
+                174.0302390066087,
+            ],
+            [
+                0.6654561430630088,
+                0.6687574284186036,
+                79.12800030407737,
+                77.64364074701808,
+            ],
+            [
+                9.71950254150562e-05,
+                -138.54347278539672,
+                -19821.992860864902,
+                0.0011373387969342873,
+                13.699054030265806,
+                2192.0821683806084,
+            ],
+            4.1164743115916743e-05,
+            false,
+        ),
+    ];
+    for (a, b, l0, t_end, certified) in cases {
+        match Solution::new(&a, &b, &l0) {
+            Err(Error::Unverified { reason, .. }) => {
+                assert!(reason.contains("fail the self-check"), "{reason}")
+            }
+            other => panic!("not refused: {:?}", other.map(|s| s.self_check())),
+        }
+        let m = super::motion::Motion::new(&a, &b, &l0).unwrap();
+        let s = m.genus2().expect("a genus-2 motion");
+        assert!(s.certify_every().is_some());
+        let times: Vec<f64> = (0..=50).map(|k| t_end * k as f64 / 50.0).collect();
+        let mut out = vec![0.0; 6 * times.len()];
+        let got = m.l_batch(&times, &mut out, &Cancel::never());
+        if certified {
+            got.unwrap();
+            let top = FrahmTop::manakov(&a, &b).unwrap();
+            let opts = Options {
+                method: Method::Dop853,
+                dt: 0.0,
+                rtol: 1e-13,
+                atol: 1e-16,
+                max_steps: 10_000_000,
+            };
+            let tr = integrate(&top, &l0, 0.0, &times, &opts).unwrap();
+            let scale = l0.iter().map(|v| v * v).sum::<f64>().sqrt();
+            assert!(max_rel(&out, &tr.y, scale) <= DRIFT_RTOL);
+        } else {
+            match got {
+                Err(Error::Unverified {
+                    what: "l(t)",
+                    reason,
+                }) => {
+                    assert!(reason.contains("fail the self-check"), "{reason}");
+                    assert!(reason.contains("certifies it"), "{reason}");
+                }
+                other => panic!("not refused: {other:?}"),
+            }
+        }
+    }
+}
+
 /// Next to an so(3) block the motion is slow, and the quotients' velocity along
 /// `U` meets Frahm's (1) only to ~ε of the scale of (1), 1e-7 relative to the
 /// speed: a state of the harsh draw (seed 5) that the self-check refused when it

@@ -90,8 +90,9 @@ pub(super) enum Outcome {
 }
 
 /// Integrates (1) from `l0` over `|times|` (all of one sign, `T` the largest
-/// modulus) and the grid of [`VERIFY_GRID`] points on `(0, T]`, and compares
-/// with `closed` at the same times.
+/// modulus) and, with `grid`, the grid of [`VERIFY_GRID`] points on `(0, T]`
+/// (without it, every requested time however many), and compares with
+/// `closed` at the same times.
 #[allow(clippy::too_many_arguments)]
 pub(super) fn certify(
     c4: &[f64; 6],
@@ -100,6 +101,7 @@ pub(super) fn certify(
     size: f64,
     sign: f64,
     times: &[f64],
+    grid: bool,
     closed: impl Fn(&[f64], &mut [f64]) -> Result<()>,
     cancel: &Cancel,
 ) -> Result<Outcome> {
@@ -114,12 +116,14 @@ pub(super) fn certify(
     }
     // The requested times themselves where they are not too many; beyond that
     // the grid (and the largest) stand for them.
-    let mut s: Vec<f64> = if times.len() <= VERIFY_MAX_TIMES {
+    let mut s: Vec<f64> = if !grid || times.len() <= VERIFY_MAX_TIMES {
         times.iter().map(|t| t.abs()).collect()
     } else {
         vec![t_end]
     };
-    s.extend((1..=VERIFY_GRID).map(|k| t_end * k as f64 / VERIFY_GRID as f64));
+    if grid {
+        s.extend((1..=VERIFY_GRID).map(|k| t_end * k as f64 / VERIFY_GRID as f64));
+    }
     s.sort_by(f64::total_cmp);
     s.dedup();
     let opts = Options {
@@ -191,5 +195,26 @@ pub(super) fn refusal(reason: String, outcome: &Outcome) -> Error {
     Error::Unverified {
         what: "l(t)",
         reason: format!("{reason}{found}"),
+    }
+}
+
+/// The refusal of `l(t)` of a solution that failed its self-check
+/// ([`super::Solution::with_c4_lo_certifying`]) where the integration did not
+/// certify it: the self-check's reason and what the integration found.
+pub(super) fn refusal_unchecked(why: &str, outcome: &Outcome) -> Error {
+    let found = match outcome {
+        Outcome::Disagree(d, t) if *t == 0.0 => {
+            format!("; at t = 0 it misses l0 by {d:.1e} |l0|")
+        }
+        other => match refusal(String::new(), other) {
+            Error::Unverified { reason, .. } => reason,
+            e => e.to_string(),
+        },
+    };
+    Error::Unverified {
+        what: "l(t)",
+        reason: format!(
+            "{why}; l(t) is returned only where an integration of (1) certifies it{found}"
+        ),
     }
 }

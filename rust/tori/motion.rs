@@ -83,6 +83,12 @@ pub fn torus_of_motion(m: &Motion) -> Result<(RealTorus, [C; 2])> {
             m.kind().name()
         ),
     })?;
+    if let Some(why) = sol.certify_every() {
+        return Err(torus_refusal(Error::Unverified {
+            what: "solution of l0",
+            reason: why.to_string(),
+        }));
+    }
     let torus = flow_data(sol, &m.frame().second_flow_b()).and_then(|d| {
         Ok((
             real_torus_with_rates(&d.tau, &d.u, &d.u2, &d.chars, d.w.as_ref())?,
