@@ -267,7 +267,8 @@ class Solution:
     @property
     def self_check_passed(self) -> bool:
         """Whether the closed form passed its self-check (:attr:`self_check` at most
-        1e-10 and :attr:`velocity_check` at most 1e-6); True for the kinds other than
+        1e-10 and :attr:`velocity_check` at most 1e-6, and its theta quotients at
+        ``v0`` fit (1) for some velocity); True for the kinds other than
         ``"genus2"``.
 
         Where it did not, the solution is kept for its :meth:`l` only: each call

@@ -110,12 +110,17 @@ pub(super) struct Candidates<'a> {
     pub(super) c4: [f64; 6],
     pub(super) closed: &'a Result<([C; 2], dubrovin::LatticeRates)>,
     pub(super) check: SelfCheck,
+    /// Whether a pattern whose quotients fit (1) at `v0` for no velocity is
+    /// kept (for [`super::Solution::with_c4_lo_certifying`]) where no pattern
+    /// fits, instead of refused.
+    pub(super) certifying: bool,
 }
 
 impl Candidates<'_> {
     /// The quotients (9)-(10) with the constants `cl` and their self-check
-    /// defect.
-    fn build(&self, cl: [C; 7]) -> Result<(Defect, Built)> {
+    /// defect; where they fit (1) at `v0` for no velocity, that refusal
+    /// (returned as an error unless [`Candidates::certifying`]).
+    fn build(&self, cl: [C; 7]) -> Result<(Defect, Built, Option<Error>)> {
         let d = self.d;
         let big_g = self.at_v0.big_g(&d.state0, &self.sc, &cl, self.eps);
         let (num, den) = quotient_weights(&d.kotter, &self.sc, self.eps, big_g, &cl);
@@ -125,7 +130,11 @@ impl Candidates<'_> {
         // the fit gives the closed form its sign.
         let sys = VelocitySystem::at(&d.jet, &d.idx, &num, &den)?;
         let (fit, residual) = sys.rate(&self.c4, "U")?;
-        check_velocity_fit(residual)?;
+        let unfit = match check_velocity_fit(residual) {
+            Ok(()) => None,
+            Err(e) if self.certifying => Some(e),
+            Err(e) => return Err(e),
+        };
         let (rate, closed) = match self.closed {
             Ok((v, lat)) => {
                 let (s, dev) = dubrovin::sign_against(&d.curve, v, &fit);
@@ -156,6 +165,7 @@ impl Candidates<'_> {
             self.check
                 .defect(&d.plan, &d.curve, &d.idx, &built, &d.v0, &d.jet)?,
             built,
+            unfit,
         ))
     }
 
@@ -169,14 +179,29 @@ impl Candidates<'_> {
         calibration: &[f64; 7],
     ) -> Result<(Defect, Built, Result<()>)> {
         let mut best: Option<(Defect, Built)> = None;
+        // Where no pattern fits (1) at v0 (certifying only): the best of those
+        // that do not, with the refusal.
+        let mut best_unfit: Option<(Defect, Built, Error)> = None;
         let mut last_err: Option<Error> = None;
         for cl in sign_patterns(cl0, calibration) {
             match self.build(cl) {
-                Ok((d, b)) if best.as_ref().is_none_or(|(bd, _)| d.rank() < bd.rank()) => {
+                Ok((d, b, None)) if best.as_ref().is_none_or(|(bd, _)| d.rank() < bd.rank()) => {
                     best = Some((d, b))
+                }
+                Ok((d, b, Some(e)))
+                    if best_unfit
+                        .as_ref()
+                        .is_none_or(|(bd, _, _)| d.rank() < bd.rank()) =>
+                {
+                    best_unfit = Some((d, b, e))
                 }
                 Ok(_) => {}
                 Err(e) => last_err = Some(e),
+            }
+        }
+        if best.is_none() {
+            if let Some((d, b, e)) = best_unfit {
+                return Ok((d, b, Err(e)));
             }
         }
         let (defect, built) = match (best, last_err) {

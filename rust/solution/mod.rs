@@ -293,6 +293,7 @@ impl Solution {
             c4,
             closed: &closed,
             check: SelfCheck::new(a, l0, &c4),
+            certifying,
         };
         let (
             defect,
@@ -307,7 +308,7 @@ impl Solution {
         ) = cands.best(&cl0, &calibration)?;
         let certify_every = match verdict {
             Ok(()) => None,
-            Err(Error::Unverified { reason, .. })
+            Err(Error::Unverified { reason, .. } | Error::Singular { reason, .. })
                 if certifying && defect.shape.is_finite() && defect.velocity.is_finite() =>
             {
                 Some(reason)
