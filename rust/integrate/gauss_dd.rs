@@ -251,6 +251,22 @@ mod tests {
     }
 
     #[test]
+    fn a_cancelled_integration_stops() {
+        let c = [
+            Dd::new(1.0),
+            Dd::new(2.0),
+            Dd::new(3.0),
+            Dd::new(4.0),
+            Dd::new(5.0),
+            Dd::new(6.0),
+        ];
+        let cancel = Cancel::never();
+        cancel.cancel();
+        let got = gauss16_dd_so4(&c, &[1.0; 6], &[10.0], 0.01, &cancel);
+        assert!(matches!(got, Err(Error::Interrupted)), "{got:?}");
+    }
+
+    #[test]
     fn invalid_steps_and_times_are_refused() {
         let c = [Dd::new(1.0); 6];
         let l0 = [1.0; 6];
