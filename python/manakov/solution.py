@@ -138,7 +138,8 @@ class Solution:
         iteration of the reduction that did not converge. The message names
         the step; integrate the state instead. A closed form that fails its
         self-check (:attr:`self_check` above 1e-10 or :attr:`velocity_check`
-        above 1e-6) is returned marked (:attr:`self_check_passed` is False):
+        above 1e-6, or theta quotients that fit (1) at ``v0`` for no velocity)
+        is returned marked (:attr:`self_check_passed` is False):
         its :meth:`l` is then certified by an integration at every call, and
         what depends on its phase (:attr:`U`, :attr:`u0`, :attr:`torus`,
         :attr:`frequencies`, :attr:`constants`, the quotients) is refused.
@@ -357,12 +358,16 @@ class Solution:
 
     @property
     def u0(self) -> np.ndarray:
-        """``u0 = u(P1) + u(P2)`` at ``t = 0`` (Abel map, base point ∞; ``v0 = u0 + K``)."""
+        """``u0 = u(P1) + u(P2)`` at ``t = 0`` (Abel map, base point ∞; ``v0 = u0 + K``).
+
+        ``ClosedFormError`` where :attr:`self_check_passed` is False."""
         return _frozen(self._genus2("u0", checked=True).u0)
 
     @property
     def U(self) -> np.ndarray:  # noqa: N802 (the paper's name)
-        """``U``: ``u = u0 + U t'`` in the normalized time ``t' = T t``, from (1)."""
+        """``U``: ``u = u0 + U t'`` in the normalized time ``t' = T t``, from (1).
+
+        ``ClosedFormError`` where :attr:`self_check_passed` is False."""
         return _frozen(self._genus2("U", checked=True).rate)
 
     @property

@@ -175,8 +175,8 @@ pub struct Solution {
     /// bounds: the self-check's larger part where `U` is the quotients' fit,
     /// its velocity part where it is the closed form ([`check::drift_defect`]).
     drift_defect: f64,
-    /// Where the theta quotients failed the self-check (its reason) and the
-    /// solution was set up anyway ([`Solution::with_c4_lo_certifying`]):
+    /// Where the theta quotients failed the self-check or fit (1) at `v0` for
+    /// no velocity (the reason) and the solution was set up anyway ([`Solution::with_c4_lo_certifying`]):
     /// every `l(t)` is then certified by an integration of (1), at every call.
     certify_every: Option<String>,
     /// `|l0|` (`Σ l_ij²` is a Casimir of (1): `|l(t)| = |l0|`).
@@ -247,8 +247,8 @@ impl Solution {
     }
 
     /// [`Solution::with_c4_lo`], except that a solution whose theta quotients
-    /// fail the self-check (with a finite defect) is returned rather than
-    /// refused, marked ([`Solution::certify_every`]) so that its `l(t)` is
+    /// fail the self-check (with a finite defect), or fit (1) at `v0` for no
+    /// velocity, is returned rather than refused, marked ([`Solution::certify_every`]) so that its `l(t)` is
     /// returned only where an integration of (1) certifies it, at every call
     /// ([`verify`]): the self-check's points spread over the whole torus, and
     /// a solution that misses them may still be right where it is evaluated
@@ -729,9 +729,9 @@ impl Solution {
         self.certify_every.is_some() || self.drift_defect > DRIFT_DEFECT_FLOOR
     }
 
-    /// Where the theta quotients failed the self-check and the solution was
-    /// set up to be certified at every call
-    /// ([`Solution::with_c4_lo_certifying`]): the self-check's reason.
+    /// Where the theta quotients failed the self-check (or fit (1) at `v0` for
+    /// no velocity) and the solution was set up to be certified at every call
+    /// ([`Solution::with_c4_lo_certifying`]): the reason.
     pub fn certify_every(&self) -> Option<&str> {
         self.certify_every.as_deref()
     }

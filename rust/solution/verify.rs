@@ -87,6 +87,9 @@ pub(super) enum Outcome {
     /// the one in double-double would take this many steps (over
     /// [`VERIFY_DD_MAX_STEPS`]).
     DisagreeDdOverBudget(f64, f64, f64),
+    /// An integration's stage iteration did not converge at the default
+    /// step (its message).
+    NotConverged(String),
 }
 
 /// Integrates (1) from `l0` over `|times|` (all of one sign, `T` the largest
@@ -133,7 +136,10 @@ pub(super) fn certify(
         atol: 0.0,
         max_steps: (steps.ceil() as u64).saturating_add(s.len() as u64 + 16),
     };
-    let tr = integrate_with(&top(c4, sign)?, l0, 0.0, &s, &opts, cancel)?;
+    let tr = match integrate_with(&top(c4, sign)?, l0, 0.0, &s, &opts, cancel) {
+        Err(e @ Error::NoConvergence { .. }) => return Ok(Outcome::NotConverged(e.to_string())),
+        other => other?,
+    };
     let signed: Vec<f64> = s.iter().map(|t| sign * t).collect();
     let mut out = try_vec("samples", 6 * signed.len(), 0.0)?;
     closed(&signed, &mut out)?;
@@ -147,7 +153,10 @@ pub(super) fn certify(
         return Ok(Outcome::DisagreeDdOverBudget(worst.0, worst.1, dd_steps));
     }
     let c: [Dd; 6] = std::array::from_fn(|q| Dd::sum(sign * c4[q], sign * c4_lo[q]));
-    let y = gauss16_dd_so4(&c, l0, &s, dt, cancel)?;
+    let y = match gauss16_dd_so4(&c, l0, &s, dt, cancel) {
+        Err(e @ Error::NoConvergence { .. }) => return Ok(Outcome::NotConverged(e.to_string())),
+        other => other?,
+    };
     let worst = disagreement(&out, &y, &signed, size);
     Ok(if worst.0 <= VERIFY_RTOL {
         Outcome::Agree
@@ -181,6 +190,9 @@ pub(super) fn refusal(reason: String, outcome: &Outcome) -> Error {
         Outcome::Disagree(d, t) => format!(
             "; an integration of (1) (Gauss-Legendre order 16 in double-double) differs \
              from it by {d:.1e} |l0| at t = {t:e}"
+        ),
+        Outcome::NotConverged(why) => format!(
+            "; an integration of (1) to certify it did not converge at its default step ({why})"
         ),
         Outcome::DisagreeDdOverBudget(d, t, steps) => format!(
             "; an integration of (1) (Gauss-Legendre order 16) differs from it by \
