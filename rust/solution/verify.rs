@@ -182,10 +182,10 @@ fn disagreement(a: &[f64], b: &[f64], times: &[f64], size: f64) -> (f64, f64) {
     worst
 }
 
-/// The refusal of `l(t)` where the certificate failed: the drift check's
-/// reason and what the integration found.
-pub(super) fn refusal(reason: String, outcome: &Outcome) -> Error {
-    let found = match outcome {
+/// What a certifying integration found, as the end of a refusal's message
+/// (empty where it agrees).
+pub(super) fn found(outcome: &Outcome) -> String {
+    match outcome {
         Outcome::Agree => String::new(),
         Outcome::Disagree(d, t) => format!(
             "; an integration of (1) (Gauss-Legendre order 16 in double-double) differs \
@@ -203,10 +203,15 @@ pub(super) fn refusal(reason: String, outcome: &Outcome) -> Error {
             "; an integration of (1) to certify it would take {steps:.1e} steps \
              (more than {VERIFY_MAX_STEPS:e})"
         ),
-    };
+    }
+}
+
+/// The refusal of `l(t)` where the certificate failed: the drift check's
+/// reason and what the integration found.
+pub(super) fn refusal(reason: String, outcome: &Outcome) -> Error {
     Error::Unverified {
         what: "l(t)",
-        reason: format!("{reason}{found}"),
+        reason: format!("{reason}{}", found(outcome)),
     }
 }
 
@@ -218,10 +223,7 @@ pub(super) fn refusal_unchecked(why: &str, outcome: &Outcome) -> Error {
         Outcome::Disagree(d, t) if *t == 0.0 => {
             format!("; at t = 0 it misses l0 by {d:.1e} |l0|")
         }
-        other => match refusal(String::new(), other) {
-            Error::Unverified { reason, .. } => reason,
-            e => e.to_string(),
-        },
+        other => found(other),
     };
     Error::Unverified {
         what: "l(t)",
