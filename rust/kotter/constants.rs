@@ -107,6 +107,16 @@ pub struct KotterConstants {
 /// `F`; a root `s_p` at some `a_j` (then `√s_kl` is 0/0); `Δ_j^(3) = 0`
 /// (the pair `s1, s2` does not determine `m_j, n_j`); `d_j` zero or infinite.
 pub fn kotter_constants(a: &[f64; 4], l: &[f64; 6]) -> Result<KotterConstants> {
+    kotter_constants_soft(a, l, None)
+}
+
+/// [`kotter_constants`]; with `soft`, a failure of the structure check of
+/// `H0` is written there instead of refused ([`constants_impl`]).
+pub(crate) fn kotter_constants_soft(
+    a: &[f64; 4],
+    l: &[f64; 6],
+    soft: Option<&mut Option<String>>,
+) -> Result<KotterConstants> {
     check_a(a)?;
     check_finite("l", l)?;
     let h = integrals(a, l);
@@ -125,7 +135,7 @@ pub fn kotter_constants(a: &[f64; 4], l: &[f64; 6]) -> Result<KotterConstants> {
             })
             .sum()
     });
-    near_singular(l, constants_impl(a, &h, &p_at_a, Some((m, n))))
+    near_singular(l, constants_impl(a, &h, &p_at_a, Some((m, n)), soft))
 }
 
 /// Below this `|h0|/h1` the constants `ε` and `K` of the corrected (40) are set
@@ -186,7 +196,7 @@ pub(super) fn near_singular<T>(l: &[f64; 6], r: Result<T>) -> Result<T> {
 pub fn constants_from_h(a: &[f64; 4], h: &[f64; 4]) -> Result<KotterConstants> {
     check_finite("h", h)?;
     let p_at_a: [f64; 4] = std::array::from_fn(|i| (h[1] * a[i] - h[2]) * a[i] + h[3]);
-    constants_impl(a, h, &p_at_a, None)
+    constants_impl(a, h, &p_at_a, None, None)
 }
 
 /// `h1² − 4h0² = |m − n|² |m + n|²` from the state: the difference of squares
@@ -204,11 +214,17 @@ const DD_DISTINCT_RTOL: f64 = 1e-13;
 
 /// [`kotter_constants`] and [`constants_from_h`]: the roots of `F` (19)
 /// polished on their branches, then everything else from `(s_p, σ_p, F'(s_p))`.
+///
+/// `soft`: where given, a failure of the structure check of `H0`
+/// ([`STRUCTURE_RTOL`]) is written there instead of refused (for a solution
+/// that certifies every `l(t)` by an integration,
+/// `crate::solution::Solution::with_c4_lo_certifying`).
 fn constants_impl(
     a: &[f64; 4],
     h: &[f64; 4],
     p_at_a: &[f64; 4],
     mn: Option<([f64; 3], [f64; 3])>,
+    soft: Option<&mut Option<String>>,
 ) -> Result<KotterConstants> {
     check_a(a)?;
     let den = match mn {
@@ -235,7 +251,14 @@ fn constants_impl(
         k_keps_dd(&bc.abgd_dd, &bc.d_dd)
     };
     let [alpha, beta, gamma, delta] = bc.abgd_dd.map(|row| row.map(Cdd::to_c));
-    let (a_coef, b_coef, abgd39, eps, k) = h0_structure(&alpha, &beta, &gamma, &delta, &bc.d, kk)?;
+    let ((a_coef, b_coef, abgd39, eps, k), refusal) =
+        h0_structure(&alpha, &beta, &gamma, &delta, &bc.d, kk)?;
+    if let Some(e) = refusal {
+        match soft {
+            Some(slot) => super::note_soft(slot, e),
+            None => return Err(e),
+        }
+    }
     let round2 = |x: &[[Cdd; 3]; 4]| x.map(|row| row.map(Cdd::to_c));
     let lo2 = |x: &[[Cdd; 3]; 4]| x.map(|row| row.map(|z| z.sub(Cdd::new(z.to_c())).to_c()));
     Ok(KotterConstants {
@@ -980,7 +1003,7 @@ fn h0_structure(
     delta: &[C; 3],
     d: &[C; 3],
     (k, k_eps, k_over_kappa): (C, C, C),
-) -> Result<H0Structure> {
+) -> Result<(H0Structure, Option<Error>)> {
     let d4 = d[0] * d[1] * d[2];
     let ac: [C; 3] = std::array::from_fn(|j| alpha[j] * gamma[j]);
     let bc: [C; 3] = std::array::from_fn(|j| alpha[j] * delta[j] + beta[j] * gamma[j]);
@@ -1016,15 +1039,10 @@ fn h0_structure(
             / ((k_eps * k_eps).modulus() + (k * kappa / d4).modulus() * terms_e2)
     };
     let worst = r1.max(r2).max(r3);
-    if worst.is_nan() || worst > STRUCTURE_RTOL {
-        return Err(Error::InvalidArgument {
-            what: "Koetter constants",
-            reason: format!(
-                "H0 does not reduce to the form (38)/(40) on Koetter's quadrics: relative \
-                 residual {worst:e} > {STRUCTURE_RTOL:e}"
-            ),
-        });
+    if worst.is_nan() {
+        return Err(structure_refusal(worst));
     }
+    let refusal = (worst > STRUCTURE_RTOL).then(|| structure_refusal(worst));
     // (39) in closed form: the (40) representative p_j = Kε² d_j w_j,
     // q_j = 2Kε w_j, r_j = K w_j/d4 reduced to the form (38) (the representative
     // of that form is unique, so these are the paper's α, β, γ, δ).
@@ -1036,7 +1054,19 @@ fn h0_structure(
     let alpha39 = 0.5 * k_over_kappa * (kappa * eps2 + (e1 - d4) * (ONE - eps2 * d4 * d4));
     let (a_coef, b_coef) = coefficients_38(&ac, &bc, &cc, d);
     let abgd39 = [alpha39, beta39, gamma39, delta39];
-    Ok((a_coef, b_coef, abgd39, eps, k))
+    Ok(((a_coef, b_coef, abgd39, eps, k), refusal))
+}
+
+/// The refusal of level-set constants whose `H0` does not reduce to the form
+/// (38)/(40) ([`STRUCTURE_RTOL`]).
+fn structure_refusal(worst: f64) -> Error {
+    Error::InvalidArgument {
+        what: "Koetter constants",
+        reason: format!(
+            "H0 does not reduce to the form (38)/(40) on Koetter's quadrics: relative \
+             residual {worst:e} > {STRUCTURE_RTOL:e}"
+        ),
+    }
 }
 
 /// The residuals of the existence conditions of (38)–(39): they exist iff

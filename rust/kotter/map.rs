@@ -128,11 +128,27 @@ pub fn kotter(a: &[f64; 4], l: &[f64; 6]) -> Result<KotterState> {
 /// [`kotter`] for a state whose level-set constants are already known
 /// (e.g. along a trajectory). The constants must belong to `l`'s level set.
 pub fn kotter_with(constants: KotterConstants, l: &[f64; 6]) -> Result<KotterState> {
-    check_finite("l", l)?;
-    near_singular(l, kotter_with_impl(constants, l))
+    kotter_with_soft(constants, l, None)
 }
 
-fn kotter_with_impl(constants: KotterConstants, l: &[f64; 6]) -> Result<KotterState> {
+/// [`kotter_with`]; with `soft`, a disagreement of `g` with the corrected
+/// (42) ([`G42_RTOL`]) is written there instead of refused (for a solution
+/// that certifies every `l(t)` by an integration,
+/// `crate::solution::Solution::with_c4_lo_certifying`).
+pub(crate) fn kotter_with_soft(
+    constants: KotterConstants,
+    l: &[f64; 6],
+    soft: Option<&mut Option<String>>,
+) -> Result<KotterState> {
+    check_finite("l", l)?;
+    near_singular(l, kotter_with_impl(constants, l, soft))
+}
+
+fn kotter_with_impl(
+    constants: KotterConstants,
+    l: &[f64; 6],
+    soft: Option<&mut Option<String>>,
+) -> Result<KotterState> {
     let lp_dd = l_p_dd(&constants, l);
     let lp = lp_dd.map(|row| row.map(Cdd::to_c));
     let xi_dd: [Cdd; 3] = std::array::from_fn(|j| lp_dd[0][j].add(lp_dd[1][j].mul_i()));
@@ -206,7 +222,7 @@ fn kotter_with_impl(constants: KotterConstants, l: &[f64; 6]) -> Result<KotterSt
     let g42 = if h0_free { points.g } else { g42_at(p0)? };
     let mis = (points.g - g42).norm();
     if mis.is_nan() || mis > G42_RTOL * g42.norm() {
-        return Err(Error::InvalidArgument {
+        let e = Error::InvalidArgument {
             what: "state l",
             reason: format!(
                 "the corrected (42) g = sqrt(h0/K)/(1 - eps P0) = {} disagrees with g = {} \
@@ -214,7 +230,11 @@ fn kotter_with_impl(constants: KotterConstants, l: &[f64; 6]) -> Result<KotterSt
                 cnum(g42),
                 cnum(points.g)
             ),
-        });
+        };
+        match soft {
+            Some(slot) if !mis.is_nan() => super::note_soft(slot, e),
+            _ => return Err(e),
+        }
     }
     Ok(KotterState {
         constants,

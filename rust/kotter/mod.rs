@@ -48,10 +48,22 @@ mod roots;
 mod schottky;
 
 pub use batch::{kotter_batch, KotterBatch, ROW_BYTES};
+pub(crate) use constants::kotter_constants_soft;
+
+/// Adds the refusal `e` of a consistency check to the soft failures in `slot`
+/// (the reasons joined by "; ").
+pub(crate) fn note_soft(slot: &mut Option<String>, e: Error) {
+    let reason = e.to_string();
+    *slot = Some(match slot.take() {
+        Some(prev) => format!("{prev}; {reason}"),
+        None => reason,
+    });
+}
 pub use constants::{
     constants_from_h, kotter_constants, l_from_xi_eta, l_p, xi_eta, Coefficients23,
     KotterConstants, H0_NEGLIGIBLE_RTOL, NEAR_SINGULAR_RTOL, REAL_RTOL, STRUCTURE_RTOL,
 };
+pub(crate) use map::kotter_with_soft;
 pub use map::{
     follow_order, from_kotter, kotter, kotter_along, kotter_along_step, kotter_with, on_level_set,
     KotterState, G42_RTOL, LEVEL_SET_RTOL, UNIFORM_RTOL,

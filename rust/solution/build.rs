@@ -30,14 +30,23 @@ pub(super) struct Divisor0 {
 impl Divisor0 {
     /// The curve (8) of `l0`'s level set, the divisor of `l0` on it, its Abel
     /// image `u0`, `v0 = u0 + K` and the thetas of the seven labels at `v0`.
-    pub(super) fn new(a: &[f64; 4], l0: &[f64; 6]) -> Result<Self> {
+    ///
+    /// `soft`: where given, a failure of the reduction's consistency checks
+    /// (`H0`'s structure, the corrected (42)) is written there instead of
+    /// refused, for a solution that certifies every `l(t)`.
+    pub(super) fn new(
+        a: &[f64; 4],
+        l0: &[f64; 6],
+        mut soft: Option<&mut Option<String>>,
+    ) -> Result<Self> {
         let LevelSetCurve {
             kotter,
             kcurve: _,
             curve,
             chars,
-        } = level_set_curve(a, l0)?;
-        let state0 = kotter_with(kotter.clone(), l0).map_err(map_coinciding)?;
+        } = level_set_curve_soft(a, l0, soft.as_deref_mut())?;
+        let state0 =
+            crate::kotter::kotter_with_soft(kotter.clone(), l0, soft).map_err(map_coinciding)?;
         let tau_rm = curve.tau_row_major();
         let tau: [C; 4] = [tau_rm[0], tau_rm[1], tau_rm[2], tau_rm[3]];
         let plan = ThetaPlan::new(&tau, 2, THETA_TOL, 1)?.with_parallel(false);

@@ -94,6 +94,17 @@ pub struct LevelSetCurve {
 /// [`Error::Singular`] that names the reason. `h0 = 0` (rank-2 states) is a
 /// regular level set: the reduction takes its limit there (docs/degenerate.md).
 pub fn level_set_curve(a: &[f64; 4], l0: &[f64; 6]) -> Result<LevelSetCurve> {
+    level_set_curve_soft(a, l0, None)
+}
+
+/// [`level_set_curve`]; with `soft`, a failure of the structure check of
+/// `H0` is written there instead of refused
+/// ([`crate::kotter::kotter_constants_soft`]).
+pub(crate) fn level_set_curve_soft(
+    a: &[f64; 4],
+    l0: &[f64; 6],
+    soft: Option<&mut Option<String>>,
+) -> Result<LevelSetCurve> {
     crate::error::check_finite("l0", l0)?;
     let size = l0.iter().fold(0.0f64, |m, v| m.max(v.abs()));
     if size == 0.0 {
@@ -116,7 +127,7 @@ pub fn level_set_curve(a: &[f64; 4], l0: &[f64; 6]) -> Result<LevelSetCurve> {
             ),
         ));
     }
-    let kotter = kotter_constants(a, l0).map_err(map_coinciding)?;
+    let kotter = crate::kotter::kotter_constants_soft(a, l0, soft).map_err(map_coinciding)?;
     let [d1, d2, d3] = kotter.d;
     let kcurve = KotterCurve::new(d1, d2, d3).map_err(map_coinciding)?;
     let curve = HyperellipticCurve::new(&kcurve.branch_points()).map_err(map_coinciding)?;

@@ -40,7 +40,7 @@ use rayon::prelude::*;
 
 use crate::curve::{KotterCurve, CYCLIC};
 use crate::error::{Error, Result, SingularKind};
-use crate::kotter::{kotter_constants, kotter_with, KotterConstants, KotterState};
+use crate::kotter::{kotter_with, KotterConstants, KotterState};
 use crate::numeric::cancel::Cancel;
 use crate::numeric::complex::sqrt_principal;
 use crate::riemann::HyperellipticCurve;
@@ -66,6 +66,7 @@ pub use check::{
     DRIFT_DEFECT_FLOOR, DRIFT_RTOL, HORIZON_RTOL, PHASE_ROUNDING_RTOL, SELF_CHECK_RTOL,
     VELOCITY_CHECK_RTOL,
 };
+use level_set::level_set_curve_soft;
 pub use level_set::{a_periods_of, level_set_curve, LevelSetCurve};
 pub use setup::{INCONSISTENT, QUOTIENT_RESIDUAL_RTOL};
 
@@ -273,7 +274,10 @@ impl Solution {
         crate::error::check_finite("c", c4)?;
         crate::error::check_finite("c_lo", c4_lo)?;
         let c4 = *c4;
-        let d = Divisor0::new(a, l0)?;
+        // In the certifying set-up the reduction's consistency checks do not
+        // refuse: their failure marks the solution as certified at every call.
+        let mut soft_failure: Option<String> = None;
+        let d = Divisor0::new(a, l0, certifying.then_some(&mut soft_failure))?;
         let at_v0 = ThetaAtV0::new(&d.jet, &d.idx)?;
         let sc = d.state0.curve.c().map(sqrt_principal);
         let eps = eps41(&d.kotter);
@@ -307,11 +311,14 @@ impl Solution {
             verdict,
         ) = cands.best(&cl0, &calibration)?;
         let certify_every = match verdict {
-            Ok(()) => None,
+            Ok(()) => soft_failure,
             Err(Error::Unverified { reason, .. } | Error::Singular { reason, .. })
                 if certifying && defect.shape.is_finite() && defect.velocity.is_finite() =>
             {
-                Some(reason)
+                Some(match soft_failure {
+                    Some(soft) => format!("{soft}; {reason}"),
+                    None => reason,
+                })
             }
             Err(e) => return Err(e),
         };

@@ -525,6 +525,58 @@ fn a_closed_form_that_fails_its_self_check_is_certified_at_every_call() {
     }
 }
 
+/// Where the reduction's consistency check of `H0` fails (the structure of
+/// (38)/(40) to `STRUCTURE_RTOL`), `Solution::new` refuses and the dispatcher
+/// keeps the closed form for certified `l(t)` only. Draw 6962 of the harsh
+/// draw of tests/data/every_state_harsh.py: over its window the closed form is
+/// within 3.7e-15 of the long-double reference; here against Dormand–Prince
+/// 8(5,3) at `rtol = 1e-13`.
+#[test]
+fn a_closed_form_whose_reduction_fails_a_consistency_check_is_certified() {
+    let a = [
+        0.17700049525365547,
+        15.427468936185612,
+        15.43176840179547,
+        15.60421547726892,
+    ];
+    let b = [
+        -0.9354661695938984,
+        -0.8793661682337175,
+        -0.17490295097879338,
+        -0.19687089204856034,
+    ];
+    let l0 = [
+        52.34634905201653,
+        1.952336594296777e-05,
+        387682.3610158869,
+        0.0006532797520630181,
+        0.2665501519359027,
+        9.549702401413574e-05,
+    ];
+    let t_end = 1.5730502192091413e-05;
+    match Solution::new(&a, &b, &l0) {
+        Err(e) => assert!(e.to_string().contains("does not reduce"), "{e}"),
+        Ok(_) => panic!("not refused"),
+    }
+    let m = super::motion::Motion::new(&a, &b, &l0).unwrap();
+    let s = m.genus2().expect("a genus-2 motion");
+    assert!(s.certify_every().unwrap().contains("does not reduce"));
+    let times: Vec<f64> = (0..=50).map(|k| t_end * k as f64 / 50.0).collect();
+    let mut out = vec![0.0; 6 * times.len()];
+    m.l_batch(&times, &mut out, &Cancel::never()).unwrap();
+    let top = FrahmTop::manakov(&a, &b).unwrap();
+    let opts = Options {
+        method: Method::Dop853,
+        dt: 0.0,
+        rtol: 1e-13,
+        atol: 1e-16,
+        max_steps: 10_000_000,
+    };
+    let tr = integrate(&top, &l0, 0.0, &times, &opts).unwrap();
+    let scale = l0.iter().map(|v| v * v).sum::<f64>().sqrt();
+    assert!(max_rel(&out, &tr.y, scale) <= DRIFT_RTOL);
+}
+
 /// Next to an so(3) block the motion is slow, and the quotients' velocity along
 /// `U` meets Frahm's (1) only to ~ε of the scale of (1), 1e-7 relative to the
 /// speed: a state of the harsh draw (seed 5) that the self-check refused when it
