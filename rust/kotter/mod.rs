@@ -53,7 +53,12 @@ pub(crate) use constants::kotter_constants_soft;
 /// Adds the refusal `e` of a consistency check to the soft failures in `slot`
 /// (the reasons joined by "; ").
 pub(crate) fn note_soft(slot: &mut Option<String>, e: Error) {
-    let reason = e.to_string();
+    // "what: reason", as the set-up's refusals name a step (the state is
+    // valid: not "invalid ...").
+    let reason = match e {
+        Error::InvalidArgument { what, reason } => format!("{what}: {reason}"),
+        other => other.to_string(),
+    };
     *slot = Some(match slot.take() {
         Some(prev) => format!("{prev}; {reason}"),
         None => reason,
