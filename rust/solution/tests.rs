@@ -36,6 +36,22 @@ const SHORT_RTOL: f64 = 1e-11;
 /// [0, 10] 1e-11 holds with little margin, so this bound is 1e-10.
 const NEAR_DEGENERATE_RTOL: f64 = 1e-10;
 
+/// `max |out − l_ref| / |l0|` over `times`, `l_ref` from Dormand–Prince 8(5,3)
+/// at `rtol = 1e-13` on the top `(a, b)` from `l0`.
+fn rel_to_dop853(a: &[f64; 4], b: &[f64; 4], l0: &[f64; 6], times: &[f64], out: &[f64]) -> f64 {
+    let top = FrahmTop::manakov(a, b).unwrap();
+    let opts = Options {
+        method: Method::Dop853,
+        dt: 0.0,
+        rtol: 1e-13,
+        atol: 1e-16,
+        max_steps: 10_000_000,
+    };
+    let tr = integrate(&top, l0, 0.0, times, &opts).unwrap();
+    let scale = l0.iter().map(|v| v * v).sum::<f64>().sqrt();
+    max_rel(out, &tr.y, scale)
+}
+
 fn max_rel(a: &[f64], b: &[f64], scale: f64) -> f64 {
     a.iter()
         .zip(b)
@@ -499,17 +515,7 @@ fn a_closed_form_that_fails_its_self_check_is_certified_at_every_call() {
         let got = m.l_batch(&times, &mut out, &Cancel::never());
         if certified {
             got.unwrap();
-            let top = FrahmTop::manakov(&a, &b).unwrap();
-            let opts = Options {
-                method: Method::Dop853,
-                dt: 0.0,
-                rtol: 1e-13,
-                atol: 1e-16,
-                max_steps: 10_000_000,
-            };
-            let tr = integrate(&top, &l0, 0.0, &times, &opts).unwrap();
-            let scale = l0.iter().map(|v| v * v).sum::<f64>().sqrt();
-            assert!(max_rel(&out, &tr.y, scale) <= DRIFT_RTOL);
+            assert!(rel_to_dop853(&a, &b, &l0, &times, &out) <= DRIFT_RTOL);
         } else {
             match got {
                 Err(Error::Unverified {
@@ -564,17 +570,7 @@ fn a_closed_form_whose_reduction_fails_a_consistency_check_is_certified() {
     let times: Vec<f64> = (0..=50).map(|k| t_end * k as f64 / 50.0).collect();
     let mut out = vec![0.0; 6 * times.len()];
     m.l_batch(&times, &mut out, &Cancel::never()).unwrap();
-    let top = FrahmTop::manakov(&a, &b).unwrap();
-    let opts = Options {
-        method: Method::Dop853,
-        dt: 0.0,
-        rtol: 1e-13,
-        atol: 1e-16,
-        max_steps: 10_000_000,
-    };
-    let tr = integrate(&top, &l0, 0.0, &times, &opts).unwrap();
-    let scale = l0.iter().map(|v| v * v).sum::<f64>().sqrt();
-    assert!(max_rel(&out, &tr.y, scale) <= DRIFT_RTOL);
+    assert!(rel_to_dop853(&a, &b, &l0, &times, &out) <= DRIFT_RTOL);
 }
 
 /// Next to an so(3) block the motion is slow, and the quotients' velocity along
