@@ -138,8 +138,9 @@ class Solution:
         iteration of the reduction that did not converge. The message names
         the step; integrate the state instead. A closed form that fails its
         self-check (:attr:`self_check` above 1e-10 or :attr:`velocity_check`
-        above 1e-6, or theta quotients that fit (1) at ``v0`` for no velocity)
-        is returned marked (:attr:`self_check_passed` is False):
+        above 1e-6, theta quotients that fit (1) at ``v0`` for no velocity, or
+        level-set constants that fail the reduction's consistency checks) is
+        returned marked (:attr:`self_check_passed` is False):
         its :meth:`l` is then certified by an integration at every call, and
         what depends on its phase (:attr:`U`, :attr:`u0`, :attr:`torus`,
         :attr:`frequencies`, :attr:`constants`, the quotients) is refused.
@@ -267,10 +268,11 @@ class Solution:
 
     @property
     def self_check_passed(self) -> bool:
-        """Whether the closed form passed its self-check (:attr:`self_check` at most
-        1e-10 and :attr:`velocity_check` at most 1e-6, and its theta quotients at
-        ``v0`` fit (1) for some velocity); True for the kinds other than
-        ``"genus2"``.
+        """Whether the closed form passed its checks: the self-check
+        (:attr:`self_check` at most 1e-10 and :attr:`velocity_check` at most 1e-6),
+        the fit of its theta quotients to (1) at ``v0``, and the reduction's
+        consistency checks (the structure (38)/(40) of ``H0``, the corrected (42));
+        True for the kinds other than ``"genus2"``.
 
         Where it did not, the solution is kept for its :meth:`l` only: each call
         integrates (1) from ``l0`` to the requested times (Gauss–Legendre order 16
