@@ -285,6 +285,28 @@ fn trim_zeros(s: &str) -> &str {
     }
 }
 
+/// A check's refusal `e` that the caller may keep instead ("soft"): with a
+/// `slot` its reason is added there (reasons joined by "; ", each naming its
+/// step as the set-up's refusals do, without "invalid" or "no trustworthy":
+/// the state is valid) and `Ok(())` returned; without one, `Err(e)`. Used where
+/// a solution that certifies every `l(t)` by an integration keeps a closed
+/// form that failed a check (`crate::solution::Solution::with_c4_lo_certifying`).
+pub(crate) fn soften(slot: Option<&mut Option<String>>, e: Error) -> Result<()> {
+    let Some(slot) = slot else {
+        return Err(e);
+    };
+    let reason = match e {
+        Error::InvalidArgument { what, reason } => format!("{what}: {reason}"),
+        Error::Unverified { reason, .. } | Error::Singular { reason, .. } => reason,
+        other => other.to_string(),
+    };
+    *slot = Some(match slot.take() {
+        Some(prev) => format!("{prev}; {reason}"),
+        None => reason,
+    });
+    Ok(())
+}
+
 /// Checks that every entry of `x` is finite.
 pub fn check_finite(what: &'static str, x: &[f64]) -> Result<()> {
     match x.iter().position(|v| !v.is_finite()) {

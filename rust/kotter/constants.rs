@@ -254,10 +254,7 @@ fn constants_impl(
     let ((a_coef, b_coef, abgd39, eps, k), refusal) =
         h0_structure(&alpha, &beta, &gamma, &delta, &bc.d, kk)?;
     if let Some(e) = refusal {
-        match soft {
-            Some(slot) => super::note_soft(slot, e),
-            None => return Err(e),
-        }
+        crate::error::soften(soft, e)?;
     }
     let round2 = |x: &[[Cdd; 3]; 4]| x.map(|row| row.map(Cdd::to_c));
     let lo2 = |x: &[[Cdd; 3]; 4]| x.map(|row| row.map(|z| z.sub(Cdd::new(z.to_c())).to_c()));

@@ -231,10 +231,10 @@ fn kotter_with_impl(
                 cnum(points.g)
             ),
         };
-        match soft {
-            Some(slot) if !mis.is_nan() => super::note_soft(slot, e),
-            _ => return Err(e),
+        if mis.is_nan() {
+            return Err(e);
         }
+        crate::error::soften(soft, e)?;
     }
     Ok(KotterState {
         constants,

@@ -49,21 +49,6 @@ mod schottky;
 
 pub use batch::{kotter_batch, KotterBatch, ROW_BYTES};
 pub(crate) use constants::kotter_constants_soft;
-
-/// Adds the refusal `e` of a consistency check to the soft failures in `slot`
-/// (the reasons joined by "; ").
-pub(crate) fn note_soft(slot: &mut Option<String>, e: Error) {
-    // "what: reason", as the set-up's refusals name a step (the state is
-    // valid: not "invalid ...").
-    let reason = match e {
-        Error::InvalidArgument { what, reason } => format!("{what}: {reason}"),
-        other => other.to_string(),
-    };
-    *slot = Some(match slot.take() {
-        Some(prev) => format!("{prev}; {reason}"),
-        None => reason,
-    });
-}
 pub use constants::{
     constants_from_h, kotter_constants, l_from_xi_eta, l_p, xi_eta, Coefficients23,
     KotterConstants, H0_NEGLIGIBLE_RTOL, NEAR_SINGULAR_RTOL, REAL_RTOL, STRUCTURE_RTOL,

@@ -136,8 +136,8 @@ impl SolutionCore {
         self.sol.drift_defect()
     }
 
-    /// The self-check's reason where the solution failed it and each `l(t)`
-    /// is certified by an integration, else `None`.
+    /// The reasons where the closed form failed a check and each `l(t)` is
+    /// certified by an integration, else `None`.
     #[getter]
     fn certify_every(&self) -> Option<String> {
         self.sol.certify_every().map(str::to_string)

@@ -176,9 +176,10 @@ pub struct Solution {
     /// bounds: the self-check's larger part where `U` is the quotients' fit,
     /// its velocity part where it is the closed form ([`check::drift_defect`]).
     drift_defect: f64,
-    /// Where the theta quotients failed the self-check or fit (1) at `v0` for
-    /// no velocity (the reason) and the solution was set up anyway ([`Solution::with_c4_lo_certifying`]):
-    /// every `l(t)` is then certified by an integration of (1), at every call.
+    /// Where the closed form failed a check (the self-check, the fit of (1)
+    /// at `v0`, the reduction's consistency checks; the reasons) and was set
+    /// up anyway ([`Solution::with_c4_lo_certifying`]): every `l(t)` is then
+    /// certified by an integration of (1), at every call.
     certify_every: Option<String>,
     /// `|l0|` (`Σ l_ij²` is a Casimir of (1): `|l(t)| = |l0|`).
     size: f64,
@@ -248,9 +249,11 @@ impl Solution {
     }
 
     /// [`Solution::with_c4_lo`], except that a solution whose theta quotients
-    /// fail the self-check (with a finite defect), or fit (1) at `v0` for no
-    /// velocity, is returned rather than refused, marked ([`Solution::certify_every`]) so that its `l(t)` is
-    /// returned only where an integration of (1) certifies it, at every call
+    /// fail the self-check (with a finite defect) or fit (1) at `v0` for no
+    /// velocity, or whose reduction fails a consistency check, is returned
+    /// rather than refused, marked ([`Solution::certify_every`]) so that its
+    /// `l(t)` is returned only where an integration of (1) certifies it, at
+    /// every call
     /// ([`verify`]): the self-check's points spread over the whole torus, and
     /// a solution that misses them may still be right where it is evaluated
     /// (docs/degenerate.md, "Solutions that fail the self-check").
@@ -310,18 +313,12 @@ impl Solution {
             },
             verdict,
         ) = cands.best(&cl0, &calibration)?;
-        let certify_every = match verdict {
-            Ok(()) => soft_failure,
-            Err(Error::Unverified { reason, .. } | Error::Singular { reason, .. })
-                if certifying && defect.shape.is_finite() && defect.velocity.is_finite() =>
-            {
-                Some(match soft_failure {
-                    Some(soft) => format!("{soft}; {reason}"),
-                    None => reason,
-                })
-            }
-            Err(e) => return Err(e),
-        };
+        if let Err(e) = verdict {
+            // a failed check with a finite defect is kept (certifying only)
+            let keep = certifying && defect.shape.is_finite() && defect.velocity.is_finite();
+            crate::error::soften(keep.then_some(&mut soft_failure), e)?;
+        }
+        let certify_every = soft_failure;
         // the phase of the closed form where the checked pattern took it, else
         // of the fit
         let closed = if closed_used {
@@ -736,9 +733,8 @@ impl Solution {
         self.certify_every.is_some() || self.drift_defect > DRIFT_DEFECT_FLOOR
     }
 
-    /// Where the theta quotients failed the self-check (or fit (1) at `v0` for
-    /// no velocity) and the solution was set up to be certified at every call
-    /// ([`Solution::with_c4_lo_certifying`]): the reason.
+    /// Where the closed form failed a check and was set up to be certified at
+    /// every call ([`Solution::with_c4_lo_certifying`]): the reasons.
     pub fn certify_every(&self) -> Option<&str> {
         self.certify_every.as_deref()
     }
