@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import itertools
 import sys
+import warnings
 from pathlib import Path
 
 import numpy as np
@@ -153,13 +154,14 @@ HARSH_BOUND = 1e-10
 
 
 @pytest.mark.parametrize("case", [DRIFTING_STATE, DISAGREEING_STATE], ids=["agrees", "disagrees"])
-def test_a_drifting_phase_is_certified_or_refused_never_wrong(case) -> None:
+def test_a_drifting_phase_is_certified_or_integrated_never_wrong(case) -> None:
     """Each time of the window: l(t) within HARSH_BOUND of the long-double
-    reference, or refused (ClosedFormError, naming the integration that would
-    have certified it); never silently wrong. The drift estimate cannot vouch for
-    either state over its window; an integration of (1) certifies the first at
-    every time (the earlier code refused it from t = 0.04 on) and refuses the
-    second over the last 40 % of its window."""
+    reference, never silently wrong. The drift estimate cannot vouch for either
+    state over its window; an integration of (1) certifies the first at every
+    time (the earlier code refused it from t = 0.04 on); over the last 40 % of
+    the second's window the closed form is off, and the confirmed integration
+    stands in for it, with an IntegratedValuesWarning (the earlier code refused
+    those times)."""
     pytest.importorskip("heyoka")
     data = str(Path(__file__).resolve().parent / "data")
     if data not in sys.path:
@@ -173,20 +175,23 @@ def test_a_drifting_phase_is_certified_or_refused_never_wrong(case) -> None:
     sol = top.solve(l0)
     assert sol.drift_defect > 1e-12
     norm = float(np.linalg.norm(l0))
-    refused = 0
+    integrated = 0
     for tk, rk in zip(t, ref):
-        try:
+        before = sol.integrated_calls
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always", manakov.IntegratedValuesWarning)
             lk = sol.l(tk)
-        except manakov.ClosedFormError as e:
-            assert "an integration of (1)" in str(e)
-            refused += 1
-            continue
+        if sol.integrated_calls > before:
+            assert len(caught) == 1 and "stand in for it" in str(caught[0].message)
+            integrated += 1
+        else:
+            assert not caught
         err = float(np.max(np.abs(np.asarray(lk, dtype=np.longdouble) - rk)) / norm)
         assert err <= HARSH_BOUND, (tk, err)
     if case is DRIFTING_STATE:
-        assert refused == 0
+        assert integrated == 0
     else:
-        assert 0 < refused < len(t)
+        assert 0 < integrated < len(t)
 
 
 #: States of the harsh draw (every_state_harsh.py, draws 5646, 7603, 9978) on
@@ -340,14 +345,16 @@ def test_euler_kinds_refuse_beyond_the_phase_horizon(l0: list) -> None:
             sol.l(t)
 
 
-def test_valid_states_are_refused_only_with_closed_form_error() -> None:
-    """``solve`` raises ValueError only for invalid input: on 6000 states of the harsh
-    draw of tests/data/every_state_harsh.py (another seed), where the closed form is
-    refused for many (near equilibria and so(3) blocks, a repeated root of F (19),
-    an iteration that does not converge), every refusal is a ClosedFormError that
-    names the step and says the state is valid, and every returned solution
-    passed its self-check or is marked as not having passed it: then its phase
-    is refused, and its l(t) returned only where an integration certifies it."""
+def test_valid_states_always_get_a_solution() -> None:
+    """``solve`` raises only for invalid input: on 6000 states of the harsh draw of
+    tests/data/every_state_harsh.py (another seed), where the closed form cannot be
+    built for some (near equilibria and so(3) blocks, a repeated root of F (19), an
+    iteration that does not converge), each such state is of kind "integrated",
+    whose reason names the step and says the state is valid, and whose
+    frequencies are refused with ClosedFormError; every genus-2 solution passed
+    its self-check or is marked as not having passed it: then its phase is
+    refused, and its l(t) returned only where an integration certifies it or
+    stands in for it."""
     rng = np.random.default_rng(31)
     kinds: dict[str, int] = {}
     # 6000 states: as more of the draw is solved, 3000 came to reach only 7 refusals
@@ -357,11 +364,14 @@ def test_valid_states_are_refused_only_with_closed_form_error() -> None:
         b = rng.uniform(-1, 1) + np.concatenate(
             [[0.0], np.cumsum(10.0 ** rng.uniform(-3, 3, 3) * rng.choice([-1.0, 1.0], 3))]
         )
-        try:
-            sol = manakov.ManakovTop(a, b).solve(l0)
-        except manakov.ClosedFormError as e:
-            assert str(e).startswith("no trustworthy "), str(e)
-            kinds["refused"] = kinds.get("refused", 0) + 1
+        sol = manakov.ManakovTop(a, b).solve(l0)
+        if sol.kind == "integrated":
+            assert "the state is valid" in repr(sol), repr(sol)
+            with pytest.raises(manakov.ClosedFormError, match="frequencies are not known"):
+                _ = sol.frequencies
+            with pytest.raises(AttributeError, match="'integrated'"):
+                _ = sol.U
+            kinds["integrated"] = kinds.get("integrated", 0) + 1
             continue
         if sol.self_check_passed:
             assert sol.kind != "genus2" or (
@@ -382,8 +392,9 @@ def test_valid_states_are_refused_only_with_closed_form_error() -> None:
                 _ = sol.frequencies
             continue
         kinds["solved"] = kinds.get("solved", 0) + 1
-    # The draw does reach the refusals and unchecked solutions it is meant to test.
-    assert kinds.get("refused", 0) >= 10 and kinds.get("unchecked", 0) >= 10, kinds
+    # The draw does reach the states without a closed form and the unchecked
+    # solutions it is meant to test.
+    assert kinds.get("integrated", 0) >= 5 and kinds.get("unchecked", 0) >= 10, kinds
 
 
 #: States of the harsh random draw (tests/data/every_state_harsh.py, seed 5) on
@@ -1045,7 +1056,7 @@ def test_frequency_map_takes_the_checked_route_beyond_the_closed_forms_resolutio
 #: shape defect 1.9e-13), or whose level-set constants fail the check of H0's
 #: structure (38)/(40). The first, third and fourth are right along their windows
 #: (7.3e-14, 2.4e-13 and 3.7e-15 against the long-double reference), the second
-#: is not.
+#: is not (2.8e-9 |l0| from an integration in double-double at the end).
 UNCHECKED_STATES = [
     (
         [-0.9118629977757504, 398.46492300776555, 398.4661794162518, 402.2344698630952],
@@ -1108,8 +1119,9 @@ UNCHECKED_STATES = [
 def test_a_closed_form_failing_its_self_check_gives_only_certified_l(k: int) -> None:
     """``solve`` keeps the closed form, marked: its phase (U, frequencies) is
     refused, and l(t) is returned where an integration certifies it, within
-    HARSH_BOUND of the long-double reference; the wrong one is refused, never
-    returned (the earlier code refused all four at ``solve``)."""
+    HARSH_BOUND of the long-double reference; where the closed form is wrong the
+    confirmed integration stands in, with a warning, never the closed form (the
+    earlier code refused all four at ``solve``, then refused the wrong one's l)."""
     pytest.importorskip("heyoka")
     data = str(Path(__file__).resolve().parent / "data")
     if data not in sys.path:
@@ -1127,10 +1139,14 @@ def test_a_closed_form_failing_its_self_check_gives_only_certified_l(k: int) -> 
         ):
             getattr(sol, what)
     t = np.linspace(0.0, float(t_end), 51)
-    if k == 1:
-        with pytest.raises(manakov.ClosedFormError, match="certifies it"):
-            sol.l(t)
-        return
     ref = longdouble_ref.reference(a, b, l0, t)
-    err = float(np.max(np.abs(np.asarray(sol.l(t), dtype=np.longdouble) - ref)))
+    if k == 1:
+        with pytest.warns(manakov.IntegratedValuesWarning, match="fail the self-check"):
+            lt = sol.l(t)
+        assert sol.integrated_calls == 1
+    else:
+        lt = sol.l(t)
+        assert sol.integrated_calls == 0
+    assert np.array_equal(lt[0], l0)
+    err = float(np.max(np.abs(np.asarray(lt, dtype=np.longdouble) - ref)))
     assert err / float(np.linalg.norm(l0)) <= HARSH_BOUND

@@ -20,7 +20,7 @@ from .integrate import METHODS, Trajectory
 from .problems import Problem, benchmark_setup, problem, problem_names
 from .reduction import Kotter, LevelSet, from_kotter, kotter
 from .riemann import HyperellipticCurve
-from .solution import Solution
+from .solution import IntegratedValuesWarning, Solution
 from .theta import (
     CHARACTERISTICS,
     PAPER_CHARACTERISTICS,
@@ -52,6 +52,7 @@ __all__ = [
     "frequency_map",
     "FrequencyMap",
     "HyperellipticCurve",
+    "IntegratedValuesWarning",
     "from_kotter",
     "from_matrix",
     "KirchhoffBody",

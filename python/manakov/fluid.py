@@ -929,11 +929,12 @@ class KirchhoffBody:
             conjugate top's ``h0 = 0``) is not singular by itself, and the states
             on the conjugate top's exact degenerate sets (``p0 = 0``; ``M0``,
             ``p0`` on two axes) are solved in its closed form.
-        ClosedFormError
-            A valid state whose conjugate top's closed form could not be built
-            (the message names the step, as :meth:`manakov.ManakovTop.solve`) or
-            did not pass its own check (:attr:`manakov.Solution.self_check`,
-            :attr:`manakov.Solution.velocity_check`); no solution is returned.
+        Notes
+        -----
+        A valid state whose conjugate top's closed form cannot be built gets a
+        solution of kind ``"integrated"`` (``solution.kind``; the reason in its
+        ``repr``), whose :meth:`ClebschSolution.state` is an integration of the
+        conjugate top's (1), as :meth:`manakov.ManakovTop.solve` gives.
         """
         self._require_clebsch("solve")
         y, lead = _states(M0, p0, ("M0", "p0"))
@@ -1067,6 +1068,15 @@ class ClebschSolution:
         ------
         ValueError
             Non-finite ``t``.
+        ClosedFormError
+            As :meth:`manakov.Solution.l`.
+
+        Warns
+        -----
+        IntegratedValuesWarning
+            As :meth:`manakov.Solution.l`: the values are those of an integration
+            of the conjugate top's (1) where its closed form cannot be built
+            (``solution.kind == "integrated"``) or is off.
         """
         tt = _float_array(t, "t")
         l = self._solution.l(tt.reshape(-1))  # noqa: E741

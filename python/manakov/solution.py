@@ -29,6 +29,10 @@ and the closed forms where it degenerates.
   ``"separatrix"``: the same on the Euler top's separatrix (``tanh``, ``sech``).
 * ``"rest"`` (``l0 = 0``), ``"spherical"`` (all ``c_ij`` equal, ``b = α a + β``),
   ``"equilibrium"`` (``l̇ = 0`` by (1)): ``l(t) = l0``.
+* ``"integrated"``: a genus-2 state whose closed form cannot be built in double
+  precision (a step of the reduction refuses it; the message says which): ``l(t)``
+  is an integration of (1) in double-double, confirmed by one with every step halved, at every
+  call, with an :class:`IntegratedValuesWarning`.
 
 Every kind works from normalized data: ``l0/s``, ``a' = (a − κ)/σ``,
 ``c' = (c − μ)/λ`` (powers of two and exact shifts, the identity for moderate
@@ -38,6 +42,7 @@ homogeneous in ``l`` and blind to a common shift of the ``c_ij``).
 
 from __future__ import annotations
 
+import warnings
 from typing import Any, NamedTuple
 
 import numpy as np
@@ -47,14 +52,30 @@ from ._checks import _angles, _float_array, _one_state, _show, _states
 from ._torus import Torus
 from .riemann import HyperellipticCurve
 
-__all__ = ["KINDS", "LABELS", "EulerMotion", "Solution"]
+__all__ = ["KINDS", "LABELS", "EulerMotion", "IntegratedValuesWarning", "Solution"]
 
 #: Labels of the Wurzelfunktionen (27)–(28) entering (37) and (42), in the
 #: order of :attr:`Solution.constants` and :attr:`Solution.characteristics`.
 LABELS: tuple[str, ...] = ("P0", "P23", "P31", "P12", "P14", "P24", "P34")
 
 #: The kinds of :attr:`Solution.kind`.
-KINDS: tuple[str, ...] = ("genus2", "rest", "spherical", "equilibrium", "euler", "separatrix")
+
+
+class IntegratedValuesWarning(UserWarning):
+    """:meth:`Solution.l` returned values of an integration of (1) standing in for
+    the closed form: the closed form disagreed with it, and the same integration at
+    half its step confirmed them (the message says by how much each)."""
+
+
+KINDS: tuple[str, ...] = (
+    "genus2",
+    "rest",
+    "spherical",
+    "equilibrium",
+    "euler",
+    "separatrix",
+    "integrated",
+)
 
 _WHY = {
     "rest": "l0 = 0, the state does not move",
@@ -62,6 +83,7 @@ _WHY = {
     "equilibrium": "l0 is a stationary rotation (dl/dt = 0 by (1))",
     "euler": "l0 lies in an invariant so(3) and moves as an Euler top (elliptic functions)",
     "separatrix": "l0 lies in an invariant so(3), on the Euler top's separatrix",
+    "integrated": "its closed form could not be built; l(t) is an integration of (1)",
 }
 
 #: What the one-state calls of the solution point to for many states.
@@ -208,7 +230,10 @@ class Solution:
 
         ``"genus2"``: the Theorem (9)–(10); ``"euler"``: an Euler top in an
         so(3) block or a self-dual state (elliptic functions);
-        ``"separatrix"``: the same on its separatrix; ``"rest"``,
+        ``"separatrix"``: the same on its separatrix; ``"integrated"``: a
+        genus-2 state whose closed form could not be built (a step of the
+        reduction refused it), whose :meth:`l` is an integration of (1) in
+        double-double confirmed by one with every step halved, at every call; ``"rest"``,
         ``"spherical"``, ``"equilibrium"``: ``l(t) = l0``.
         """
         return str(self._motion.kind)
@@ -272,24 +297,29 @@ class Solution:
         (:attr:`self_check` at most 1e-10 and :attr:`velocity_check` at most 1e-6),
         the fit of its theta quotients to (1) at ``v0``, and the reduction's
         consistency checks (the structure (38)/(40) of ``H0``, the corrected (42));
-        True for the kinds other than ``"genus2"``.
+        True for the closed forms of the other kinds, False for ``"integrated"``
+        (no closed form).
 
         Where it did not, the solution is kept for its :meth:`l` only: each call
         integrates (1) from ``l0`` to the requested times (Gauss–Legendre order 16
         at its default step, in double and, where that disagrees, in double-double)
         and returns the closed form's values where the two agree to 5e-11
-        ``|l0|`` at every requested time, else raises ``ClosedFormError``. The
+        ``|l0|`` at every requested time, else the integration's own where it is
+        confirmed (:meth:`l`, Notes), else raises ``ClosedFormError``. The
         self-check's points spread over the whole torus, and a closed form that
         misses some of them can still be right along the part of the motion that is
         evaluated (docs/degenerate.md, "Solutions that fail the self-check").
         """
-        return self._core is None or self._core.certify_every is None
+        if self._core is None:
+            return self.kind != "integrated"
+        return self._core.certify_every is None
 
     def l(self, t: Any) -> np.ndarray:
         """The state at time(s) ``t``.
 
         By the Theorem (9)–(10) for a genus-2 state, Jacobi's elliptic
-        functions for an Euler top, ``l0`` for the constant kinds.
+        functions for an Euler top, ``l0`` for the constant kinds, an
+        integration of (1) for the kind ``"integrated"`` (Notes).
 
         Parameters
         ----------
@@ -306,27 +336,67 @@ class Solution:
         ValueError
             Non-finite ``t``.
         ClosedFormError
-            A genus-2 solution whose drift defect ``δ`` (:attr:`drift_defect`)
-            is above rounding (1e-12), at a ``t`` where the drift
-            ``δ |t| |dl/dt| / |l0|`` of its phase may exceed 5e-11 and an
-            integration of (1) from ``l0`` (Gauss–Legendre order 16 at its
-            default step, in double and, where that disagrees, in
-            double-double) does not certify it: it differs from the closed form
-            by more than 5e-11 ``|l0|``, or would take more than 2e6 steps (5e4
-            in double-double). Where it certifies ``l(t)`` the closed form's
-            values are returned (the first such call integrates; later calls
-            within the certified ``|t|`` do not). A genus-2 solution that
-            failed its self-check (:attr:`self_check_passed` False), at any
-            requested time where the same integration, run at every call, does
-            not agree with it to 5e-11 ``|l0|``. Any kind
-            with a moving phase, beyond its phase horizon: where the rounding
-            of the velocity alone (4 ulp) moves ``l(t)`` by more than 1e-6
-            ``|l0|`` (e.g. ``|t| ~ 1e12`` on a top and state of unit size),
-            the phase is no longer determined by double precision.
+            Where the closed form cannot be trusted at ``t`` and no integration
+            could stand in for it (below); and, for any kind with a moving phase,
+            beyond its phase horizon: where the rounding of the velocity alone
+            (4 ulp) moves ``l(t)`` by more than 1e-6 ``|l0|`` (e.g. ``|t| ~ 1e12``
+            on a top and state of unit size), the phase is no longer determined by
+            double precision.
+
+        Warns
+        -----
+        IntegratedValuesWarning
+            The values returned are those of an integration of (1), not of the
+            closed form (below); :attr:`integrated_calls` counts such calls.
+
+        Notes
+        -----
+        For the kind ``"integrated"`` every call integrates (1) from ``l0`` to the
+        requested times, in double-double at the default step and again with every
+        step halved until two successive runs agree to 5e-12 ``|l0|`` (within 2e5
+        steps in all), and returns the finest run's values, with an
+        :class:`IntegratedValuesWarning`; otherwise ``ClosedFormError``.
+
+        A genus-2 closed form is checked against an integration of (1) from ``l0``
+        (Gauss–Legendre order 16 at its default step, in double and, where that
+        disagrees, in double-double) where it cannot vouch for itself:
+
+        * when its drift defect ``δ`` (:attr:`drift_defect`) is above rounding
+          (1e-12), at the times where the drift ``δ |t| |dl/dt| / |l0|`` of its
+          phase may exceed 5e-11 (the first such call integrates; later calls
+          within the certified ``|t|`` do not);
+        * at every call and every requested time, when it failed its self-check
+          (:attr:`self_check_passed` False).
+
+        Where the two agree to 5e-11 ``|l0|`` at every requested time, the closed
+        form's values are returned. Where they do not, the closed form is the one
+        that is off if the same integration in double-double with every step
+        halved agrees with the one at the default step to 5e-12 ``|l0|`` (order 16:
+        the half step's truncation error is 2^-16 of the default step's; where they
+        differ by more, the steps are halved again until two successive runs agree):
+        then the finest run's values are returned, at every requested time of that
+        direction of time, with an :class:`IntegratedValuesWarning`. Otherwise, or
+        where the integrations would take more than 2e6 steps (2e5 in
+        double-double, all runs together), ``ClosedFormError``.
         """
         tt = _float_array(t, "t")
+        before = self.integrated_calls
         out = self._motion.l(np.ascontiguousarray(tt.reshape(-1)))
+        if self.integrated_calls != before:
+            warnings.warn(
+                f"l(t) of this state is an integration: {self._motion.stand_ins[1]}",
+                IntegratedValuesWarning,
+                stacklevel=2,
+            )
         return out.reshape(tt.shape + (6,))
+
+    @property
+    def integrated_calls(self) -> int:
+        """How many calls of :meth:`l` returned values of an integration of (1)
+        (each also warns, :class:`IntegratedValuesWarning`): every call for the kind
+        ``"integrated"``, those where it stood in for the closed form for
+        ``"genus2"`` (:meth:`l`, Notes), none for the other kinds."""
+        return int(self._motion.stand_ins[0])
 
     def abel(self, l: Any) -> np.ndarray:
         """The Abel image ``u(P1) + u(P2)`` (modulo the lattice) of states ``l``
@@ -549,4 +619,6 @@ class Solution:
         if e is not None:
             sub, w, _, regime, (m, _, _) = e
             return f"Solution(kind={self.kind!r}, {sub}, {regime}, m = {m:.12g})"
+        if self.kind == "integrated":
+            return f"Solution(kind='integrated', {self._motion.stand_ins[1]})"
         return f"Solution(kind={self.kind!r}, l = {self._l0.tolist()})"

@@ -852,23 +852,27 @@ class ManakovTop(FrahmTop):
         -------
         manakov.solution.Solution
             ``.kind`` (``"genus2"``, ``"euler"``, ``"separatrix"``,
-            ``"equilibrium"``, ``"spherical"``, ``"rest"``), ``.l(t)``,
-            ``.frequencies``; for ``"genus2"`` also ``.u0``, ``.U``, ``.tau``,
-            ``.curve``, ``.characteristics``, ``.constants``, ``.abel(l)``.
+            ``"equilibrium"``, ``"spherical"``, ``"rest"``, ``"integrated"``),
+            ``.l(t)``, ``.frequencies``; for ``"genus2"`` also ``.u0``, ``.U``,
+            ``.tau``, ``.curve``, ``.characteristics``, ``.constants``, ``.abel(l)``.
 
         Raises
         ------
         ValueError
             Not an so(4) top, or invalid ``l0`` (shape, non-finite values).
-        manakov.ClosedFormError
-            A valid state whose closed form could not be built (a level set on
-            which the Theorem's coordinates are singular to working precision;
-            the message names the step): integrate it instead. A closed form
-            that fails its self-check (``Solution.self_check`` above 1e-10 or
-            ``Solution.velocity_check`` above 1e-6) is returned marked
-            (``Solution.self_check_passed`` False): its ``l(t)`` is certified by
-            an integration at every call, its phase is refused
-            (docs/degenerate.md §10).
+
+        Notes
+        -----
+        Every valid state gets a solution. Where the closed form cannot be built
+        (a level set on which the Theorem's coordinates are singular to working
+        precision; the ``repr`` names the step) it is of kind ``"integrated"``: its
+        ``l(t)`` is an integration of (1) in double-double, confirmed with every
+        step halved, at every call, with an ``IntegratedValuesWarning``; it has
+        no frequencies. A closed form that fails its self-check
+        (``Solution.self_check`` above 1e-10 or ``Solution.velocity_check`` above
+        1e-6) is returned marked (``Solution.self_check_passed`` False): its
+        ``l(t)`` is certified by an integration at every call, or replaced by it
+        where it is off, and its phase is refused (docs/degenerate.md §10).
         """
         self._require_so4("solve")
         return Solution(self.a, self.b, l0)

@@ -30,9 +30,23 @@ const S: usize = 8;
 /// contraction ratio is ~0.2, and 106 bits take ~45 iterations.
 const MAX_ITER: usize = 120;
 
-/// The stage iteration has converged once its largest increment is below
-/// this fraction of the state's size (double-double rounding is ~1e-32).
-const STAGE_TOL: f64 = 1e-30;
+/// The stage iteration has converged once every component's increment is
+/// below this fraction of that component (double-double rounding is
+/// ~1e-32). Per component: on states whose components span many orders of
+/// magnitude, an increment small next to the largest component can still be
+/// a large change of a small one, and the motion amplifies exactly those.
+const STAGE_TOL: f64 = 1e-32;
+
+/// Components below this fraction of the largest count as this fraction of
+/// it in the convergence test (a component crossing zero has no relative
+/// precision to reach).
+const STAGE_FLOOR: f64 = 1e-12;
+
+/// Where the increments stop shrinking (rounding), the iteration has
+/// converged if they are below this: double-double's rounding of the field,
+/// `~1e-32` of its largest terms, is at most `1e-20` of a component at the
+/// floor.
+const STAGE_STALL: f64 = 1e-18;
 
 fn dd(p: [f64; 2]) -> Dd {
     Dd { hi: p[0], lo: p[1] }
@@ -78,6 +92,7 @@ fn field(d: &[Dd; 12], l: &[Dd; 6]) -> [Dd; 6] {
 fn step(d: &[Dd; 12], y: &mut [Dd; 6], h: Dd, k: &mut [[Dd; 6]; S]) -> Result<()> {
     let ha: [[Dd; S]; S] = std::array::from_fn(|i| std::array::from_fn(|j| h.mul(dd(A8_DD[i][j]))));
     let ymax = y.iter().fold(0.0f64, |m, v| m.max(v.hi.abs()));
+    let scale: [f64; 6] = std::array::from_fn(|q| y[q].hi.abs().max(STAGE_FLOOR * ymax));
     let mut last = f64::INFINITY;
     for iteration in 1..=MAX_ITER {
         let mut dmax = 0.0f64;
@@ -90,8 +105,8 @@ fn step(d: &[Dd; 12], y: &mut [Dd; 6], h: Dd, k: &mut [[Dd; 6]; S]) -> Result<()
                 }
             }
             *ni = field(d, &yi);
-            for (a, b) in ni.iter().zip(&k[i]) {
-                dmax = dmax.max(a.sub(*b).hi.abs());
+            for ((a, b), s) in ni.iter().zip(&k[i]).zip(&scale) {
+                dmax = dmax.max(a.sub(*b).hi.abs() / s);
             }
         }
         *k = next;
@@ -100,8 +115,8 @@ fn step(d: &[Dd; 12], y: &mut [Dd; 6], h: Dd, k: &mut [[Dd; 6]; S]) -> Result<()
             break;
         }
         // Converged, or stalled at rounding (the increments stopped shrinking
-        // once they are far below double precision).
-        if dmax <= STAGE_TOL * ymax || (dmax >= last && dmax <= 1e-26 * ymax) {
+        // once they are far below double precision next to the state's size).
+        if dmax <= STAGE_TOL || (dmax >= last && dmax <= STAGE_STALL) {
             for (bj, kj) in B8_DD.iter().zip(k.iter()) {
                 let hb = h.mul(dd(*bj));
                 for (v, kv) in y.iter_mut().zip(kj) {
@@ -118,34 +133,37 @@ fn step(d: &[Dd; 12], y: &mut [Dd; 6], h: Dd, k: &mut [[Dd; 6]; S]) -> Result<()
     Err(Error::NoConvergence {
         what: "Gauss stage iteration in double-double (step too large)",
         tol: STAGE_TOL,
-        reached: last / ymax,
+        reached: last,
         iterations: MAX_ITER,
     })
 }
 
 /// Steps [`gauss16_dd_so4`] takes to reach the sorted times `times` from 0 at
-/// steps of at most `dt`.
-pub(crate) fn gauss16_dd_steps(times: &[f64], dt: f64) -> f64 {
+/// steps of at most `dt`, each split in `split`.
+pub(crate) fn gauss16_dd_steps(times: &[f64], dt: f64, split: u32) -> f64 {
     let mut prev = 0.0;
     let mut n = 0.0;
     for &t in times {
         n += ((t - prev) / dt).ceil();
         prev = t;
     }
-    n
+    n * f64::from(split)
 }
 
 /// `l(t)` of (1) on so(4) from `l(0) = l0` at the sorted times `times ≥ 0`,
 /// for the coefficients `c` (state order) in double-double, by the 8-stage
 /// Gauss method in double-double at steps of at most `dt` (each interval
-/// between requested times in equal steps, their length in double-double).
-/// Returns the states rounded to double, 6 per time. The caller checks the
-/// step count ([`gauss16_dd_steps`]) against its budget first.
+/// between requested times in equal steps, their length in double-double),
+/// each split in `split` equal ones (`split = 2` halves every step, also
+/// where the interval is shorter than `dt`). Returns the states rounded to
+/// double, 6 per time. The caller checks the step count
+/// ([`gauss16_dd_steps`]) against its budget first.
 pub(crate) fn gauss16_dd_so4(
     c: &[Dd; 6],
     l0: &[f64; 6],
     times: &[f64],
     dt: f64,
+    split: u32,
     cancel: &Cancel,
 ) -> Result<Vec<f64>> {
     if !(dt > 0.0 && dt.is_finite()) {
@@ -167,7 +185,7 @@ pub(crate) fn gauss16_dd_so4(
     let mut prev = 0.0f64;
     for (row, &t) in out.chunks_exact_mut(6).zip(times) {
         let span = Dd::sum(t, -prev);
-        let n = (span.to_f64() / dt).ceil();
+        let n = (span.to_f64() / dt).ceil() * f64::from(split.max(1));
         if n > 0.0 {
             let h = span.div(Dd::new(n));
             for _ in 0..n as u64 {
@@ -214,7 +232,7 @@ mod tests {
         let times: Vec<f64> = (1..=20).map(|k| k as f64 * 2.5).collect();
         let dt = 0.05;
         let cdd = c4.map(Dd::new);
-        let dd_out = gauss16_dd_so4(&cdd, &l0, &times, dt, &Cancel::never()).unwrap();
+        let dd_out = gauss16_dd_so4(&cdd, &l0, &times, dt, 1, &Cancel::never()).unwrap();
         let opts = Options {
             method: Method::Gauss16,
             dt,
@@ -262,7 +280,7 @@ mod tests {
         ];
         let cancel = Cancel::never();
         cancel.cancel();
-        let got = gauss16_dd_so4(&c, &[1.0; 6], &[10.0], 0.01, &cancel);
+        let got = gauss16_dd_so4(&c, &[1.0; 6], &[10.0], 0.01, 1, &cancel);
         assert!(matches!(got, Err(Error::Interrupted)), "{got:?}");
     }
 
@@ -271,9 +289,10 @@ mod tests {
         let c = [Dd::new(1.0); 6];
         let l0 = [1.0; 6];
         let never = Cancel::never();
-        assert!(gauss16_dd_so4(&c, &l0, &[1.0], 0.0, &never).is_err());
-        assert!(gauss16_dd_so4(&c, &l0, &[2.0, 1.0], 0.1, &never).is_err());
-        assert!(gauss16_dd_so4(&c, &l0, &[-1.0], 0.1, &never).is_err());
-        assert_eq!(gauss16_dd_steps(&[0.25, 1.0], 0.1), 3.0 + 8.0);
+        assert!(gauss16_dd_so4(&c, &l0, &[1.0], 0.0, 1, &never).is_err());
+        assert!(gauss16_dd_so4(&c, &l0, &[2.0, 1.0], 0.1, 1, &never).is_err());
+        assert!(gauss16_dd_so4(&c, &l0, &[-1.0], 0.1, 1, &never).is_err());
+        assert_eq!(gauss16_dd_steps(&[0.25, 1.0], 0.1, 1), 3.0 + 8.0);
+        assert_eq!(gauss16_dd_steps(&[0.25, 1.0], 0.1, 2), 22.0);
     }
 }

@@ -125,8 +125,22 @@ impl MotionCore {
                 reason: "a genus-2 motion's frequencies are its torus's".into(),
             }
             .into()),
+            Kind::Integrated => Err(Error::Unverified {
+                what: "frequencies",
+                reason: format!(
+                    "{}; its frequencies are not known",
+                    self.motion.stand_ins().1
+                ),
+            }
+            .into()),
             _ => Ok([0.0, 0.0]),
         }
+    }
+
+    /// `(calls, why)` of [`Motion::stand_ins`].
+    #[getter]
+    fn stand_ins(&self) -> (u64, String) {
+        self.motion.stand_ins()
     }
 
     /// The real torus of a genus-2 motion: `(λ rows, coords rows, ν, U')`.

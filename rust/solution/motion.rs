@@ -10,6 +10,7 @@
 //! | [`Kind::Euler`] | an so(3) block or `n = ±m`, exactly | Jacobi elliptic functions ([`super::euler`]) |
 //! | [`Kind::Separatrix`] | the same, with `Δ = 0` | `tanh`, `sech` |
 //! | [`Kind::Genus2`] | every other state | the Theorem (9)–(10) ([`Solution`]) |
+//! | [`Kind::Integrated`] | a genus-2 state whose closed form cannot be built | an integration of (1) in double-double, confirmed by one with every step halved |
 //!
 //! The sets are tested exactly (components compared as doubles; the
 //! equilibrium and spherical tests at the rounding of their defining
@@ -44,17 +45,25 @@ pub enum Kind {
     Euler,
     /// The same on the separatrix of the Euler top (`m = 1`).
     Separatrix,
+    /// A genus-2 state whose closed form could not be built (a step of the
+    /// reduction refused it): `l(t)` by an integration of (1) in
+    /// double-double, confirmed by one with every step halved ([`verify`]), at every call.
+    /// Never a class of [`classify`]: the motion's body decides it.
+    ///
+    /// [`verify`]: super::verify
+    Integrated,
 }
 
 impl Kind {
     /// All kinds, in the order of their codes.
-    pub const ALL: [Kind; 6] = [
+    pub const ALL: [Kind; 7] = [
         Kind::Genus2,
         Kind::Rest,
         Kind::Spherical,
         Kind::Equilibrium,
         Kind::Euler,
         Kind::Separatrix,
+        Kind::Integrated,
     ];
 
     /// The name the Python API uses.
@@ -66,6 +75,7 @@ impl Kind {
             Kind::Equilibrium => "equilibrium",
             Kind::Euler => "euler",
             Kind::Separatrix => "separatrix",
+            Kind::Integrated => "integrated",
         }
     }
 
@@ -78,8 +88,17 @@ impl Kind {
 #[derive(Debug)]
 enum Body {
     Constant,
-    Euler { emb: Embedding, top: Box<EulerTop> },
+    Euler {
+        emb: Embedding,
+        top: Box<EulerTop>,
+    },
     Genus2(Arc<Solution>),
+    /// The step of the reduction that refused the closed form, and the count
+    /// of `l(t)` calls.
+    Integrated {
+        why: String,
+        calls: std::sync::atomic::AtomicU64,
+    },
 }
 
 /// A solved state of a Manakov top, of any [`Kind`].
@@ -125,6 +144,10 @@ pub(crate) fn refusal_of(what: &'static str, advice: &str, e: Error) -> Error {
     }
 }
 
+/// The end of the reason of a [`Kind::Integrated`] motion.
+const INTEGRATED: &str = "its l(t) is an integration of (1) in double-double, confirmed by \
+                          one with every step halved, at every call";
+
 /// Times per cancellation check in the closed forms (~1 ms).
 const CHUNK: usize = 16384;
 
@@ -135,9 +158,12 @@ impl Motion {
     /// Normalizes, classifies and solves the state `l0` of the top `(a, b)`.
     ///
     /// Errors: invalid `a`, `b` or `l0` (non-finite, repeated `a_i`), the
-    /// only ones on the input; a valid state whose closed form cannot be built
-    /// or fails its self-check gets [`Error::Unverified`] naming the step (for
-    /// the genus-2 kind the errors of [`Solution::with_c4`], re-worded).
+    /// only ones on the input. A valid genus-2 state whose closed form cannot
+    /// be built is of kind [`Kind::Integrated`], the step that refused it in
+    /// [`Motion::stand_ins`]; one whose closed form fails a check is kept for
+    /// certified `l(t)` ([`Solution::with_c4_lo_certifying`]). An Euler state
+    /// whose closed form cannot be built gets [`Error::Unverified`] naming the
+    /// step.
     pub fn new(a: &[f64; 4], b: &[f64; 4], l0: &[f64; 6]) -> Result<Self> {
         crate::error::check_finite("l0", l0)?;
         let frame = TopFrame::new(a, b)?;
@@ -174,10 +200,24 @@ impl Motion {
                     top: Box::new(top),
                 }
             }
-            Kind::Genus2 => Body::Genus2(Arc::new(
-                Solution::with_c4_lo_certifying(&frame.a, &frame.c4, &frame.c4_lo, &ln)
-                    .map_err(refusal)?,
-            )),
+            Kind::Genus2 | Kind::Integrated => {
+                match Solution::with_c4_lo_certifying(&frame.a, &frame.c4, &frame.c4_lo, &ln) {
+                    Ok(s) => Body::Genus2(Arc::new(s)),
+                    // The closed form cannot be built: the motion is the
+                    // integration's (cancellation and size errors pass).
+                    Err(e) => match refusal_of("closed form for this l0", INTEGRATED, e) {
+                        Error::Unverified { reason, .. } => Body::Integrated {
+                            why: reason,
+                            calls: std::sync::atomic::AtomicU64::new(0),
+                        },
+                        other => return Err(other),
+                    },
+                }
+            }
+        };
+        let kind = match body {
+            Body::Integrated { .. } => Kind::Integrated,
+            _ => kind,
         };
         Ok(Motion {
             kind,
@@ -247,8 +287,80 @@ impl Motion {
         match &self.body {
             Body::Constant => Some(0.0),
             Body::Euler { top, .. } => Some(top.frequency() * self.time_scale),
-            Body::Genus2(_) => None,
+            Body::Genus2(_) | Body::Integrated { .. } => None,
         }
+    }
+
+    /// `(calls, why)`: how many `l(t)` calls returned values of an
+    /// integration of (1) (all of them for [`Kind::Integrated`]; those where
+    /// it stood in for the closed form for [`Kind::Genus2`],
+    /// [`Solution::stand_ins`]) and why the last one did; `(0, "")` for the
+    /// other kinds.
+    pub fn stand_ins(&self) -> (u64, String) {
+        match &self.body {
+            Body::Integrated { why, calls } => (
+                calls.load(std::sync::atomic::Ordering::Relaxed),
+                why.clone(),
+            ),
+            Body::Genus2(sol) => sol.stand_ins(),
+            _ => (0, String::new()),
+        }
+    }
+
+    /// `l(t_k)` of a [`Kind::Integrated`] motion: per direction of time, one
+    /// confirmed integration in double-double over the requested times (in
+    /// the normalized frame).
+    fn integrated_rows(
+        &self,
+        why: &str,
+        t: &[f64],
+        out: &mut [f64],
+        cancel: &Cancel,
+    ) -> Result<()> {
+        let ln = self.l0.map(|v| v / self.scale);
+        let size = ln.iter().map(|x| x * x).sum::<f64>().sqrt();
+        let ts: Vec<f64> = t.iter().map(|&x| self.time_scale * x).collect();
+        crate::error::check_finite("t x time scale", &ts)?;
+        for (o, &tk) in out.chunks_exact_mut(6).zip(&ts) {
+            if tk == 0.0 {
+                o.copy_from_slice(&self.l0);
+            }
+        }
+        for sign in [1.0, -1.0] {
+            let mut s: Vec<f64> = ts
+                .iter()
+                .filter(|&&x| x * sign > 0.0)
+                .map(|x| x.abs())
+                .collect();
+            if s.is_empty() {
+                continue;
+            }
+            s.sort_by(f64::total_cmp);
+            s.dedup();
+            let (y, _) = super::verify::integrate_confirmed(
+                &self.frame.c4,
+                &self.frame.c4_lo,
+                &ln,
+                size,
+                sign,
+                s.clone(),
+                cancel,
+            )?
+            .map_err(|e| Error::Unverified {
+                what: "l(t)",
+                reason: format!("{why}; {e}"),
+            })?;
+            super::verify::stand_in_rows(&ts, sign, &s, &y, out);
+            for (o, &tk) in out.chunks_exact_mut(6).zip(&ts) {
+                if tk * sign > 0.0 && self.scale != 1.0 {
+                    o.iter_mut().for_each(|v| *v *= self.scale);
+                }
+            }
+        }
+        if let Body::Integrated { calls, .. } = &self.body {
+            calls.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+        }
+        Ok(())
     }
 
     /// The rows `l(t_k)` of one block of times: the closed forms of the
@@ -282,6 +394,7 @@ impl Motion {
                 }
                 Ok(())
             }
+            Body::Integrated { why, .. } => self.integrated_rows(why, t, out, cancel),
             Body::Genus2(sol) => {
                 if self.time_scale == 1.0 && self.scale == 1.0 {
                     // The generic path, unchanged.
@@ -314,7 +427,9 @@ impl Motion {
             });
         }
         crate::error::check_finite("t", t)?;
-        if let Body::Genus2(_) = &self.body {
+        if let Body::Genus2(_) | Body::Integrated { .. } = &self.body {
+            // Their own batches: the genus-2 one splits over threads itself,
+            // the integration runs once from 0 over all the times.
             return self.rows(t, out, cancel);
         }
         rows_in_parallel(t, out, cancel, CHUNK, PAR_PIECE, |tp, op| {

@@ -19,8 +19,12 @@
 //! and the motion carries it to the whole state (docs/degenerate.md). The same
 //! method in double-double ([`gauss16_dd_so4`], rounding `~1e-32 |l0|`, the
 //! top's `c_ij` in double-double) then decides, within
-//! [`VERIFY_DD_MAX_STEPS`]. Where it too disagrees, or the integrations would
-//! exceed their budgets, `l(t)` is refused as before.
+//! [`VERIFY_DD_MAX_STEPS`]. Where it too disagrees, the closed form is the one
+//! that is off if the same integration with every step halved agrees with it
+//! to [`STAND_IN_SPREAD`] (the steps halved again until two successive runs
+//! do, within [`STAND_IN_MAX_STEPS`]): then the finest run's values stand in
+//! for the closed form's ([`Outcome::Integrated`]). Otherwise, or where the
+//! integrations would exceed their budgets, `l(t)` is refused.
 
 use crate::error::{Error, Result};
 use crate::integrate::gauss_dd::{gauss16_dd_so4, gauss16_dd_steps};
@@ -43,6 +47,23 @@ pub const VERIFY_MAX_STEPS: f64 = 2e6;
 /// Most steps the double-double integration may take per direction of time
 /// where the one in double disagrees (~40 µs a step, so ~2 s).
 pub const VERIFY_DD_MAX_STEPS: f64 = 5e4;
+
+/// Largest spread `max |l_h − l_{h/2}| / |l0|` of two successive
+/// double-double integrations for the finer one to stand in for the closed
+/// form: a tenth of [`VERIFY_RTOL`]. Where truncation dominates, the finer
+/// run is `2^16` times better than the spread; where the rounding of
+/// double-double, amplified by the motion, does (components spanning twelve
+/// orders of magnitude), halving the step does not shrink the spread, which
+/// then estimates the error only to a factor of a few (draw 3797 of
+/// tests/data/every_state_harsh.py: spread 1.9e-11, error 8.1e-11 against
+/// quadruple precision).
+pub const STAND_IN_SPREAD: f64 = VERIFY_RTOL / 10.0;
+
+/// Most steps, all runs together, of the double-double integrations that
+/// confirm the one standing in for a closed form that is off (the default
+/// step, then halved until two successive runs agree): `~40 µs` a step, so
+/// `~8 s`.
+pub const STAND_IN_MAX_STEPS: f64 = 4.0 * VERIFY_DD_MAX_STEPS;
 
 /// Samples of the certifying integration on `(0, T]` besides the requested
 /// times: the error of a phase drift grows with `|t|`, and a grid sees it
@@ -79,8 +100,6 @@ fn top(c4: &[f64; 6], sign: f64) -> Result<FrahmTop> {
 pub(super) enum Outcome {
     /// Closed form and integration agree to [`VERIFY_RTOL`] `|l0|`.
     Agree,
-    /// They disagree by this much (relative to `|l0|`), at this time.
-    Disagree(f64, f64),
     /// The integration would take this many steps (over [`VERIFY_MAX_STEPS`]).
     OverBudget(f64),
     /// The integration in double disagrees by this much at this time, and
@@ -90,6 +109,25 @@ pub(super) enum Outcome {
     /// An integration's stage iteration did not converge at the default
     /// step (its message).
     NotConverged(String),
+    /// The closed form is off by `off` (relative to `|l0|`) at time
+    /// `off_at`, and two successive integrations in double-double (the
+    /// default step, halved until they do) agree to `spread` ≤
+    /// [`STAND_IN_SPREAD`] at every sample: the finer one's values stand in
+    /// for the closed form's.
+    Integrated {
+        /// The absolute values of the sampled times, sorted (every requested
+        /// time is one of them).
+        times: Vec<f64>,
+        /// `l` at `sign · times[k]`, 6 per time (the finest integration).
+        y: Vec<f64>,
+        off: f64,
+        off_at: f64,
+        spread: f64,
+    },
+    /// The closed form is off by this much at this time, and no two
+    /// successive double-double integrations within [`STAND_IN_MAX_STEPS`]
+    /// agree (why, in words).
+    Unconfirmed(f64, f64, String),
 }
 
 /// Integrates (1) from `l0` over `|times|` (all of one sign, `T` the largest
@@ -148,21 +186,145 @@ pub(super) fn certify(
         return Ok(Outcome::Agree);
     }
     // The double integration may be the one that is off: double-double decides.
-    let dd_steps = gauss16_dd_steps(&s, dt);
+    let dd_steps = gauss16_dd_steps(&s, dt, 1);
     if dd_steps > VERIFY_DD_MAX_STEPS {
         return Ok(Outcome::DisagreeDdOverBudget(worst.0, worst.1, dd_steps));
     }
     let c: [Dd; 6] = std::array::from_fn(|q| Dd::sum(sign * c4[q], sign * c4_lo[q]));
-    let y = match gauss16_dd_so4(&c, l0, &s, dt, cancel) {
+    let y = match gauss16_dd_so4(&c, l0, &s, dt, 1, cancel) {
         Err(e @ Error::NoConvergence { .. }) => return Ok(Outcome::NotConverged(e.to_string())),
         other => other?,
     };
     let worst = disagreement(&out, &y, &signed, size);
-    Ok(if worst.0 <= VERIFY_RTOL {
-        Outcome::Agree
+    if worst.0 <= VERIFY_RTOL {
+        return Ok(Outcome::Agree);
+    }
+    stand_in(&c, l0, size, sign, times, grid, (s, y), dt, worst, cancel)
+}
+
+/// Where the closed form and the double-double integration disagree: the
+/// closed form is the one that is off when the same integration at half the
+/// step agrees with it to [`STAND_IN_SPREAD`] (order 16: the half step's
+/// truncation error is `2^-16` of the default step's, so their difference
+/// measures the default step's error, and bounds the half step's; where it
+/// does not, the step is halved again, within [`STAND_IN_MAX_STEPS`]). Then
+/// the finest run's values stand in for the closed form's
+/// ([`Outcome::Integrated`]), at every requested time.
+#[allow(clippy::too_many_arguments)]
+fn stand_in(
+    c: &[Dd; 6],
+    l0: &[f64; 6],
+    size: f64,
+    sign: f64,
+    times: &[f64],
+    grid: bool,
+    (s, y): (Vec<f64>, Vec<f64>),
+    dt: f64,
+    (off, off_at): (f64, f64),
+    cancel: &Cancel,
+) -> Result<Outcome> {
+    // Where the requested times were too many to compare one by one, they
+    // were not integrated to: the stand-in needs every one of them.
+    let (s, y) = if grid && times.len() > VERIFY_MAX_TIMES {
+        let mut all: Vec<f64> = times.iter().map(|t| t.abs()).collect();
+        all.extend_from_slice(&s);
+        all.sort_by(f64::total_cmp);
+        all.dedup();
+        (all, Vec::new())
     } else {
-        Outcome::Disagree(worst.0, worst.1)
+        (s, y)
+    };
+    let run = |split: u32| -> Result<std::result::Result<Vec<f64>, Outcome>> {
+        match gauss16_dd_so4(c, l0, &s, dt, split, cancel) {
+            Err(e @ Error::NoConvergence { .. }) => Ok(Err(Outcome::NotConverged(e.to_string()))),
+            other => other.map(Ok),
+        }
+    };
+    let mut spent = gauss16_dd_steps(&s, dt, 1);
+    if spent + gauss16_dd_steps(&s, dt, 2) > STAND_IN_MAX_STEPS {
+        return Ok(Outcome::Unconfirmed(
+            off,
+            off_at,
+            format!(
+                "an integration in double-double at the default step and one with every \
+                 step halved would take {:.1e} steps (more than {STAND_IN_MAX_STEPS:e})",
+                spent + gauss16_dd_steps(&s, dt, 2)
+            ),
+        ));
+    }
+    let mut coarse = if y.is_empty() {
+        match run(1)? {
+            Ok(v) => v,
+            Err(o) => return Ok(o),
+        }
+    } else {
+        y
+    };
+    let signed: Vec<f64> = s.iter().map(|t| sign * t).collect();
+    // Halve every step until two successive integrations agree (each halving
+    // divides the truncation error by 2^16 once in the asymptotic regime).
+    // Every step, not the bound `dt`: between close requested times the steps
+    // are shorter than `dt`, and a smaller bound would leave them as they are.
+    let mut split = 1u32;
+    let mut spread = f64::INFINITY;
+    let mut before = f64::INFINITY;
+    while spread > STAND_IN_SPREAD {
+        // Truncation shrinks the spread `2^16`-fold a halving; where it does
+        // not shrink even 4-fold, rounding dominates, and finer steps would
+        // only spend the budget (states next to an unstable rotation, whose
+        // small components the motion amplifies exponentially).
+        if spread > before / 4.0 {
+            let why = format!(
+                "the integrations with every step split in {}, {} and {} differ by \
+                 {before:.1e} and {spread:.1e} |l0| (more than {STAND_IN_SPREAD:.0e}): the \
+                 spread does not shrink with the step (rounding, amplified by the motion)",
+                split / 4,
+                split / 2,
+                split
+            );
+            return Ok(Outcome::Unconfirmed(off, off_at, why));
+        }
+        let next = gauss16_dd_steps(&s, dt, 2 * split);
+        if spent + next > STAND_IN_MAX_STEPS {
+            let why = format!(
+                "the integrations with every step split in {} and in {} differ by \
+                 {spread:.1e} |l0| (more than {STAND_IN_SPREAD:.0e}), and a finer one would \
+                 exceed {STAND_IN_MAX_STEPS:e} steps",
+                split / 2,
+                split
+            );
+            return Ok(Outcome::Unconfirmed(off, off_at, why));
+        }
+        split *= 2;
+        spent += next;
+        let fine = match run(split)? {
+            Ok(v) => v,
+            Err(o) => return Ok(o),
+        };
+        before = spread;
+        spread = disagreement(&coarse, &fine, &signed, size).0;
+        coarse = fine;
+    }
+    Ok(Outcome::Integrated {
+        times: s,
+        y: coarse,
+        off,
+        off_at,
+        spread,
     })
+}
+
+/// Writes the stand-in's values ([`Outcome::Integrated`]) into the rows of
+/// `out` whose time `t_k` has the sign `sign`.
+pub(super) fn stand_in_rows(t: &[f64], sign: f64, times: &[f64], y: &[f64], out: &mut [f64]) {
+    for (&tk, row) in t.iter().zip(out.chunks_exact_mut(6)) {
+        if tk * sign > 0.0 {
+            let k = times
+                .binary_search_by(|x| x.total_cmp(&tk.abs()))
+                .expect("every requested time is sampled");
+            row.copy_from_slice(&y[6 * k..6 * k + 6]);
+        }
+    }
 }
 
 /// The largest `max_q |a_q − b_q| / size` over the rows (a NaN counts as
@@ -186,10 +348,10 @@ fn disagreement(a: &[f64], b: &[f64], times: &[f64], size: f64) -> (f64, f64) {
 /// (empty where it agrees).
 pub(super) fn found(outcome: &Outcome) -> String {
     match outcome {
-        Outcome::Agree => String::new(),
-        Outcome::Disagree(d, t) => format!(
+        Outcome::Agree | Outcome::Integrated { .. } => String::new(),
+        Outcome::Unconfirmed(d, t, why) => format!(
             "; an integration of (1) (Gauss-Legendre order 16 in double-double) differs \
-             from it by {d:.1e} |l0| at t = {t:e}"
+             from it by {d:.1e} |l0| at t = {t:e}, and {why}"
         ),
         Outcome::NotConverged(why) => format!(
             "; an integration of (1) to certify it did not converge at its default step ({why})"
@@ -219,16 +381,50 @@ pub(super) fn refusal(reason: String, outcome: &Outcome) -> Error {
 /// ([`super::Solution::with_c4_lo_certifying`]) where the integration did not
 /// certify it: the self-check's reason and what the integration found.
 pub(super) fn refusal_unchecked(why: &str, outcome: &Outcome) -> Error {
-    let found = match outcome {
-        Outcome::Disagree(d, t) if *t == 0.0 => {
-            format!("; at t = 0 it misses l0 by {d:.1e} |l0|")
-        }
-        other => found(other),
-    };
+    let found = found(outcome);
     Error::Unverified {
         what: "l(t)",
         reason: format!(
             "{why}; l(t) is returned only where an integration of (1) certifies it{found}"
         ),
     }
+}
+
+/// `l(±t_k)` of (1) from `l0` at the sorted times `times ≥ 0` (`sign` the
+/// direction), by Gauss–Legendre order 16 in double-double at the default
+/// step, halved until two successive runs agree to [`STAND_IN_SPREAD`] `|l0|`
+/// at every time (within [`STAND_IN_MAX_STEPS`]): the rows, 6 per time, and
+/// their spread. Where they do not agree, or an iteration does not
+/// converge, `Ok(Err(why))`. The motion of a state without a closed form
+/// ([`super::motion::Kind::Integrated`]).
+pub(super) fn integrate_confirmed(
+    c4: &[f64; 6],
+    c4_lo: &[f64; 6],
+    l0: &[f64; 6],
+    size: f64,
+    sign: f64,
+    times: Vec<f64>,
+    cancel: &Cancel,
+) -> Result<std::result::Result<(Vec<f64>, f64), String>> {
+    let c: [Dd; 6] = std::array::from_fn(|q| Dd::sum(sign * c4[q], sign * c4_lo[q]));
+    let dt = default_dt(c4, size);
+    let outcome = stand_in(
+        &c,
+        l0,
+        size,
+        sign,
+        &[],
+        false,
+        (times, Vec::new()),
+        dt,
+        (f64::NAN, 0.0),
+        cancel,
+    )?;
+    Ok(match outcome {
+        Outcome::Integrated { y, spread, .. } => Ok((y, spread)),
+        Outcome::Unconfirmed(_, _, why) | Outcome::NotConverged(why) => Err(why),
+        Outcome::Agree | Outcome::OverBudget(_) | Outcome::DisagreeDdOverBudget(..) => {
+            Err("the integration found nothing to confirm".into())
+        }
+    })
 }

@@ -42,6 +42,8 @@ pub fn state_frequencies_in_with(frame: &TopFrame, l0: &[f64; 6], cancel: &Cance
         Kind::Rest => MapEntry::failed(Status::ZeroState),
         Kind::Spherical | Kind::Equilibrium => MapEntry::failed(Status::Equilibrium),
         Kind::Separatrix => MapEntry::failed(Status::Separatrix),
+        // Not a class of `classify` (a motion's body decides it).
+        Kind::Integrated => MapEntry::failed(Status::Singular),
         Kind::Euler => {
             match Motion::in_frame(frame.clone(), l0)
                 .and_then(|m| euler_frequencies_with(&m, cancel))

@@ -123,3 +123,64 @@ fn shifted_a_gives_the_same_motion() {
         }
     }
 }
+
+/// A genus-2 state whose closed form cannot be built (the reduction refuses
+/// it) is of kind [`Kind::Integrated`]: `l(t)` is the confirmed integration
+/// in double-double, at every call. Draw 921 of the harsh draw of
+/// tests/data/every_state_harsh.py (components from 7.9e-5 to 2.0e5;
+/// F(s) (19) has a repeated root to double precision), against the
+/// quadruple-precision reference of tests/data/longdouble_ref.py
+/// (`reference_quad`) at the end of its window.
+#[test]
+fn a_state_without_a_closed_form_is_integrated() {
+    let a = [
+        -0.40479253116618286,
+        42.304798225664136,
+        42.31061822972205,
+        42.82083809160014,
+    ];
+    let b = [
+        0.6428522984348821,
+        -113.6114258865171,
+        -245.78800591972782,
+        -947.5605312431403,
+    ];
+    let l0 = [
+        6606.538820057217,
+        -109.13243355654599,
+        -198984.87716968727,
+        -11.791448622088316,
+        -117.11871122851196,
+        7.907522737757678e-05,
+    ];
+    let t = 2.2118745405398934e-07;
+    let quad = [
+        18747.52085127394,
+        989.9264563901506,
+        198198.03043773773,
+        2.776829483693518,
+        -1935.1081788673716,
+        -7.064288108108099,
+    ];
+    assert!(Solution::new(&a, &b, &l0).is_err());
+    let m = Motion::new(&a, &b, &l0).unwrap();
+    assert_eq!(m.kind(), Kind::Integrated);
+    assert!(m.genus2().is_none() && m.closed_form_frequency().is_none());
+    assert!(
+        m.stand_ins().1.contains("repeated root"),
+        "{}",
+        m.stand_ins().1
+    );
+    let times = [-t, 0.0, t / 2.0, t];
+    let mut out = vec![0.0; 6 * times.len()];
+    m.l_batch(&times, &mut out, &Cancel::never()).unwrap();
+    assert_eq!(&out[6..12], &l0[..]);
+    assert!(max_rel(&out[18..], &quad, norm(&l0)) <= 1e-14);
+    // backwards: the same motion reversed returns to l0 (the time-reversed
+    // flow of (1) from l(-t) is the forward one)
+    let back = Motion::new(&a, &b, &out[..6].try_into().unwrap()).unwrap();
+    let mut again = [0.0; 6];
+    back.l_batch(&[t], &mut again, &Cancel::never()).unwrap();
+    assert!(max_rel(&again, &l0, norm(&l0)) <= 1e-12);
+    assert_eq!(m.stand_ins().0, 1);
+}
