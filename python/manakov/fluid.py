@@ -929,6 +929,7 @@ class KirchhoffBody:
             conjugate top's ``h0 = 0``) is not singular by itself, and the states
             on the conjugate top's exact degenerate sets (``p0 = 0``; ``M0``,
             ``p0`` on two axes) are solved in its closed form.
+
         Notes
         -----
         A valid state whose conjugate top's closed form cannot be built gets a
