@@ -373,7 +373,8 @@ class Solution:
         that is off if the same integration in double-double with every step
         halved agrees with the one at the default step to 5e-12 ``|l0|`` (order 16:
         the half step's truncation error is 2^-16 of the default step's; where they
-        differ by more, the steps are halved again until two successive runs agree):
+        differ by more, the steps are halved again until two successive runs agree,
+        as long as each halving shrinks the difference at least fourfold):
         then the finest run's values are returned, at every requested time of that
         direction of time, with an :class:`IntegratedValuesWarning`. Otherwise, or
         where the integrations would take more than 2e6 steps (2e5 in

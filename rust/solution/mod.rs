@@ -794,18 +794,7 @@ impl Solution {
             )?;
             match outcome {
                 verify::Outcome::Agree => {}
-                verify::Outcome::Integrated {
-                    times: s,
-                    y,
-                    off,
-                    off_at,
-                    spread,
-                } => {
-                    verify::stand_in_rows(t, sign, &s, &y, out);
-                    if stood.is_none_or(|w| off > w.0) {
-                        stood = Some((off, sign * off_at, spread));
-                    }
-                }
+                verify::Outcome::Integrated(si) => si.apply(t, sign, out, &mut stood),
                 other => return Err(verify::refusal_unchecked(why, &other)),
             }
         }
@@ -851,7 +840,7 @@ impl Solution {
     /// what is already certified), an integration of (1), once per direction
     /// of time, certifies `l(t)` where the two agree to
     /// [`verify::VERIFY_RTOL`] ([`verify`]). Where they do not, and the same
-    /// integration at half the step confirms its own values, those stand in
+    /// integration with every step halved confirms its own values, those stand in
     /// for the closed form's at every requested time of that direction
     /// ([`Solution::stand_ins`]); else `l(t)` is refused.
     fn check_drift_certified(&self, t: &[f64], out: &mut [f64], cancel: &Cancel) -> Result<()> {
@@ -902,18 +891,7 @@ impl Solution {
                     let mut c = self.certified.lock().unwrap_or_else(|e| e.into_inner());
                     c[s] = c[s].max(reach);
                 }
-                verify::Outcome::Integrated {
-                    times: st,
-                    y,
-                    off,
-                    off_at,
-                    spread,
-                } => {
-                    verify::stand_in_rows(t, sign, &st, &y, out);
-                    if stood.is_none_or(|w| off > w.0) {
-                        stood = Some((off, sign * off_at, spread));
-                    }
-                }
+                verify::Outcome::Integrated(si) => si.apply(t, sign, out, &mut stood),
                 other => return Err(verify::refusal(reason, &other)),
             }
         }

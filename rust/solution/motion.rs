@@ -337,20 +337,20 @@ impl Motion {
             }
             s.sort_by(f64::total_cmp);
             s.dedup();
-            let (y, _) = super::verify::integrate_confirmed(
+            super::verify::integrate_confirmed(
                 &self.frame.c4,
                 &self.frame.c4_lo,
                 &ln,
                 size,
                 sign,
-                s.clone(),
+                s,
                 cancel,
             )?
             .map_err(|e| Error::Unverified {
                 what: "l(t)",
                 reason: format!("{why}; {e}"),
-            })?;
-            super::verify::stand_in_rows(&ts, sign, &s, &y, out);
+            })?
+            .rows(&ts, sign, out);
             for (o, &tk) in out.chunks_exact_mut(6).zip(&ts) {
                 if tk * sign > 0.0 && self.scale != 1.0 {
                     o.iter_mut().for_each(|v| *v *= self.scale);

@@ -61,7 +61,8 @@ pub const STAND_IN_SPREAD: f64 = VERIFY_RTOL / 10.0;
 
 /// Most steps, all runs together, of the double-double integrations that
 /// confirm the one standing in for a closed form that is off (the default
-/// step, then halved until two successive runs agree): `~40 µs` a step, so
+/// step, then every step halved until two successive runs agree): `~40 µs`
+/// a step, so
 /// `~8 s`.
 pub const STAND_IN_MAX_STEPS: f64 = 4.0 * VERIFY_DD_MAX_STEPS;
 
@@ -109,25 +110,62 @@ pub(super) enum Outcome {
     /// An integration's stage iteration did not converge at the default
     /// step (its message).
     NotConverged(String),
-    /// The closed form is off by `off` (relative to `|l0|`) at time
-    /// `off_at`, and two successive integrations in double-double (the
-    /// default step, halved until they do) agree to `spread` ≤
-    /// [`STAND_IN_SPREAD`] at every sample: the finer one's values stand in
-    /// for the closed form's.
-    Integrated {
-        /// The absolute values of the sampled times, sorted (every requested
-        /// time is one of them).
-        times: Vec<f64>,
-        /// `l` at `sign · times[k]`, 6 per time (the finest integration).
-        y: Vec<f64>,
-        off: f64,
-        off_at: f64,
-        spread: f64,
-    },
+    /// The closed form is off, and two successive integrations in
+    /// double-double (the default step, its steps split until they agree)
+    /// agree to [`STAND_IN_SPREAD`] at every sample: the finer one's values
+    /// stand in for the closed form's.
+    Integrated(StandIn),
     /// The closed form is off by this much at this time, and no two
     /// successive double-double integrations within [`STAND_IN_MAX_STEPS`]
     /// agree (why, in words).
     Unconfirmed(f64, f64, String),
+}
+
+/// A confirmed integration in double-double that stands in for a closed
+/// form that is off ([`Outcome::Integrated`]).
+pub(super) struct StandIn {
+    /// The absolute values of the sampled times, sorted (every requested
+    /// time is one of them).
+    pub times: Vec<f64>,
+    /// `l` at `sign · times[k]`, 6 per time (the finest integration).
+    pub y: Vec<f64>,
+    /// How far the closed form is off (relative to `|l0|`), and at which
+    /// `|t|`.
+    pub off: f64,
+    pub off_at: f64,
+    /// The spread of the last two integrations (relative to `|l0|`).
+    pub spread: f64,
+}
+
+impl StandIn {
+    /// Writes the values into the rows of `out` whose time `t_k` has the
+    /// sign `sign`.
+    pub(super) fn rows(&self, t: &[f64], sign: f64, out: &mut [f64]) {
+        for (&tk, row) in t.iter().zip(out.chunks_exact_mut(6)) {
+            if tk * sign > 0.0 {
+                let k = self
+                    .times
+                    .binary_search_by(|x| x.total_cmp(&tk.abs()))
+                    .expect("every requested time is sampled");
+                row.copy_from_slice(&self.y[6 * k..6 * k + 6]);
+            }
+        }
+    }
+
+    /// [`StandIn::rows`], keeping in `worst` the largest disagreement of the
+    /// call's directions of time as `(off, signed time, spread)`.
+    pub(super) fn apply(
+        &self,
+        t: &[f64],
+        sign: f64,
+        out: &mut [f64],
+        worst: &mut Option<(f64, f64, f64)>,
+    ) {
+        self.rows(t, sign, out);
+        if worst.is_none_or(|w| self.off > w.0) {
+            *worst = Some((self.off, sign * self.off_at, self.spread));
+        }
+    }
 }
 
 /// Integrates (1) from `l0` over `|times|` (all of one sign, `T` the largest
@@ -203,11 +241,12 @@ pub(super) fn certify(
 }
 
 /// Where the closed form and the double-double integration disagree: the
-/// closed form is the one that is off when the same integration at half the
-/// step agrees with it to [`STAND_IN_SPREAD`] (order 16: the half step's
-/// truncation error is `2^-16` of the default step's, so their difference
-/// measures the default step's error, and bounds the half step's; where it
-/// does not, the step is halved again, within [`STAND_IN_MAX_STEPS`]). Then
+/// closed form is the one that is off when the same integration with every
+/// step halved agrees with it to [`STAND_IN_SPREAD`] (order 16: the half
+/// steps' truncation error is `2^-16` of the default step's, so their
+/// difference measures the default step's error, and bounds the half steps';
+/// where it does not, the steps are halved again, within
+/// [`STAND_IN_MAX_STEPS`] and while the spread shrinks at least fourfold). Then
 /// the finest run's values stand in for the closed form's
 /// ([`Outcome::Integrated`]), at every requested time.
 #[allow(clippy::too_many_arguments)]
@@ -305,26 +344,13 @@ fn stand_in(
         spread = disagreement(&coarse, &fine, &signed, size).0;
         coarse = fine;
     }
-    Ok(Outcome::Integrated {
+    Ok(Outcome::Integrated(StandIn {
         times: s,
         y: coarse,
         off,
         off_at,
         spread,
-    })
-}
-
-/// Writes the stand-in's values ([`Outcome::Integrated`]) into the rows of
-/// `out` whose time `t_k` has the sign `sign`.
-pub(super) fn stand_in_rows(t: &[f64], sign: f64, times: &[f64], y: &[f64], out: &mut [f64]) {
-    for (&tk, row) in t.iter().zip(out.chunks_exact_mut(6)) {
-        if tk * sign > 0.0 {
-            let k = times
-                .binary_search_by(|x| x.total_cmp(&tk.abs()))
-                .expect("every requested time is sampled");
-            row.copy_from_slice(&y[6 * k..6 * k + 6]);
-        }
-    }
+    }))
 }
 
 /// The largest `max_q |a_q − b_q| / size` over the rows (a NaN counts as
@@ -348,7 +374,7 @@ fn disagreement(a: &[f64], b: &[f64], times: &[f64], size: f64) -> (f64, f64) {
 /// (empty where it agrees).
 pub(super) fn found(outcome: &Outcome) -> String {
     match outcome {
-        Outcome::Agree | Outcome::Integrated { .. } => String::new(),
+        Outcome::Agree | Outcome::Integrated(_) => String::new(),
         Outcome::Unconfirmed(d, t, why) => format!(
             "; an integration of (1) (Gauss-Legendre order 16 in double-double) differs \
              from it by {d:.1e} |l0| at t = {t:e}, and {why}"
@@ -392,10 +418,11 @@ pub(super) fn refusal_unchecked(why: &str, outcome: &Outcome) -> Error {
 
 /// `l(±t_k)` of (1) from `l0` at the sorted times `times ≥ 0` (`sign` the
 /// direction), by Gauss–Legendre order 16 in double-double at the default
-/// step, halved until two successive runs agree to [`STAND_IN_SPREAD`] `|l0|`
-/// at every time (within [`STAND_IN_MAX_STEPS`]): the rows, 6 per time, and
-/// their spread. Where they do not agree, or an iteration does not
-/// converge, `Ok(Err(why))`. The motion of a state without a closed form
+/// step, its steps split until two successive runs agree to
+/// [`STAND_IN_SPREAD`] `|l0|` at every time (within [`STAND_IN_MAX_STEPS`]):
+/// the finest run ([`StandIn`]; with no closed form to be off, `off` is
+/// NaN). Where they do not agree, or an iteration does not converge,
+/// `Ok(Err(why))`. The motion of a state without a closed form
 /// ([`super::motion::Kind::Integrated`]).
 pub(super) fn integrate_confirmed(
     c4: &[f64; 6],
@@ -405,7 +432,7 @@ pub(super) fn integrate_confirmed(
     sign: f64,
     times: Vec<f64>,
     cancel: &Cancel,
-) -> Result<std::result::Result<(Vec<f64>, f64), String>> {
+) -> Result<std::result::Result<StandIn, String>> {
     let c: [Dd; 6] = std::array::from_fn(|q| Dd::sum(sign * c4[q], sign * c4_lo[q]));
     let dt = default_dt(c4, size);
     let outcome = stand_in(
@@ -421,7 +448,7 @@ pub(super) fn integrate_confirmed(
         cancel,
     )?;
     Ok(match outcome {
-        Outcome::Integrated { y, spread, .. } => Ok((y, spread)),
+        Outcome::Integrated(si) => Ok(si),
         Outcome::Unconfirmed(_, _, why) | Outcome::NotConverged(why) => Err(why),
         Outcome::Agree | Outcome::OverBudget(_) | Outcome::DisagreeDdOverBudget(..) => {
             Err("the integration found nothing to confirm".into())
