@@ -353,8 +353,8 @@ def test_valid_states_always_get_a_solution() -> None:
     whose reason names the step and says the state is valid, and whose
     frequencies are refused with ClosedFormError; every genus-2 solution passed
     its self-check or is marked as not having passed it: then its phase is
-    refused, and its l(t) returned only where an integration certifies it or
-    stands in for it."""
+    refused (its l(t), certified or stood in for by an integration, is the
+    subject of the tests above)."""
     rng = np.random.default_rng(31)
     kinds: dict[str, int] = {}
     # 6000 states: as more of the draw is solved, 3000 came to reach only 7 refusals

@@ -62,9 +62,10 @@ LABELS: tuple[str, ...] = ("P0", "P23", "P31", "P12", "P14", "P24", "P34")
 
 
 class IntegratedValuesWarning(UserWarning):
-    """:meth:`Solution.l` returned values of an integration of (1) standing in for
-    the closed form: the closed form disagreed with it, and the same integration at
-    half its step confirmed them (the message says by how much each)."""
+    """:meth:`Solution.l` returned values of an integration of (1) in double-double,
+    confirmed by one with every step halved: for the kind ``"integrated"`` (no closed
+    form), or where a genus-2 closed form disagreed with it (the message says why,
+    and by how much)."""
 
 
 KINDS: tuple[str, ...] = (
@@ -377,8 +378,8 @@ class Solution:
         as long as each halving shrinks the difference at least fourfold):
         then the finest run's values are returned, at every requested time of that
         direction of time, with an :class:`IntegratedValuesWarning`. Otherwise, or
-        where the integrations would take more than 2e6 steps (2e5 in
-        double-double, all runs together), ``ClosedFormError``.
+        where the integrations would take more than 2e6 steps (in double-double 5e4
+        for the first run, 2e5 for all runs together), ``ClosedFormError``.
         """
         tt = _float_array(t, "t")
         before = self.integrated_calls

@@ -106,7 +106,11 @@ fn step(d: &[Dd; 12], y: &mut [Dd; 6], h: Dd, k: &mut [[Dd; 6]; S]) -> Result<()
             }
             *ni = field(d, &yi);
             for ((a, b), s) in ni.iter().zip(&k[i]).zip(&scale) {
-                dmax = dmax.max(a.sub(*b).hi.abs() / s);
+                let inc = a.sub(*b).hi.abs() / s;
+                // NaN is not skipped: it must fail the convergence test
+                if inc > dmax || inc.is_nan() {
+                    dmax = inc;
+                }
             }
         }
         *k = next;

@@ -760,16 +760,14 @@ impl Solution {
         out: &mut [f64],
         cancel: &Cancel,
     ) -> Result<()> {
-        let mut stood: Option<(f64, f64, f64)> = None;
+        let mut stood: Option<(f64, f64, f64, u32)> = None;
         for (&tk, lk) in t.iter().zip(out.chunks_exact_mut(6)) {
             if tk == 0.0 {
-                let d = lk
-                    .iter()
-                    .zip(&self.l0)
-                    .fold(0.0f64, |m, (x, y)| m.max((x - y).abs()))
+                let d = verify::nan_max(lk.iter().zip(&self.l0).map(|(x, y)| (x - y).abs()))
                     / self.size;
                 if d.is_nan() || d > verify::VERIFY_RTOL {
-                    stood = Some((if d.is_nan() { f64::INFINITY } else { d }, 0.0, 0.0));
+                    // no integration: l0 itself (split 0)
+                    stood = Some((if d.is_nan() { f64::INFINITY } else { d }, 0.0, 0.0, 0));
                 }
                 // `l(0) = l0` is known exactly: it stands in for the closed
                 // form, whose check failed.
@@ -798,27 +796,33 @@ impl Solution {
                 other => return Err(verify::refusal_unchecked(why, &other)),
             }
         }
-        if let Some((off, at, spread)) = stood {
-            self.note_stand_in(why, off, at, spread);
+        if let Some(worst) = stood {
+            self.note_stand_in(why, worst);
         }
         Ok(())
     }
 
     /// Counts a call whose values (some or all) come from the integration
-    /// that stands in for the closed form, and keeps why.
-    fn note_stand_in(&self, why: &str, off: f64, at: f64, spread: f64) {
+    /// that stands in for the closed form, and keeps why: the largest
+    /// disagreement `(off, t, spread, split)` of the call (`split = 0`: only
+    /// `l(0) = l0` stood in).
+    fn note_stand_in(&self, why: &str, (off, at, spread, split): (f64, f64, f64, u32)) {
         self.stand_ins
             .fetch_add(1, std::sync::atomic::Ordering::Relaxed);
         let mut m = self
             .stand_in_reason
             .lock()
             .unwrap_or_else(|e| e.into_inner());
-        *m = format!(
-            "{why}; the closed form differs from an integration of (1) (Gauss-Legendre \
-             order 16 in double-double) by {off:.1e} |l0| at t = {at:e}, and the \
-             integration's values stand in for it (confirmed by one with every step \
-             halved, to {spread:.1e} |l0|)"
-        );
+        *m = if split == 0 {
+            format!("{why}; the closed form misses l0 by {off:.1e} |l0| at t = 0, and l0 stands in")
+        } else {
+            format!(
+                "{why}; the closed form differs from an integration of (1) (Gauss-Legendre \
+                 order 16 in double-double) by {off:.1e} |l0| at t = {at:e}, and the \
+                 integration's values stand in for it (confirmed by one with every step \
+                 split in {split}, to {spread:.1e} |l0|)"
+            )
+        };
     }
 
     /// How many `l(t)` calls returned values of the integration that stands
@@ -865,7 +869,7 @@ impl Solution {
         let Some(reason) = reason else {
             return Ok(());
         };
-        let mut stood: Option<(f64, f64, f64)> = None;
+        let mut stood: Option<(f64, f64, f64, u32)> = None;
         for (s, failing) in failing.iter().enumerate() {
             if failing.is_empty() {
                 continue;
@@ -892,17 +896,22 @@ impl Solution {
                     c[s] = c[s].max(reach);
                 }
                 verify::Outcome::Integrated(si) => si.apply(t, sign, out, &mut stood),
-                other => return Err(verify::refusal(reason, &other)),
+                other => {
+                    return Err(verify::refusal(
+                        format!("{reason}; evaluate nearer t = 0"),
+                        &other,
+                    ))
+                }
             }
         }
-        if let Some((off, at, spread)) = stood {
+        if let Some(worst) = stood {
             // `l(0) = l0` exactly, as the integration has it.
             for (&tk, lk) in t.iter().zip(out.chunks_exact_mut(6)) {
                 if tk == 0.0 {
                     lk.copy_from_slice(&self.l0);
                 }
             }
-            self.note_stand_in(&reason, off, at, spread);
+            self.note_stand_in(&reason, worst);
         }
         Ok(())
     }
@@ -999,7 +1008,7 @@ fn drift_reason(t: f64, defect: f64, drift: f64) -> String {
     format!(
         "at t = {t:e} the relative defect {defect:e} left by the self-check may \
          move l(t) by {drift:e} |l0| > {DRIFT_RTOL:e} (the drift \
-         delta |t| |dl/dt| of the phase); evaluate nearer t = 0"
+         delta |t| |dl/dt| of the phase)"
     )
 }
 

@@ -93,10 +93,12 @@ enum Body {
         top: Box<EulerTop>,
     },
     Genus2(Arc<Solution>),
-    /// The step of the reduction that refused the closed form, and the count
-    /// of `l(t)` calls.
+    /// Why there is no closed form (the step that refused it, then what
+    /// `l(t)` is), the step alone, and the count of `l(t)` calls that
+    /// integrated.
     Integrated {
         why: String,
+        step: String,
         calls: std::sync::atomic::AtomicU64,
     },
 }
@@ -206,10 +208,19 @@ impl Motion {
                     // The closed form cannot be built: the motion is the
                     // integration's (cancellation and size errors pass).
                     Err(e) => match refusal_of("closed form for this l0", INTEGRATED, e) {
-                        Error::Unverified { reason, .. } => Body::Integrated {
-                            why: reason,
-                            calls: std::sync::atomic::AtomicU64::new(0),
-                        },
+                        Error::Unverified { what, reason } => {
+                            // A refusal of the solution itself passes through
+                            // `refusal_of` as it is: the same ending for both.
+                            let step = match reason.strip_suffix(INTEGRATED) {
+                                Some(s) => s.trim_end_matches("; the state is valid: ").into(),
+                                None => format!("{what}: {reason}"),
+                            };
+                            Body::Integrated {
+                                why: format!("{step}; the state is valid: {INTEGRATED}"),
+                                step,
+                                calls: std::sync::atomic::AtomicU64::new(0),
+                            }
+                        }
                         other => return Err(other),
                     },
                 }
@@ -298,7 +309,7 @@ impl Motion {
     /// other kinds.
     pub fn stand_ins(&self) -> (u64, String) {
         match &self.body {
-            Body::Integrated { why, calls } => (
+            Body::Integrated { why, calls, .. } => (
                 calls.load(std::sync::atomic::Ordering::Relaxed),
                 why.clone(),
             ),
@@ -312,7 +323,7 @@ impl Motion {
     /// the normalized frame).
     fn integrated_rows(
         &self,
-        why: &str,
+        step: &str,
         t: &[f64],
         out: &mut [f64],
         cancel: &Cancel,
@@ -348,7 +359,10 @@ impl Motion {
             )?
             .map_err(|e| Error::Unverified {
                 what: "l(t)",
-                reason: format!("{why}; {e}"),
+                reason: format!(
+                    "{step}; the state is valid, but no integration of (1) in double-double \
+                     confirms itself: {e}"
+                ),
             })?
             .rows(&ts, sign, out);
             for (o, &tk) in out.chunks_exact_mut(6).zip(&ts) {
@@ -357,7 +371,8 @@ impl Motion {
                 }
             }
         }
-        if let Body::Integrated { calls, .. } = &self.body {
+        // A call that integrated (not one at t = 0 alone, or of no times).
+        if let (Body::Integrated { calls, .. }, true) = (&self.body, ts.iter().any(|&x| x != 0.0)) {
             calls.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
         }
         Ok(())
@@ -394,7 +409,7 @@ impl Motion {
                 }
                 Ok(())
             }
-            Body::Integrated { why, .. } => self.integrated_rows(why, t, out, cancel),
+            Body::Integrated { step, .. } => self.integrated_rows(step, t, out, cancel),
             Body::Genus2(sol) => {
                 if self.time_scale == 1.0 && self.scale == 1.0 {
                     // The generic path, unchanged.

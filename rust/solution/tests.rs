@@ -373,6 +373,12 @@ fn drift_of_the_phase_where_the_integration_disagrees_gives_the_integration() {
     let (calls, why) = s.stand_ins();
     assert_eq!(calls, 1);
     assert!(why.contains("stand in for it"), "{why}");
+    assert!(!why.contains("evaluate nearer"), "{why}");
+    // backwards in time: the reason names the (negative) time it found
+    s.l(-t).expect("the integration stands in backwards too");
+    let (calls, why) = s.stand_ins();
+    assert_eq!(calls, 2);
+    assert!(why.contains("at t = -"), "{why}");
     // The closed form alone is off there (what the integration replaced).
     let mut closed = [0.0; 6];
     s.eval_rows(&[t], &mut closed).unwrap();

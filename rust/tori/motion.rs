@@ -77,6 +77,12 @@ pub fn state_frequencies_in_with(frame: &TopFrame, l0: &[f64; 6], cancel: &Cance
 /// Errors: a motion of another kind (the message names it; those have no
 /// 2-torus), and those of [`flow_data`] and [`real_torus_with_rates`].
 pub fn torus_of_motion(m: &Motion) -> Result<(RealTorus, [C; 2])> {
+    if m.kind() == Kind::Integrated {
+        return Err(Error::Unverified {
+            what: "torus of this l0",
+            reason: format!("{}; its frequencies are not known", m.stand_ins().1),
+        });
+    }
     let sol = m.genus2().ok_or_else(|| Error::InvalidArgument {
         what: "state l0",
         reason: format!(

@@ -183,4 +183,15 @@ fn a_state_without_a_closed_form_is_integrated() {
     back.l_batch(&[t], &mut again, &Cancel::never()).unwrap();
     assert!(max_rel(&again, &l0, norm(&l0)) <= 1e-12);
     assert_eq!(m.stand_ins().0, 1);
+    // calls that integrate nothing are not counted
+    m.l_batch(&[0.0], &mut [0.0; 6], &Cancel::never()).unwrap();
+    m.l_batch(&[], &mut [], &Cancel::never()).unwrap();
+    assert_eq!(m.stand_ins().0, 1);
+    // the kind has no torus: a refusal naming the step, not invalid input
+    match crate::tori::motion::torus_of_motion(&m) {
+        Err(Error::Unverified { reason, .. }) => {
+            assert!(reason.contains("repeated root"), "{reason}")
+        }
+        other => panic!("not refused: {:?}", other.map(|_| ())),
+    }
 }
