@@ -398,7 +398,7 @@ class Solution:
         (each also warns, :class:`IntegratedValuesWarning`): every call for the kind
         ``"integrated"``, those where it stood in for the closed form for
         ``"genus2"`` (:meth:`l`, Notes), none for the other kinds."""
-        return int(self._motion.stand_ins[0])
+        return int(self._motion.stand_in_calls)
 
     def abel(self, l: Any) -> np.ndarray:
         """The Abel image ``u(P1) + u(P2)`` (modulo the lattice) of states ``l``

@@ -151,7 +151,7 @@ pub(crate) fn gauss16_dd_steps(times: &[f64], dt: f64, split: u32) -> f64 {
         n += ((t - prev) / dt).ceil();
         prev = t;
     }
-    n * f64::from(split)
+    n * f64::from(split.max(1))
 }
 
 /// `l(t)` of (1) on so(4) from `l(0) = l0` at the sorted times `times ≥ 0`,

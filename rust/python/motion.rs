@@ -143,6 +143,12 @@ impl MotionCore {
         self.motion.stand_ins()
     }
 
+    /// The count alone ([`Motion::stand_in_calls`]).
+    #[getter]
+    fn stand_in_calls(&self) -> u64 {
+        self.motion.stand_in_calls()
+    }
+
     /// The real torus of a genus-2 motion: `(λ rows, coords rows, ν, U')`.
     fn torus<'py>(&self, py: Python<'py>) -> PyResult<TorusOut<'py>> {
         let (t, u2) = py.detach(|| torus_of_motion(&self.motion))?;

@@ -143,13 +143,6 @@ impl SolutionCore {
         self.sol.certify_every().map(str::to_string)
     }
 
-    /// `(calls, reason)`: how many `l(t)` calls returned values of the
-    /// integration standing in for the closed form, and why the last did.
-    #[getter]
-    fn stand_ins(&self) -> (u64, String) {
-        self.sol.stand_ins()
-    }
-
     /// `(idx (8,), num (6, 8), den (8,))` of `l_q = N_q/D`.
     fn quotient<'py>(&self, py: Python<'py>) -> PyResult<Quotient<'py>> {
         let (idx, num, den) = self.sol.quotient();

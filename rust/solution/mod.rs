@@ -825,12 +825,17 @@ impl Solution {
         };
     }
 
+    /// The count of [`Solution::stand_ins`] alone (cheap: one atomic load).
+    pub fn stand_in_calls(&self) -> u64 {
+        self.stand_ins.load(std::sync::atomic::Ordering::Relaxed)
+    }
+
     /// How many `l(t)` calls returned values of the integration that stands
     /// in for the closed form where the closed form disagreed with it
     /// ([`verify::Outcome::Integrated`]), and why the last one did.
     pub fn stand_ins(&self) -> (u64, String) {
         (
-            self.stand_ins.load(std::sync::atomic::Ordering::Relaxed),
+            self.stand_in_calls(),
             self.stand_in_reason
                 .lock()
                 .unwrap_or_else(|e| e.into_inner())

@@ -93,11 +93,9 @@ enum Body {
         top: Box<EulerTop>,
     },
     Genus2(Arc<Solution>),
-    /// Why there is no closed form (the step that refused it, then what
-    /// `l(t)` is), the step alone, and the count of `l(t)` calls that
-    /// integrated.
+    /// The step that refused the closed form, and the count of `l(t)` calls
+    /// that integrated.
     Integrated {
-        why: String,
         step: String,
         calls: std::sync::atomic::AtomicU64,
     },
@@ -130,19 +128,28 @@ fn refusal(e: Error) -> Error {
 /// its numbers in the message, then `advice`; cancellation and size errors
 /// pass (the closed form's refusals here, the torus's in `tori::motion`).
 pub(crate) fn refusal_of(what: &'static str, advice: &str, e: Error) -> Error {
-    let step = match &e {
+    match failed_step(e) {
+        Ok(step) => Error::Unverified {
+            what,
+            reason: format!("{step}; the state is valid: {advice}"),
+        },
+        Err(e) => e,
+    }
+}
+
+/// The step that failed, in words (`what: reason`), of an error of a valid
+/// state's closed form; a refusal (`Unverified`, which words its own step)
+/// and cancellation and size errors are returned as they are.
+fn failed_step(e: Error) -> std::result::Result<String, Error> {
+    match e {
         Error::Unverified { .. }
         | Error::Interrupted
         | Error::TooLarge { .. }
-        | Error::OutOfMemory { .. } => return e,
+        | Error::OutOfMemory { .. } => Err(e),
         Error::Singular { what, reason, .. } | Error::InvalidArgument { what, reason } => {
-            format!("{what}: {reason}")
+            Ok(format!("{what}: {reason}"))
         }
-        other => other.to_string(),
-    };
-    Error::Unverified {
-        what,
-        reason: format!("{step}; the state is valid: {advice}"),
+        other => Ok(other.to_string()),
     }
 }
 
@@ -207,22 +214,19 @@ impl Motion {
                     Ok(s) => Body::Genus2(Arc::new(s)),
                     // The closed form cannot be built: the motion is the
                     // integration's (cancellation and size errors pass).
-                    Err(e) => match refusal_of("closed form for this l0", INTEGRATED, e) {
-                        Error::Unverified { what, reason } => {
-                            // A refusal of the solution itself passes through
-                            // `refusal_of` as it is: the same ending for both.
-                            let step = match reason.strip_suffix(INTEGRATED) {
-                                Some(s) => s.trim_end_matches("; the state is valid: ").into(),
-                                None => format!("{what}: {reason}"),
-                            };
-                            Body::Integrated {
-                                why: format!("{step}; the state is valid: {INTEGRATED}"),
-                                step,
-                                calls: std::sync::atomic::AtomicU64::new(0),
-                            }
+                    Err(e) => {
+                        let step = match failed_step(e) {
+                            Ok(step) => step,
+                            // a refusal of the solution itself
+                            Err(Error::Unverified { what, reason }) => format!("{what}: {reason}"),
+                            // cancellation and size errors pass
+                            Err(other) => return Err(other),
+                        };
+                        Body::Integrated {
+                            step,
+                            calls: std::sync::atomic::AtomicU64::new(0),
                         }
-                        other => return Err(other),
-                    },
+                    }
                 }
             }
         };
@@ -302,6 +306,16 @@ impl Motion {
         }
     }
 
+    /// The count of [`Motion::stand_ins`] alone (cheap: no message is
+    /// formatted).
+    pub fn stand_in_calls(&self) -> u64 {
+        match &self.body {
+            Body::Integrated { calls, .. } => calls.load(std::sync::atomic::Ordering::Relaxed),
+            Body::Genus2(sol) => sol.stand_in_calls(),
+            _ => 0,
+        }
+    }
+
     /// `(calls, why)`: how many `l(t)` calls returned values of an
     /// integration of (1) (all of them for [`Kind::Integrated`]; those where
     /// it stood in for the closed form for [`Kind::Genus2`],
@@ -309,9 +323,9 @@ impl Motion {
     /// other kinds.
     pub fn stand_ins(&self) -> (u64, String) {
         match &self.body {
-            Body::Integrated { why, calls, .. } => (
-                calls.load(std::sync::atomic::Ordering::Relaxed),
-                why.clone(),
+            Body::Integrated { step, .. } => (
+                self.stand_in_calls(),
+                format!("{step}; the state is valid: {INTEGRATED}"),
             ),
             Body::Genus2(sol) => sol.stand_ins(),
             _ => (0, String::new()),
@@ -365,8 +379,11 @@ impl Motion {
                 ),
             })?
             .rows(&ts, sign, out);
+        }
+        if self.scale != 1.0 {
+            // the integrated rows into the user's frame (those at t = 0 are l0)
             for (o, &tk) in out.chunks_exact_mut(6).zip(&ts) {
-                if tk * sign > 0.0 && self.scale != 1.0 {
+                if tk != 0.0 {
                     o.iter_mut().for_each(|v| *v *= self.scale);
                 }
             }

@@ -215,9 +215,9 @@ pub(super) fn certify(
         atol: 0.0,
         max_steps: (steps.ceil() as u64).saturating_add(s.len() as u64 + 16),
     };
-    let tr = match integrate_with(&top(c4, sign)?, l0, 0.0, &s, &opts, cancel) {
-        Err(e @ Error::NoConvergence { .. }) => return Ok(Outcome::NotConverged(e.to_string())),
-        other => other?,
+    let tr = match converged(integrate_with(&top(c4, sign)?, l0, 0.0, &s, &opts, cancel))? {
+        Ok(tr) => tr,
+        Err(o) => return Ok(o),
     };
     let signed: Vec<f64> = s.iter().map(|t| sign * t).collect();
     let mut out = try_vec("samples", 6 * signed.len(), 0.0)?;
@@ -232,9 +232,9 @@ pub(super) fn certify(
         return Ok(Outcome::DisagreeDdOverBudget(worst.0, worst.1, dd_steps));
     }
     let c: [Dd; 6] = std::array::from_fn(|q| Dd::sum(sign * c4[q], sign * c4_lo[q]));
-    let y = match gauss16_dd_so4(&c, l0, &s, dt, 1, cancel) {
-        Err(e @ Error::NoConvergence { .. }) => return Ok(Outcome::NotConverged(e.to_string())),
-        other => other?,
+    let y = match converged(gauss16_dd_so4(&c, l0, &s, dt, 1, cancel))? {
+        Ok(y) => y,
+        Err(o) => return Ok(o),
     };
     let worst = disagreement(&out, &y, &signed, size);
     if worst.0 <= VERIFY_RTOL {
@@ -276,21 +276,18 @@ fn stand_in(
     } else {
         (s, y)
     };
-    let run = |split: u32| -> Result<std::result::Result<Vec<f64>, Outcome>> {
-        match gauss16_dd_so4(c, l0, &s, dt, split, cancel) {
-            Err(e @ Error::NoConvergence { .. }) => Ok(Err(Outcome::NotConverged(e.to_string()))),
-            other => other.map(Ok),
-        }
-    };
-    let mut spent = gauss16_dd_steps(&s, dt, 1);
-    if spent + gauss16_dd_steps(&s, dt, 2) > STAND_IN_MAX_STEPS {
+    let run = |split: u32| converged(gauss16_dd_so4(c, l0, &s, dt, split, cancel));
+    // Steps at the default step; splitting every step in `k` takes `k` times as many.
+    let base = gauss16_dd_steps(&s, dt, 1);
+    let mut spent = base;
+    if 3.0 * base > STAND_IN_MAX_STEPS {
         return Ok(Outcome::Unconfirmed(
             off,
             off_at,
             format!(
                 "an integration in double-double at the default step and one with every \
                  step halved would take {:.1e} steps (more than {STAND_IN_MAX_STEPS:e})",
-                spent + gauss16_dd_steps(&s, dt, 2)
+                3.0 * base
             ),
         ));
     }
@@ -326,7 +323,7 @@ fn stand_in(
             );
             return Ok(Outcome::Unconfirmed(off, off_at, why));
         }
-        let next = gauss16_dd_steps(&s, dt, 2 * split);
+        let next = base * f64::from(2 * split);
         if spent + next > STAND_IN_MAX_STEPS {
             let why = format!(
                 "the integrations with every step split in {} and in {} differ by \
@@ -362,6 +359,15 @@ fn stand_in(
         spread,
         split,
     }))
+}
+
+/// `r`, with an iteration that did not converge at the step taken as the
+/// outcome [`Outcome::NotConverged`] (a refusal naming it, not an error).
+fn converged<T>(r: Result<T>) -> Result<std::result::Result<T, Outcome>> {
+    match r {
+        Err(e @ Error::NoConvergence { .. }) => Ok(Err(Outcome::NotConverged(e.to_string()))),
+        other => other.map(Ok),
+    }
 }
 
 /// The largest of `v`, NaN if any is (`f64::max` would skip a NaN).
