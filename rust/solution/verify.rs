@@ -480,3 +480,95 @@ pub(super) fn integrate_confirmed(
         }
     })
 }
+
+/// Phases, in lattice periods of the fastest coordinate, at which
+/// [`abel_rate_defect`] compares: one period, and four, so that a wrong
+/// velocity shows as a defect growing with time, where the error of a
+/// single Abel image would not.
+const ABEL_PHASES: [f64; 2] = [1.0, 4.0];
+
+/// Most steps (both runs together) of the integrations of
+/// [`abel_rate_defect`]: Gauss–Legendre order 16 in double, `~1 µs` a step,
+/// so `~0.3 s`.
+pub const ABEL_CHECK_MAX_STEPS: f64 = 3e5;
+
+/// The velocity `u` of the flow (1) with coefficients `c4` (state order) on
+/// the level set of `sol`, checked without theta functions: `l0` is
+/// integrated (Gauss–Legendre order 16, at the default step and at half of
+/// it) to the times `t_k` at which `u t_k` has advanced [`ABEL_PHASES`]
+/// periods in its fastest lattice coordinate, and the Abel image of each
+/// state, `u(P1(t_k)) + u(P2(t_k))` ([`Solution::abel`]: the reduction of the
+/// integrated state and Abel integrals on the curve), is compared with
+/// `u0 + u t_k` modulo the lattice. Returns the largest defect over the times
+/// and both runs, in lattice coordinates and divided by the phase advanced:
+/// the relative error of `u` this comparison allows (NaN where it cannot be
+/// made: an integration over budget or not converged, a state the Abel map
+/// refuses).
+///
+/// The theta quotients' own velocity check ([`Solution::velocity_check`]) is
+/// ill-conditioned where the curve is nearly pinched (its thetas are sums of
+/// nearly cancelling terms); this comparison uses only the reduction and the
+/// curve's periods, which the closed form of `u` shares, but not its
+/// derivation (Dubrovin's equations at half periods): a wrong `u` shows as a
+/// defect proportional to `t`. The caller has bounded `u`'s error by far less
+/// than a period per period (the velocity check within
+/// [`super::check::VELOCITY_CHECK_RTOL`]), so the nearest lattice vector is
+/// the right one.
+pub fn abel_rate_defect(
+    sol: &super::Solution,
+    c4: &[f64; 6],
+    u: &[num_complex::Complex64; 2],
+    cancel: &Cancel,
+) -> Result<f64> {
+    let curve = sol.curve();
+    let (x, y) = curve.lattice_coordinates(u);
+    let rate = nan_max(x.iter().chain(&y).map(|v| v.abs()));
+    if !(rate > 0.0 && rate.is_finite()) {
+        return Ok(f64::NAN);
+    }
+    let times = ABEL_PHASES.map(|f| f / rate);
+    let size = sol.size;
+    let dt = default_dt(c4, size);
+    let steps = 1.5 * times[1] / dt;
+    if steps.is_nan() || steps > ABEL_CHECK_MAX_STEPS {
+        return Ok(f64::NAN);
+    }
+    let u0 = sol.u0();
+    let top = top(c4, 1.0)?;
+    let mut worst = 0.0f64;
+    for h in [dt, dt / 2.0] {
+        let opts = Options {
+            method: Method::Gauss16,
+            dt: h,
+            rtol: 0.0,
+            atol: 0.0,
+            max_steps: ((times[1] / h).ceil() as u64).saturating_add(16),
+        };
+        let tr = match integrate_with(&top, &sol.l0, 0.0, &times, &opts, cancel) {
+            Ok(tr) => tr,
+            Err(Error::NoConvergence { .. }) => return Ok(f64::NAN),
+            Err(e) => return Err(e),
+        };
+        for (k, l) in tr.y.chunks_exact(6).enumerate() {
+            let l: [f64; 6] = l.try_into().expect("rows of 6");
+            let Ok(w) = sol.abel(&l) else {
+                return Ok(f64::NAN);
+            };
+            let d = [
+                w[0] - u0[0] - u[0] * times[k],
+                w[1] - u0[1] - u[1] * times[k],
+            ];
+            let (dx, dy) = curve.lattice_coordinates(&d);
+            let off = nan_max(dx.iter().chain(&dy).map(|v| (v - v.round()).abs()));
+            worst = if off.is_nan() {
+                f64::NAN
+            } else {
+                worst.max(off / ABEL_PHASES[k])
+            };
+            if worst.is_nan() {
+                return Ok(worst);
+            }
+        }
+    }
+    Ok(worst)
+}

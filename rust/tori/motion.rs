@@ -15,7 +15,7 @@
 
 use num_complex::Complex64 as C;
 
-use super::solve::{classify as classify_error, flow_data, level_set_entry};
+use super::solve::{classify as classify_error, flow_data, level_set_entry_with};
 use super::{real_torus_with_rates, MapEntry, RealTorus, Status};
 use crate::error::{Error, Result};
 use crate::numeric::cancel::Cancel;
@@ -57,7 +57,8 @@ pub fn state_frequencies_in_with(frame: &TopFrame, l0: &[f64; 6], cancel: &Cance
             }
         }
         Kind::Genus2 => {
-            let entry = level_set_entry(&frame.a, &frame.c4, &frame.second_flow_b(), &ln);
+            let entry =
+                level_set_entry_with(&frame.a, &frame.c4, &frame.second_flow_b(), &ln, cancel);
             if entry.status == Status::Ok && t_scale != 1.0 {
                 MapEntry {
                     status: Status::Ok,

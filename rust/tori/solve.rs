@@ -28,6 +28,8 @@ use crate::solution::dubrovin::{
     closed_form_fits, half_period_velocities, lattice_rates_dd, CLOSED_FORM,
 };
 use crate::solution::velocity::algebraic_rates;
+use crate::solution::verify::abel_rate_defect;
+use crate::solution::VELOCITY_CHECK_RTOL;
 use crate::solution::{a_periods_of, level_set_curve, Solution};
 
 /// Above this spread of the branch points ([`HyperellipticCurve::spread`])
@@ -79,17 +81,25 @@ pub fn c_pairs(a: &[f64; 4], b: &[f64; 4]) -> Result<[f64; 6]> {
 /// `τ`, `U`, `U'` (the flow of `ManakovTop(a, b2)` by [`rate_for`]) and the
 /// characteristics of a solution, in the layout of this module.
 pub fn flow_data(sol: &Solution, b2: &[f64; 4]) -> Result<FlowData> {
+    flow_data_with(sol, b2, &Cancel::never())
+}
+
+/// [`flow_data`] with a cancellation token, checked inside the integrations
+/// of the Abel-map check of the velocities ([`abel_rate_defect`]).
+pub fn flow_data_with(sol: &Solution, b2: &[f64; 4], cancel: &Cancel) -> Result<FlowData> {
     // The frequencies come from U: where its self-check left a velocity
-    // defect above the shape's bound (slow motions, which l(t) bounds by its
-    // drift check instead), U is not vouched for to that accuracy, and
-    // neither would the frequencies be.
-    if sol.velocity_check() > FREQUENCY_VELOCITY_RTOL {
+    // defect above the shape's bound (next to pinched curves, where the theta
+    // quotients' derivatives are sums of nearly cancelling terms), U and U'
+    // are vouched for only if the Abel images of integrated states move along
+    // them ([`abel_rate_defect`], at the end).
+    let by_abel = sol.velocity_check() > FREQUENCY_VELOCITY_RTOL;
+    if sol.velocity_check() > VELOCITY_CHECK_RTOL {
+        // (not reached from a solution that passed its self-check)
         return Err(Error::Unverified {
             what: "frequencies",
             reason: format!(
                 "the theta quotients move along U against Frahm's equations (1) by {:e} of \
-                 the largest speed (> {FREQUENCY_VELOCITY_RTOL:e}), which U's frequencies \
-                 would inherit",
+                 the largest speed (> {VELOCITY_CHECK_RTOL:e})",
                 sol.velocity_check()
             ),
         });
@@ -139,9 +149,13 @@ pub fn flow_data(sol: &Solution, b2: &[f64; 4]) -> Result<FlowData> {
         });
     }
     let Some(lat) = closed else {
+        let u = sol.rate();
+        if by_abel {
+            abel_check(sol, &c2, &u, &u2, cancel)?;
+        }
         return Ok(FlowData {
             tau: [[t[0], t[1]], [t[2], t[3]]],
-            u: sol.rate(),
+            u,
             u2,
             chars,
             w: None,
@@ -164,12 +178,60 @@ pub fn flow_data(sol: &Solution, b2: &[f64; 4]) -> Result<FlowData> {
             ),
         });
     }
+    if by_abel {
+        abel_check(sol, &c2, &u, &u2_closed, cancel)?;
+    }
     Ok(FlowData {
         tau: [[t[0], t[1]], [t[2], t[3]]],
         u,
         u2: u2_closed,
         chars,
         w: Some(lat.w[0]),
+    })
+}
+
+/// `U` and `U'` (the flows with coefficients `sol.c4()` and `c2`) checked by
+/// the Abel images of integrated states ([`abel_rate_defect`]) to
+/// [`FREQUENCY_VELOCITY_RTOL`], for a solution whose theta quotients'
+/// velocity check did not hold them to it.
+fn abel_check(
+    sol: &Solution,
+    c2: &[f64; 6],
+    u: &[C; 2],
+    u2: &[C; 2],
+    cancel: &Cancel,
+) -> Result<()> {
+    let d1 = abel_rate_defect(sol, sol.c4(), u, cancel)?;
+    let d2 = if d1 <= FREQUENCY_VELOCITY_RTOL {
+        abel_rate_defect(sol, c2, u2, cancel)?
+    } else {
+        f64::NAN
+    };
+    if d1 <= FREQUENCY_VELOCITY_RTOL && d2 <= FREQUENCY_VELOCITY_RTOL {
+        return Ok(());
+    }
+    let abel = if d1.is_nan() || (d1 <= FREQUENCY_VELOCITY_RTOL && d2.is_nan()) {
+        "the Abel images of integrated states could not check them (an integration beyond \
+         its budget, or a state the Abel map refuses)"
+            .to_string()
+    } else {
+        format!(
+            "the Abel images of integrated states move along them only to {:e} (relative)",
+            if d1 <= FREQUENCY_VELOCITY_RTOL {
+                d2
+            } else {
+                d1
+            }
+        )
+    };
+    Err(Error::Unverified {
+        what: "frequencies",
+        reason: format!(
+            "the theta quotients move along U against Frahm's equations (1) by {:e} of the \
+             largest speed (> {FREQUENCY_VELOCITY_RTOL:e}), and {abel}: U's frequencies are \
+             not vouched for to {FREQUENCY_VELOCITY_RTOL:e}",
+            sol.velocity_check()
+        ),
     })
 }
 
@@ -318,6 +380,17 @@ pub fn state_frequencies_level_set(a: &[f64; 4], b: &[f64; 4], l0: &[f64; 6]) ->
 /// a consensus on the velocities, through the Theorem's solution
 /// ([`flow_data`]).
 pub fn level_set_entry(a: &[f64; 4], c4: &[f64; 6], b2: &[f64; 4], l0: &[f64; 6]) -> MapEntry {
+    level_set_entry_with(a, c4, b2, l0, &Cancel::never())
+}
+
+/// [`level_set_entry`] with a cancellation token ([`flow_data_with`]).
+pub fn level_set_entry_with(
+    a: &[f64; 4],
+    c4: &[f64; 6],
+    b2: &[f64; 4],
+    l0: &[f64; 6],
+    cancel: &Cancel,
+) -> MapEntry {
     let c2 = match c_pairs(a, b2) {
         Ok(c2) => c2,
         Err(e) => return MapEntry::failed(classify(&e)),
@@ -328,7 +401,7 @@ pub fn level_set_entry(a: &[f64; 4], c4: &[f64; 6], b2: &[f64; 4], l0: &[f64; 6]
             Err(Error::Singular {
                 kind: SingularKind::NoVelocityConsensus,
                 ..
-            }) => Solution::with_c4(a, c4, l).and_then(|s| flow_data(&s, b2)),
+            }) => Solution::with_c4(a, c4, l).and_then(|s| flow_data_with(&s, b2, cancel)),
             other => other,
         },
         classify,

@@ -828,3 +828,60 @@ fn the_double_route_is_good_where_the_spread_is_moderate() {
     assert!(worst <= 1e-14, "{worst:e} over {checked}");
     eprintln!("double vs DD where the spread is moderate: {worst:e} over {checked} states");
 }
+
+/// Draw 48 of the harsh random draw (tests/data/every_state_harsh.py, seed
+/// 20261125): the branch points of (8) spread over 1e30, and the theta
+/// quotients' velocity check leaves 1.8e-9 (above the 1e-10 the frequencies
+/// are vouched for to), so the map refused the state. The Abel images of
+/// integrated states vouch for `U` instead; it agrees with the slope of the
+/// Abel images of a trajectory integrated in 80-bit long double over 20
+/// periods (tests/data/frequency_abel_check.py; `X` below, `Y = 0`) to 1.1e-12.
+/// A velocity off by 1e-8 fails the same check.
+#[test]
+fn the_abel_map_of_integrated_states_vouches_for_u_where_the_thetas_cannot() {
+    use crate::solution::verify::abel_rate_defect;
+    use crate::tori::solve::{c_pairs, state_frequencies, FREQUENCY_VELOCITY_RTOL};
+    let a = [
+        -0.9256184990074312,
+        279.5208482998301,
+        279.7404819891023,
+        633.6897780257893,
+    ];
+    let b = [
+        0.7214233479274308,
+        0.803524043302418,
+        0.13253913180949373,
+        0.15850845930244173,
+    ];
+    let l0 = [
+        -24227.877002259997,
+        -4.465596212550228e-05,
+        -4.466639654445864e-05,
+        -9.437204342422283e-05,
+        0.0030091702881019362,
+        9.001940697342075e-05,
+    ];
+    // the long-double Abel fit's lattice rates
+    let x_ref: [f64; 2] = [-659.1365549602779, 12.179008547527214];
+    let e = state_frequencies(&a, &b, &l0);
+    assert_eq!(e.status, Status::Ok);
+    assert!(e.nu.iter().all(|v| v.is_finite() && *v > 0.0), "{:?}", e.nu);
+    let sol = crate::solution::Solution::new(&a, &b, &l0).unwrap();
+    assert!(sol.velocity_check() > FREQUENCY_VELOCITY_RTOL);
+    let c4 = c_pairs(&a, &b).unwrap();
+    let u = sol.rate();
+    let (x, y) = sol.curve().lattice_coordinates(&u);
+    for k in 0..2 {
+        assert!((x[k] - x_ref[k]).abs() <= 1e-10 * x_ref[0].abs(), "{x:?}");
+        assert!(y[k].abs() <= 1e-10 * x_ref[0].abs(), "{y:?}");
+    }
+    let cancel = Cancel::never();
+    let d = abel_rate_defect(&sol, &c4, &u, &cancel).unwrap();
+    assert!(d <= FREQUENCY_VELOCITY_RTOL, "{d:e}");
+    let off = [u[0] * (1.0 + 1e-8), u[1]];
+    let d = abel_rate_defect(&sol, &c4, &off, &cancel).unwrap();
+    assert!(d > 1e-9, "{d:e}");
+    // the frequencies of `sol.torus` are the map's
+    let t = crate::tori::solve::torus_of_state(&a, &b, &l0).unwrap().0;
+    assert_eq!(t.nu.map(f64::to_bits), e.nu.map(f64::to_bits));
+}

@@ -1,0 +1,115 @@
+# ruff: noqa: E741  (l is the paper's name for the state)
+"""Frequencies vouched for by the Abel map of integrated states, against a long-double
+trajectory.
+
+Where the theta quotients' own velocity check leaves a defect above 1e-10 (next to
+pinched curves), ``frequency_map`` and ``sol.frequencies`` give the frequencies only
+if the Abel images of two integrated states (one and four periods of the fastest
+lattice coordinate, integrated at the default step and at half of it) lie on
+``u0 + U t`` to 1e-10 of the phase advanced. This script takes every state of the
+harsh draw of ``every_state_harsh.py`` (seed 20261125) whose velocity check exceeds
+1e-10 and whose frequency-map status is ``ok``, integrates it with heyoka in 80-bit
+long double over 20 periods (201 samples), takes the Abel image of every sample
+(``sol.abel``; samples whose image misses the lattice by more than 1e-8 are set
+aside: points next to branch points), and fits the slope of the unwrapped images:
+the true velocity in lattice coordinates. Reported per state: ``max|U - U_fit|``
+relative to the largest lattice rate; then median and maximum.
+
+Run: ``python tests/data/frequency_abel_check.py [N]`` (N draws, default 10000;
+about 4 minutes). Output committed as ``tests/data/frequency_abel_check.txt``.
+"""
+
+from __future__ import annotations
+
+import os
+import platform
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+import manakov
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from closed_u_long_double import LD, propagate  # noqa: E402
+from every_state_harsh import draw  # noqa: E402
+
+SEED = 20261125
+PERIODS = 20.0
+SAMPLES = 201
+ABEL_MISS = 1e-8  # a sample's image this far from the lattice point is set aside
+MIN_SAMPLES = 100
+
+
+def lattice(tau, z):
+    y = np.linalg.solve(tau.imag, z.imag)
+    return z.real - tau.real @ y, y
+
+
+def fitted_error(top, sol, l0):
+    """max|U - U_fit| / (largest lattice rate), and the samples used (None if too few)."""
+    x, y = lattice(sol.tau, sol.U)
+    rate = max(np.max(np.abs(x)), np.max(np.abs(y)))
+    t_user = np.linspace(0.0, PERIODS / rate / sol.time_scale, SAMPLES)
+    ref = propagate(top.a, top.b, l0, t_user, LD).astype(float)
+    keep, miss = [], []
+    for t, l in zip(t_user * sol.time_scale, ref):
+        try:
+            w = sol.abel(l)
+        except (ValueError, manakov.ClosedFormError):
+            continue
+        dx, dy = lattice(sol.tau, w - sol.u0 - sol.U * t)
+        r = np.concatenate([dx - np.round(dx), dy - np.round(dy)])
+        if np.max(np.abs(r)) < ABEL_MISS:
+            keep.append(t)
+            miss.append(r)
+    if len(keep) < MIN_SAMPLES:
+        return None, len(keep)
+    tt = np.array(keep)
+    design = np.vstack([np.ones_like(tt), tt]).T
+    coef, *_ = np.linalg.lstsq(design, np.array(miss), rcond=None)
+    return float(np.max(np.abs(coef[1])) / rate), len(keep)
+
+
+def main(n: int = 10_000) -> None:
+    rng = np.random.default_rng(SEED)
+    t0 = time.time()
+    print(
+        f"machine: {platform.machine()} {os.cpu_count()} cpus; manakov {manakov.__version__}; "
+        f"harsh draw, seed {SEED}, {n} states"
+    )
+    errs, skipped, checked = [], 0, 0
+    for i in range(n):
+        a, b, l0 = draw(rng)
+        top = manakov.ManakovTop(a, b)
+        fm = manakov.frequency_map(top, l0[None, :])
+        if manakov.tori.STATUS_NAMES[int(fm.status[0])] != "ok":
+            continue
+        sol = top.solve(l0)
+        if sol.kind != "genus2" or not sol.self_check_passed or sol.velocity_check <= 1e-10:
+            # (a solution kept after failing its self-check has no U to compare; the
+            # map's frequencies of such a state come from the level set's closed form)
+            continue
+        checked += 1
+        e, used = fitted_error(top, sol, l0)
+        if e is None:
+            skipped += 1
+            print(f"draw {i:5d}: velocity check {sol.velocity_check:.1e}; only {used} Abel images")
+            continue
+        errs.append(e)
+        print(
+            f"draw {i:5d}: velocity check {sol.velocity_check:.1e}; U against the long-double "
+            f"Abel fit {e:.1e} ({used} samples)",
+            flush=True,
+        )
+    e = np.array(errs)
+    print(
+        f"\n{checked} states ok by the Abel-map check; fitted {len(e)}: U error median "
+        f"{np.median(e):.1e}, max {np.max(e):.1e}, above 1e-10: {int(np.sum(e > 1e-10))}; "
+        f"{skipped} with too few Abel images to fit ({time.time() - t0:.0f} s)"
+    )
+
+
+if __name__ == "__main__":
+    main(*(int(x) for x in sys.argv[1:2]))
