@@ -153,23 +153,25 @@ class Solution:
     ValueError
         Invalid ``a``, ``b``, ``l0`` (shapes, non-finite values, repeated
         ``a_i``): only invalid input.
-    manakov.ClosedFormError
-        A valid state whose closed form could not be built — a level set on
-        which the Theorem's coordinates are singular to working precision
-        (``h1² = 4h0²`` off the exact sets above, coinciding branch points, a
-        repeated root of F (19), the divisor of ``l0`` at infinity), an
-        iteration of the reduction that did not converge. The message names
-        the step; integrate the state instead. A closed form that fails its
-        self-check (:attr:`self_check` above 1e-10 or :attr:`velocity_check`
-        above 1e-6, theta quotients that fit (1) at ``v0`` for no velocity, or
-        level-set constants that fail the reduction's consistency checks) is
-        returned marked (:attr:`self_check_passed` is False):
-        its :meth:`l` is then certified by an integration at every call, and
-        what depends on its phase (:attr:`U`, :attr:`u0`, :attr:`torus`,
-        :attr:`frequencies`, :attr:`constants`, the quotients) is refused.
 
     Notes
     -----
+    **Every valid state.** It gets a solution. Where the closed form cannot be built (a
+    level set on which the Theorem's coordinates are singular to working
+    precision: ``h1² = 4h0²`` off the exactly self-dual states, coinciding branch points, a
+    repeated root of F (19), the divisor of ``l0`` at infinity, an iteration of the
+    reduction that did not converge) it is of kind ``"integrated"``: the ``repr``
+    names the step, :meth:`l` is an integration of (1) in double-double, confirmed
+    with every step halved, at every call, with an ``IntegratedValuesWarning``, and
+    there are no frequencies. A closed form that fails its self-check
+    (:attr:`self_check` above 1e-10 or :attr:`velocity_check` above 1e-6, theta
+    quotients that fit (1) at ``v0`` for no velocity, or level-set constants that
+    fail the reduction's consistency checks) is returned marked
+    (:attr:`self_check_passed` is False): its :meth:`l` is then certified by an
+    integration at every call, or replaced by it where it is off, and what depends
+    on its phase (:attr:`U`, :attr:`u0`, :attr:`torus`, :attr:`frequencies`,
+    :attr:`constants`, the quotients) is refused with ``ClosedFormError``.
+
     **Frames.** The solution is built on normalized data: ``l0' = l0/s``,
     ``a' = (a − κ)/σ``, ``c' = (c − μ)/λ`` (:attr:`state_scale`,
     :attr:`frame`), with ``l(t) = s l'(T t)``, ``T = s λ``
@@ -542,7 +544,10 @@ class Solution:
             quotients' second flow disagrees with its closed form, no real
             lattice fits, or the self-check's velocity defect
             (:attr:`velocity_check`) is above 1e-10, which ``U`` and the
-            frequencies would carry. The message names the step.
+            frequencies would carry, and the Abel images of integrated states
+            do not vouch for ``U`` and ``U'`` to 1e-10 either (at three of seven
+            times one to four periods out, at two integration steps;
+            docs/degenerate.md §10). The message names the step.
         """
         self._genus2("torus", checked=True)
         if self._torus is None:
