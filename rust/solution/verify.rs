@@ -494,15 +494,16 @@ const ABEL_AGREEING: usize = 3;
 
 /// Most steps (both runs together) of the integrations of
 /// [`abel_rate_defect`]: Gauss–Legendre order 16 in double, `~1 µs` a step,
-/// so `~0.3 s`.
-pub const ABEL_CHECK_MAX_STEPS: f64 = 3e5;
+/// so `~0.1 s` per flow (`sol.frequencies` checks two flows without a
+/// cancellation token, and must answer Ctrl-C within 0.5 s).
+pub const ABEL_CHECK_MAX_STEPS: f64 = 1e5;
 
 /// The velocity `u` of the flow (1) with coefficients `c4` (state order) on
 /// the level set of `sol`, checked without theta functions: `l0` is
 /// integrated (Gauss–Legendre order 16, at the default step and at half of
 /// it) to the times `t_k` at which `u t_k` has advanced [`ABEL_PHASES`]
 /// periods in its fastest lattice coordinate, and the Abel image of each
-/// state, `u(P1(t_k)) + u(P2(t_k))` ([`Solution::abel`]: the reduction of the
+/// state, `u(P1(t_k)) + u(P2(t_k))` ([`super::Solution::abel`]: the reduction of the
 /// integrated state and Abel integrals on the curve), is compared with
 /// `u0 + u t_k` modulo the lattice, in lattice coordinates and divided by the
 /// phase advanced. Returns, over both runs, the largest of each run's
@@ -512,15 +513,15 @@ pub const ABEL_CHECK_MAX_STEPS: f64 = 3e5;
 /// integration over budget or not converged, fewer than [`ABEL_AGREEING`]
 /// states the Abel map takes).
 ///
-/// The theta quotients' own velocity check ([`Solution::velocity_check`]) is
+/// The theta quotients' own velocity check ([`super::Solution::velocity_check`]) is
 /// ill-conditioned where the curve is nearly pinched (its thetas are sums of
 /// nearly cancelling terms); this comparison uses only the reduction and the
 /// curve's periods, which the closed form of `u` shares, but not its
 /// derivation (Dubrovin's equations at half periods): a wrong `u` shows as a
 /// defect proportional to `t`. The caller has bounded `u`'s error by far less
 /// than a period per period (the velocity check within
-/// [`super::check::VELOCITY_CHECK_RTOL`], or the closed form's own
-/// consistency), so the nearest lattice vector is the right one.
+/// [`super::check::VELOCITY_CHECK_RTOL`]), so the nearest lattice vector is
+/// the right one.
 pub fn abel_rate_defect(
     sol: &super::Solution,
     c4: &[f64; 6],
@@ -530,9 +531,9 @@ pub fn abel_rate_defect(
     abel_rate_defect_of(sol.curve(), |l| sol.abel(l), &sol.l0, c4, u, cancel)
 }
 
-/// [`abel_rate_defect`] on a curve with its Abel map of states `abel`
-/// (e.g. [`super::LevelSetCurve::abel`]), from the state `l0`.
-pub fn abel_rate_defect_of(
+/// [`abel_rate_defect`] on a curve with its Abel map of states `abel`, from
+/// the state `l0`.
+fn abel_rate_defect_of(
     curve: &crate::riemann::HyperellipticCurve,
     abel: impl Fn(&[f64; 6]) -> Result<[num_complex::Complex64; 2]>,
     l0: &[f64; 6],
