@@ -1009,6 +1009,62 @@ def test_the_velocity_part_of_the_self_check_has_its_own_bound(case) -> None:
     assert err is not None and err <= ABEL_FIT_BOUND
 
 
+#: Draws of the harsh random draw (tests/data/every_state_harsh.py, seed 20261125)
+#: whose theta quotients' velocity check exceeds 1e-10: (a, b, l0). Draw 48 (branch
+#: points spread over 1e30): the Abel images of integrated states vouch for U and U'
+#: (and U agrees with a long-double Abel fit to 1.1e-12); draw 1724: they move along
+#: U only to 1.7e-9, at every phase.
+ABEL_STATES = [
+    (
+        [-0.9256184990074312, 279.5208482998301, 279.7404819891023, 633.6897780257893],
+        [0.7214233479274308, 0.803524043302418, 0.13253913180949373, 0.15850845930244173],
+        [
+            -24227.877002259997,
+            -4.465596212550228e-05,
+            -4.466639654445864e-05,
+            -9.437204342422283e-05,
+            0.0030091702881019362,
+            9.001940697342075e-05,
+        ],
+    ),
+    (
+        [-0.5418066723731292, 5.489311414050225, 7.892608735593191, 8.482776549852908],
+        [-0.5061151963599513, -0.16699530284397474, -0.17447762438702374, -0.40448708043917325],
+        [
+            6.665991411962938e-05,
+            -0.00017742300824603844,
+            -38703.052749430375,
+            0.0005861107858978626,
+            13989.820985456234,
+            -5.125851437021158e-06,
+        ],
+    ),
+]
+
+
+def test_the_abel_map_of_integrated_states_vouches_for_the_frequencies() -> None:
+    """Where the velocity check cannot vouch for U, the frequencies are given only
+    if the Abel images of integrated states do, by ``sol.frequencies`` and the
+    frequency map alike (the same bits); otherwise both refuse, naming the check."""
+    (a, b, l0), (a2, b2, l02) = ABEL_STATES
+    top = manakov.ManakovTop(a, b)
+    sol = top.solve(l0)
+    assert sol.self_check_passed and sol.velocity_check > SHAPE_CHECK_BOUND
+    fm = manakov.frequency_map(top, np.asarray([l0]))
+    assert int(fm.status[0]) == manakov.tori.OK
+    np.testing.assert_array_equal(fm.nu[0], sol.frequencies)
+    assert np.all(sol.frequencies > 0)
+
+    top = manakov.ManakovTop(a2, b2)
+    sol = top.solve(l02)
+    assert sol.self_check_passed and sol.velocity_check > SHAPE_CHECK_BOUND
+    with pytest.raises(manakov.ClosedFormError, match="Abel images of integrated states"):
+        _ = sol.frequencies
+    fm = manakov.frequency_map(top, np.asarray([l02]))
+    assert manakov.tori.STATUS_NAMES[int(fm.status[0])] == "singular"
+    assert np.isnan(fm.nu[0]).all()
+
+
 #: States of the harsh draw (seed 5) whose branch points spread over 1e18 and
 #: more: their torus took the double route and ``sol.frequencies`` raised
 #: ValueError ("the solution's set-up is wrong at this state") though the
