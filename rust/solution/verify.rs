@@ -25,6 +25,10 @@
 //! do, within [`STAND_IN_MAX_STEPS`]): then the finest run's values stand in
 //! for the closed form's ([`Outcome::Integrated`]). Otherwise, or where the
 //! integrations would exceed their budgets, `l(t)` is refused.
+//!
+//! The velocity `U` itself, where the theta quotients' velocity check cannot
+//! vouch for it to the frequencies' accuracy, is checked the same way, by
+//! the Abel images of integrated states ([`abel_rate_defect`]).
 
 use crate::error::{Error, Result};
 use crate::integrate::gauss_dd::{gauss16_dd_so4, gauss16_dd_steps};
