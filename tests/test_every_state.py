@@ -1065,6 +1065,35 @@ def test_the_abel_map_of_integrated_states_vouches_for_the_frequencies() -> None
     assert np.isnan(fm.nu[0]).all()
 
 
+#: Draw 2569 of the same harsh draw (branch points spread over 5e19): the theta
+#: quotients' second flow at v0 disagrees with the closed form beyond rounding, so
+#: the map reported "inconsistent quotients"; the Abel images of integrated states
+#: vouch for the closed form's U and U' (and U agrees with a long-double Abel fit to
+#: 8e-17, tests/data/frequency_abel_check.txt).
+SECOND_FLOW_STATE = (
+    [-0.016037165123906627, 0.5660137801400072, 0.5693851326940633, 0.971924116008821],
+    [-0.8247676899180314, -820.7323378968325, -817.4022075717587, -813.9419013918285],
+    [
+        42372.04097017483,
+        -0.015164808843369421,
+        -970.2578328004325,
+        3.9786670507545795e-06,
+        245651.39147523142,
+        0.00013540501777417548,
+    ],
+)
+
+
+def test_the_abel_map_decides_where_the_second_flow_disagrees() -> None:
+    a, b, l0 = SECOND_FLOW_STATE
+    top = manakov.ManakovTop(a, b)
+    sol = top.solve(l0)
+    assert sol.self_check_passed
+    fm = manakov.frequency_map(top, np.asarray([l0]))
+    assert int(fm.status[0]) == manakov.tori.OK
+    np.testing.assert_array_equal(fm.nu[0], sol.frequencies)
+
+
 #: States of the harsh draw (seed 5) whose branch points spread over 1e18 and
 #: more: their torus took the double route and ``sol.frequencies`` raised
 #: ValueError ("the solution's set-up is wrong at this state") though the

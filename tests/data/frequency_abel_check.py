@@ -7,17 +7,24 @@ pinched curves), ``frequency_map`` and ``sol.frequencies`` give the frequencies 
 if the Abel images of integrated states (phases of one to four periods of the
 fastest lattice coordinate, integrated at the default step and at half of it; three
 of the seven phases in each run) lie on ``u0 + U t`` to 1e-10 of the phase
-advanced, for ``U`` and for the second flow's ``U'``. This script takes every state
-of the harsh draw of ``every_state_harsh.py`` (seed 20261125) whose velocity check
-exceeds 1e-10 and whose frequency-map status is ``ok``, integrates it with heyoka in
-80-bit long double over 20 periods (201 samples), takes the Abel image of every
-sample (``sol.abel``; samples whose image misses the lattice by more than 1e-8 are
-set aside: points next to branch points), and fits the slope of the unwrapped
-images: the true velocity in lattice coordinates. Reported per state:
-``max|U - U_fit|`` relative to the largest lattice rate; then median and maximum.
+advanced, for ``U`` and for the second flow's ``U'``; so does it where the
+quotients' second flow at ``v0`` disagrees with the closed form. This script takes
+every state of the harsh draw of ``every_state_harsh.py`` (seed 20261125) whose
+frequency-map status is ``ok`` and whose solution passed its self-check with a
+velocity check above 1e-10, or has branch points spread over more than 1e14 (there
+the map takes the solution's route: the theta quotients or the Abel images vouch for
+``U``), integrates it with heyoka in 80-bit long double over 20 periods (201
+samples), takes the Abel image of every sample (``sol.abel``; samples whose image
+misses the lattice by more than 1e-8 are set aside: points next to branch points),
+and fits the slope of the unwrapped images: the true velocity in lattice
+coordinates. Reported per state: ``max|U - U_fit|`` relative to the largest lattice
+rate; then median and maximum for the two groups. The long-double trajectory is not
+a reference beyond its own accuracy: on these states (components spanning up to
+twelve orders of magnitude) its rounding is amplified as double's is
+(``every_state_harsh.py``), and its error over 20 periods enters the slope.
 
 Run: ``python tests/data/frequency_abel_check.py [N]`` (N draws, default 10000;
-about a minute). Output committed as ``tests/data/frequency_abel_check.txt``.
+about three minutes). Output committed as ``tests/data/frequency_abel_check.txt``.
 """
 
 from __future__ import annotations
@@ -46,6 +53,14 @@ MIN_SAMPLES = 100
 def lattice(tau, z):
     y = np.linalg.solve(tau.imag, z.imag)
     return z.real - tau.real @ y, y
+
+
+def spread(sol):
+    """``max|d| / min|d_i - d_j|`` of the branch points: beyond 1e14 the frequency
+    map takes the solution's route, where the theta quotients check U and U'."""
+    d = np.asarray(sol._core.branch_points)
+    sep = min(abs(d[i] - d[j]) for i in range(len(d)) for j in range(i + 1, len(d)))
+    return float(np.max(np.abs(d)) / sep) if sep > 0 else np.inf
 
 
 def fitted_error(top, sol, l0):
@@ -80,7 +95,7 @@ def main(n: int = 10_000) -> None:
         f"machine: {platform.machine()} {os.cpu_count()} cpus; manakov {manakov.__version__}; "
         f"harsh draw, seed {SEED}, {n} states"
     )
-    errs, skipped, checked = [], 0, 0
+    errs, errs_spread, skipped, checked = [], [], 0, 0
     for i in range(n):
         a, b, l0 = draw(rng)
         top = manakov.ManakovTop(a, b)
@@ -88,26 +103,37 @@ def main(n: int = 10_000) -> None:
         if manakov.tori.STATUS_NAMES[int(fm.status[0])] != "ok":
             continue
         sol = top.solve(l0)
-        if sol.kind != "genus2" or not sol.self_check_passed or sol.velocity_check <= 1e-10:
+        if sol.kind != "genus2" or not sol.self_check_passed:
+            continue
+        if sol.velocity_check <= 1e-10 and spread(sol) <= 1e14:
             continue
         checked += 1
         e, used = fitted_error(top, sol, l0)
         if e is None:
             skipped += 1
-            print(f"draw {i:5d}: velocity check {sol.velocity_check:.1e}; only {used} Abel images")
+            print(
+                f"draw {i:5d}: velocity check {sol.velocity_check:.1e}, spread "
+                f"{spread(sol):.0e}; only {used} Abel images"
+            )
             continue
-        errs.append(e)
+        (errs if sol.velocity_check > 1e-10 else errs_spread).append(e)
         print(
-            f"draw {i:5d}: velocity check {sol.velocity_check:.1e}; U against the long-double "
-            f"Abel fit {e:.1e} ({used} samples)",
+            f"draw {i:5d}: velocity check {sol.velocity_check:.1e}, spread {spread(sol):.0e}; "
+            f"U against the long-double Abel fit {e:.1e} ({used} samples)",
             flush=True,
         )
-    e = np.array(errs)
-    print(
-        f"\n{checked} states ok with a velocity check above 1e-10; fitted {len(e)}: U error "
-        f"median {np.median(e):.1e}, max {np.max(e):.1e}, above 1e-10: {int(np.sum(e > 1e-10))}; "
-        f"{skipped} with too few Abel images to fit ({time.time() - t0:.0f} s)"
-    )
+    print(f"\n{checked} states ok with a velocity check above 1e-10 or branch points spread")
+    took = time.time() - t0
+    print(f"over more than 1e14; {skipped} with too few Abel images to fit ({took:.0f} s)")
+    for what, v in (
+        ("velocity check above 1e-10 (the Abel-map check vouched for U)", errs),
+        ("velocity check at most 1e-10, spread above 1e14 (the thetas vouched for U)", errs_spread),
+    ):
+        e = np.array(v)
+        print(
+            f"  {what}: fitted {len(e)}, U error median {np.median(e):.1e}, "
+            f"max {np.max(e):.1e}, above 1e-10: {int(np.sum(e > 1e-10))}"
+        )
 
 
 if __name__ == "__main__":
