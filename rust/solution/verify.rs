@@ -532,19 +532,7 @@ pub fn abel_rate_defect(
     u: &[num_complex::Complex64; 2],
     cancel: &Cancel,
 ) -> Result<f64> {
-    abel_rate_defect_of(sol.curve(), |l| sol.abel(l), &sol.l0, c4, u, cancel)
-}
-
-/// [`abel_rate_defect`] on a curve with its Abel map of states `abel`, from
-/// the state `l0`.
-fn abel_rate_defect_of(
-    curve: &crate::riemann::HyperellipticCurve,
-    abel: impl Fn(&[f64; 6]) -> Result<[num_complex::Complex64; 2]>,
-    l0: &[f64; 6],
-    c4: &[f64; 6],
-    u: &[num_complex::Complex64; 2],
-    cancel: &Cancel,
-) -> Result<f64> {
+    let (curve, l0) = (sol.curve(), &sol.l0);
     let (x, y) = curve.lattice_coordinates(u);
     let rate = nan_max(x.iter().chain(&y).map(|v| v.abs()));
     if !(rate > 0.0 && rate.is_finite()) {
@@ -552,13 +540,13 @@ fn abel_rate_defect_of(
     }
     let times = ABEL_PHASES.map(|f| f / rate);
     let t_end = times[ABEL_PHASES.len() - 1];
-    let size = l0.iter().map(|v| v * v).sum::<f64>().sqrt();
-    let dt = default_dt(c4, size);
+    let dt = default_dt(c4, sol.size);
     let steps = 3.0 * t_end / dt;
     if steps.is_nan() || steps > ABEL_CHECK_MAX_STEPS {
         return Ok(f64::NAN);
     }
-    let Ok(u0) = abel(l0) else {
+    // the Abel image of l0 by the same route as the integrated states'
+    let Ok(u0) = sol.abel(l0) else {
         return Ok(f64::NAN);
     };
     let top = top(c4, 1.0)?;
@@ -579,7 +567,7 @@ fn abel_rate_defect_of(
         let mut defects: Vec<f64> = Vec::with_capacity(times.len());
         for (k, l) in tr.y.chunks_exact(6).enumerate() {
             let l: [f64; 6] = l.try_into().expect("rows of 6");
-            let Ok(w) = abel(&l) else {
+            let Ok(w) = sol.abel(&l) else {
                 continue;
             };
             let d = [

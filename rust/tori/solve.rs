@@ -135,86 +135,65 @@ pub fn flow_data_with(sol: &Solution, b2: &[f64; 4], cancel: &Cancel) -> Result<
     let candidate = closed
         .as_ref()
         .map_or([C::new(0.0, 0.0); 2], |lat| lat.u[1]);
-    let ((u2, res), res_closed) = sol.rate_and_residual_of(&c2, &candidate)?;
-    // Where the theta quotients' second flow at v0 disagrees with the closed
-    // form (or fits no velocity), the closed form stands only if the Abel
-    // images of integrated states move along U and U' (next to pinched curves
-    // the quotients' derivatives lose their digits; the shape of the
-    // quotients, which fixes the lattice of periods of l, passed the
-    // self-check).
-    let closed_by_abel =
-        |lat: &crate::solution::dubrovin::LatticeRates| -> Result<Option<FlowData>> {
-            match abel_check(sol, &c2, &lat.u[0], &lat.u[1], cancel) {
-                Ok(()) => Ok(Some(FlowData {
-                    tau: [[t[0], t[1]], [t[2], t[3]]],
-                    u: lat.u[0],
-                    u2: lat.u[1],
-                    chars: chars.clone(),
-                    w: Some(lat.w[0]),
-                })),
-                Err(Error::Unverified { .. }) => Ok(None),
-                Err(e) => Err(e),
-            }
-        };
-    if res.is_nan() || res > QUOTIENT_RESIDUAL_RTOL {
-        if let Some(lat) = closed.as_ref() {
-            if let Some(d) = closed_by_abel(lat)? {
-                return Ok(d);
-            }
-        }
-        return Err(Error::Singular {
-            what: INCONSISTENT,
-            kind: SingularKind::InconsistentQuotients,
-            reason: format!(
-                "the theta quotients (9)-(10) at v0 satisfy Frahm's equations (1) of the \
-                 second flow for no velocity (least-squares residual {res:e} > \
-                 {QUOTIENT_RESIDUAL_RTOL:e}): the solution's set-up is wrong at this state; \
-                 its frequencies would be too"
-            ),
-        });
-    }
-    let Some(lat) = closed else {
-        let u = sol.rate();
-        if by_abel {
-            abel_check(sol, &c2, &u, &u2, cancel)?;
-        }
-        return Ok(FlowData {
-            tau: [[t[0], t[1]], [t[2], t[3]]],
-            u,
-            u2,
-            chars,
-            w: None,
-        });
+    let ((u2_fit, res), res_closed) = sol.rate_and_residual_of(&c2, &candidate)?;
+    let theta_refusal = |reason: String| Error::Singular {
+        what: INCONSISTENT,
+        kind: SingularKind::InconsistentQuotients,
+        reason,
     };
-    let (u, u2_closed) = (lat.u[0], lat.u[1]);
-    let dev = (u2_closed[0] - u2[0])
-        .norm()
-        .max((u2_closed[1] - u2[1]).norm())
-        / u2[0].norm().max(u2[1].norm()).max(f64::MIN_POSITIVE);
-    if !closed_form_fits(dev, res_closed, res) {
-        if let Some(d) = closed_by_abel(&lat)? {
-            return Ok(d);
-        }
-        return Err(Error::Singular {
-            what: INCONSISTENT,
-            kind: SingularKind::InconsistentQuotients,
-            reason: format!(
+    let refusal = if res.is_nan() || res > QUOTIENT_RESIDUAL_RTOL {
+        Some(theta_refusal(format!(
+            "the theta quotients (9)-(10) at v0 satisfy Frahm's equations (1) of the second \
+             flow for no velocity (least-squares residual {res:e} > \
+             {QUOTIENT_RESIDUAL_RTOL:e}): the solution's set-up is wrong at this state; its \
+             frequencies would be too"
+        )))
+    } else if let Some(lat) = closed.as_ref() {
+        let u2c = lat.u[1];
+        let dev = (u2c[0] - u2_fit[0]).norm().max((u2c[1] - u2_fit[1]).norm())
+            / u2_fit[0]
+                .norm()
+                .max(u2_fit[1].norm())
+                .max(f64::MIN_POSITIVE);
+        (!closed_form_fits(dev, res_closed, res)).then(|| {
+            theta_refusal(format!(
                 "the theta quotients (9)-(10) at v0 move along the second flow at a velocity \
                  {dev:e} (relative) away from the closed form, which leaves a residual \
                  {res_closed:e} in their equations against {res:e} for their own fit: the \
                  solution's set-up is wrong at this state; its frequencies would be too"
-            ),
-        });
-    }
-    if by_abel {
-        abel_check(sol, &c2, &u, &u2_closed, cancel)?;
+            ))
+        })
+    } else {
+        None
+    };
+    let (u, u2, w) = match closed.as_ref() {
+        Some(lat) => (lat.u[0], lat.u[1], Some(lat.w[0])),
+        None => (sol.rate(), u2_fit, None),
+    };
+    if let Some(refusal) = refusal {
+        // Where the quotients' second flow at v0 disagrees with the closed
+        // form (or fits no velocity), the closed form stands only if the Abel
+        // images of integrated states move along U and U' (next to pinched
+        // curves the quotients' derivatives lose their digits; the shape of
+        // the quotients, which fixes the lattice of periods of l, passed the
+        // self-check).
+        if closed.is_none() {
+            return Err(refusal);
+        }
+        match abel_check(sol, &c2, &u, &u2, cancel) {
+            Ok(()) => {}
+            Err(Error::Unverified { .. }) => return Err(refusal),
+            Err(e) => return Err(e),
+        }
+    } else if by_abel {
+        abel_check(sol, &c2, &u, &u2, cancel)?;
     }
     Ok(FlowData {
         tau: [[t[0], t[1]], [t[2], t[3]]],
         u,
-        u2: u2_closed,
+        u2,
         chars,
-        w: Some(lat.w[0]),
+        w,
     })
 }
 
@@ -238,19 +217,18 @@ fn abel_check(
     if d1 <= FREQUENCY_VELOCITY_RTOL && d2 <= FREQUENCY_VELOCITY_RTOL {
         return Ok(());
     }
-    let abel = if d1.is_nan() || (d1 <= FREQUENCY_VELOCITY_RTOL && d2.is_nan()) {
+    // the failing flow's defect (NaN: the check could not be made)
+    let worst = if d1 <= FREQUENCY_VELOCITY_RTOL {
+        d2
+    } else {
+        d1
+    };
+    let abel = if worst.is_nan() {
         "the Abel images of integrated states could not check them (an integration beyond \
          its budget, or a state the Abel map refuses)"
             .to_string()
     } else {
-        format!(
-            "the Abel images of integrated states move along them only to {:e} (relative)",
-            if d1 <= FREQUENCY_VELOCITY_RTOL {
-                d2
-            } else {
-                d1
-            }
-        )
+        format!("the Abel images of integrated states move along them only to {worst:e} (relative)")
     };
     Err(Error::Unverified {
         what: "frequencies",
