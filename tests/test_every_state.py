@@ -1065,6 +1065,78 @@ def test_the_abel_map_of_integrated_states_vouches_for_the_frequencies() -> None
     assert np.isnan(fm.nu[0]).all()
 
 
+#: Draws 1186 and 3623 of the same harsh draw (branch points spread over 2e20 and 3e25,
+#: velocity checks ~1e-14): the theta quotients hardly depend on one direction of u, and
+#: their least-squares fit of U at v0 moved along it. The earlier code took that fit on
+#: both (on 1186 the closed form missed the quotients' equations by 5e-14, against 2e-15
+#: for the fit; on 3623 the closed form refused) and the frequency map answered ok, with U
+#: off by 1.2e-10 and 4.6e-10 of the largest lattice rate against the Abel images of a
+#: long-double and of a quadruple-precision trajectory (tests/data/frequency_abel_check.txt).
+WEAK_DIRECTION_STATES = [
+    (
+        [-0.4454024278348636, -0.42589631886380747, 249.18970958170598, 249.2216294628726],
+        [-0.3075013164131313, 1.0866925012822841, 1.0519353458939835, -48.43258356477687],
+        [
+            2.3256432749528925e-05,
+            -0.287819530727858,
+            3.4718312737733566e-05,
+            21.223581172596212,
+            -32635.21482975332,
+            -352009.37074253923,
+        ],
+    ),
+    (
+        [-0.3814808669904197, -0.3729425763169566, -0.3596055202044561, 205.83910298881904],
+        [-0.6336396621091573, -23.67820708965942, -23.688458628401747, -199.92630912572676],
+        [
+            -3204.129745655722,
+            -42.9394532941246,
+            -1.017504428068009e-06,
+            0.1019325793331956,
+            4.6881045416241725e-05,
+            -0.0039002131835123273,
+        ],
+    ),
+]
+
+#: U of draw 1186 against the slope of the Abel images of a long-double trajectory over
+#: 20 periods, relative to the largest lattice rate (measured 1.1e-13; the earlier fit
+#: 1.2e-10).
+WEAK_DIRECTION_BOUND = 1e-12
+
+
+def test_the_fit_of_u_is_not_trusted_along_a_direction_the_quotients_hardly_see() -> None:
+    """The closed form of U stands where it satisfies the quotients' equations to the
+    bound they vouch for; where U is their fit, the frequencies need the Abel images of
+    integrated states, which refuse it on draw 3623 (by the defect the
+    quadruple-precision trajectory shows)."""
+    (a, b, l0), (a2, b2, l02) = WEAK_DIRECTION_STATES
+    top = manakov.ManakovTop(a, b)
+    sol = top.solve(l0)
+    assert sol.self_check_passed and sol.velocity_check <= SHAPE_CHECK_BOUND
+    fm = manakov.frequency_map(top, np.asarray([l0]))
+    assert int(fm.status[0]) == manakov.tori.OK
+    np.testing.assert_array_equal(fm.nu[0], sol.frequencies)
+
+    top2 = manakov.ManakovTop(a2, b2)
+    sol2 = top2.solve(l02)
+    assert sol2.self_check_passed and sol2.velocity_check <= SHAPE_CHECK_BOUND
+    with pytest.raises(manakov.ClosedFormError, match="least-squares fit"):
+        _ = sol2.frequencies
+    fm = manakov.frequency_map(top2, np.asarray([l02]))
+    assert manakov.tori.STATUS_NAMES[int(fm.status[0])] == "singular"
+    assert np.isnan(fm.nu[0]).all()
+
+    pytest.importorskip("heyoka")
+    data = str(Path(__file__).resolve().parent / "data")
+    if data not in sys.path:
+        sys.path.insert(0, data)
+    import frequency_abel_check
+
+    err, _ = frequency_abel_check.fitted_error(top, sol, np.asarray(l0, float))
+    assert err is not None and err <= WEAK_DIRECTION_BOUND
+
+
 #: Draw 2569 of the same harsh draw (branch points spread over 5e19): the theta
 #: quotients' second flow at v0 disagrees with the closed form beyond rounding, so
 #: the map reported "inconsistent quotients"; the Abel images of integrated states
@@ -1154,13 +1226,13 @@ def test_frequency_map_takes_the_checked_route_beyond_the_closed_forms_resolutio
     assert abs(nu[0] - 3102.5) <= 5.0 and abs(nu[1] - 62637.5) <= 5.0, nu
 
 
-#: Draws 857, 163, 203 and 6962 of the harsh draw (every_state_harsh.py): closed
-#: forms that fail their self-check (shape defects 1.1e-8 and 7.5e-9), whose theta
+#: Draws 857, 195, 203 and 6962 of the harsh draw (every_state_harsh.py): closed
+#: forms that fail their self-check (shape defects 1.1e-8 and 9.3e-10), whose theta
 #: quotients at v0 fit (1) for no velocity (least-squares residual 1.6e-6 > 1e-6,
 #: shape defect 1.9e-13), or whose level-set constants fail the check of H0's
 #: structure (38)/(40). The first, third and fourth are right along their windows
 #: (7.3e-14, 2.4e-13 and 3.7e-15 against the long-double reference), the second
-#: is not (2.8e-9 |l0| from an integration in double-double at the end).
+#: is not (1.3e-9 |l0| from an integration in double-double within it).
 UNCHECKED_STATES = [
     (
         [-0.9118629977757504, 398.46492300776555, 398.4661794162518, 402.2344698630952],
@@ -1176,17 +1248,17 @@ UNCHECKED_STATES = [
         0.014688063554244504,
     ),
     (
-        [0.7871471108199299, 0.7882267353305348, 174.0290173375445, 174.0302390066087],
-        [0.6654561430630088, 0.6687574284186036, 79.12800030407737, 77.64364074701808],
+        [0.8810341654200204, 0.9163375965178816, 1.1432612337807124, 1.1532078079950483],
+        [0.3707677167575256, 6.486656610661125, -317.54358509588627, -316.01351405932826],
         [
-            9.71950254150562e-05,
-            -138.54347278539672,
-            -19821.992860864902,
-            0.0011373387969342873,
-            13.699054030265806,
-            2192.0821683806084,
+            37.8489023231889,
+            -8.544633908886218e-06,
+            -677.2913640014009,
+            -0.0007415929064130015,
+            0.039819187686347714,
+            -1.228988799401224e-06,
         ],
-        4.1164743115916743e-05,
+        0.0009206859868637815,
     ),
     (
         [0.6109151358462188, 0.6124854301945707, 154.43112318429013, 154.43214855487565],
@@ -1243,7 +1315,9 @@ def test_a_closed_form_failing_its_self_check_gives_only_certified_l(k: int) -> 
         ):
             getattr(sol, what)
     t = np.linspace(0.0, float(t_end), 51)
-    ref = longdouble_ref.reference(a, b, l0, t)
+    # the second state's long-double trajectory is itself off by 4e-3 |l0| (its
+    # components span seven orders of magnitude); quadruple precision decides
+    ref = (longdouble_ref.reference_quad if k == 1 else longdouble_ref.reference)(a, b, l0, t)
     if k == 1:
         with pytest.warns(manakov.IntegratedValuesWarning, match="fail the self-check"):
             lt = sol.l(t)

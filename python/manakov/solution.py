@@ -544,7 +544,10 @@ class Solution:
             quotients' second flow disagrees with its closed form, no real
             lattice fits, or the self-check's velocity defect
             (:attr:`velocity_check`) is above 1e-10, which ``U`` and the
-            frequencies would carry, and the Abel images of integrated states
+            frequencies would carry, or ``U`` is the theta quotients' fit at
+            ``v0`` next to a pinched curve (where its closed form refused; the
+            quotients then hardly depend on one direction of ``u``, and the fit
+            can be off along it), and the Abel images of integrated states
             do not vouch for ``U`` and ``U'`` to 1e-10 either (at three of seven
             times one to four periods out, at two integration steps;
             docs/degenerate.md §10). The message names the step.

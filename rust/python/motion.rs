@@ -151,7 +151,10 @@ impl MotionCore {
 
     /// The real torus of a genus-2 motion: `(λ rows, coords rows, ν, U')`.
     fn torus<'py>(&self, py: Python<'py>) -> PyResult<TorusOut<'py>> {
-        let (t, u2) = py.detach(|| torus_of_motion(&self.motion))?;
+        let (t, u2) = {
+            let cancel = py_cancel();
+            py.detach(|| torus_of_motion(&self.motion, &cancel))
+        }?;
         Ok((
             stack(t.lambda)?.into_pyarray(py),
             stack(t.coords)?.into_pyarray(py),

@@ -80,7 +80,10 @@ fn torus_of_state_py<'py>(
     let a: [f64; 4] = array1(&a, "a")?;
     let b: [f64; 4] = array1(&b, "b")?;
     let l0: [f64; 6] = array1(&l0, "l0")?;
-    let (t, u2) = py.detach(|| tori::solve::torus_of_state(&a, &b, &l0))?;
+    let (t, u2) = {
+        let cancel = py_cancel();
+        py.detach(|| tori::solve::torus_of_state(&a, &b, &l0, &cancel))
+    }?;
     Ok((
         stack(t.lambda)?.into_pyarray(py),
         stack(t.coords)?.into_pyarray(py),

@@ -498,14 +498,29 @@ const ABEL_AGREEING: usize = 3;
 
 /// Most steps (both runs together) of the integrations of
 /// [`abel_rate_defect`]: Gauss–Legendre order 16 in double, `~1 µs` a step,
-/// so `~0.1 s` per flow (`sol.frequencies` checks two flows without a
-/// cancellation token, and must answer Ctrl-C within 0.5 s).
+/// so `~0.1 s` per flow.
 pub const ABEL_CHECK_MAX_STEPS: f64 = 1e5;
+
+/// Where the double runs of [`abel_rate_defect`] leave a defect above this
+/// (the frequencies' bound), the same integrations are repeated in
+/// double-double: on states whose components span many orders of magnitude
+/// the rounding of Gauss–Legendre in double (`~1e-16 |l0|` a step) is a large
+/// relative change of the small components, which moves the Abel images (a
+/// state of the harsh draw next to a pinched curve: 3.2e-10 from the double
+/// runs, 3e-13 from double-double, 3.4e-13 against a quadruple-precision
+/// trajectory).
+pub const ABEL_DD_FROM: f64 = 1e-10;
+
+/// Most steps (both runs together) of the double-double integrations of
+/// [`abel_rate_defect`], `~20 µs` a step: `~2 s` per flow at most (the
+/// cancellation token is checked at every step).
+pub const ABEL_CHECK_MAX_DD_STEPS: f64 = 1e5;
 
 /// The velocity `u` of the flow (1) with coefficients `c4` (state order) on
 /// the level set of `sol`, checked without theta functions: `l0` is
 /// integrated (Gauss–Legendre order 16, at the default step and at half of
-/// it) to the times `t_k` at which `u t_k` has advanced [`ABEL_PHASES`]
+/// it; again in double-double where the two leave more than [`ABEL_DD_FROM`])
+/// to the times `t_k` at which `u t_k` has advanced [`ABEL_PHASES`]
 /// periods in its fastest lattice coordinate, and the Abel image of each
 /// state, `u(P1(t_k)) + u(P2(t_k))` ([`super::Solution::abel`]: the reduction of the
 /// integrated state and Abel integrals on the curve), is compared with
@@ -549,23 +564,10 @@ pub fn abel_rate_defect(
     let Ok(u0) = sol.abel(l0) else {
         return Ok(f64::NAN);
     };
-    let top = top(c4, 1.0)?;
-    let mut worst = 0.0f64;
-    for h in [dt, dt / 2.0] {
-        let opts = Options {
-            method: Method::Gauss16,
-            dt: h,
-            rtol: 0.0,
-            atol: 0.0,
-            max_steps: ((t_end / h).ceil() as u64).saturating_add(16 + times.len() as u64),
-        };
-        let tr = match integrate_with(&top, l0, 0.0, &times, &opts, cancel) {
-            Ok(tr) => tr,
-            Err(Error::NoConvergence { .. }) => return Ok(f64::NAN),
-            Err(e) => return Err(e),
-        };
+    // each run's ABEL_AGREEING-th smallest defect (None: too few Abel images)
+    let defect_of = |y: &[f64]| -> Option<f64> {
         let mut defects: Vec<f64> = Vec::with_capacity(times.len());
-        for (k, l) in tr.y.chunks_exact(6).enumerate() {
+        for (k, l) in y.chunks_exact(6).enumerate() {
             let l: [f64; 6] = l.try_into().expect("rows of 6");
             let Ok(w) = sol.abel(&l) else {
                 continue;
@@ -581,10 +583,48 @@ pub fn abel_rate_defect(
             }
         }
         if defects.len() < ABEL_AGREEING {
-            return Ok(f64::NAN);
+            return None;
         }
         defects.sort_by(f64::total_cmp);
-        worst = worst.max(defects[ABEL_AGREEING - 1]);
+        Some(defects[ABEL_AGREEING - 1])
+    };
+    let top = top(c4, 1.0)?;
+    let mut worst = 0.0f64;
+    for h in [dt, dt / 2.0] {
+        let opts = Options {
+            method: Method::Gauss16,
+            dt: h,
+            rtol: 0.0,
+            atol: 0.0,
+            max_steps: ((t_end / h).ceil() as u64).saturating_add(16 + times.len() as u64),
+        };
+        let tr = match integrate_with(&top, l0, 0.0, &times, &opts, cancel) {
+            Ok(tr) => tr,
+            Err(Error::NoConvergence { .. }) => return Ok(f64::NAN),
+            Err(e) => return Err(e),
+        };
+        let Some(d) = defect_of(&tr.y) else {
+            return Ok(f64::NAN);
+        };
+        worst = worst.max(d);
     }
-    Ok(worst)
+    if worst <= ABEL_DD_FROM || 3.0 * gauss16_dd_steps(&times, dt, 1) > ABEL_CHECK_MAX_DD_STEPS {
+        return Ok(worst);
+    }
+    // The double integrations may be the ones that are off: double-double
+    // decides (the same steps, and every step halved).
+    let c = c4.map(Dd::new);
+    let mut worst_dd = 0.0f64;
+    for split in [1, 2] {
+        let y = match gauss16_dd_so4(&c, l0, &times, dt, split, cancel) {
+            Ok(y) => y,
+            Err(Error::NoConvergence { .. }) => return Ok(worst),
+            Err(e) => return Err(e),
+        };
+        let Some(d) = defect_of(&y) else {
+            return Ok(worst);
+        };
+        worst_dd = worst_dd.max(d);
+    }
+    Ok(worst_dd)
 }

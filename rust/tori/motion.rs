@@ -15,7 +15,7 @@
 
 use num_complex::Complex64 as C;
 
-use super::solve::{classify as classify_error, flow_data, level_set_entry_with};
+use super::solve::{classify as classify_error, flow_data_with, level_set_entry_with};
 use super::{real_torus_with_rates, MapEntry, RealTorus, Status};
 use crate::error::{Error, Result};
 use crate::numeric::cancel::Cancel;
@@ -75,9 +75,11 @@ pub fn state_frequencies_in_with(frame: &TopFrame, l0: &[f64; 6], cancel: &Cance
 /// the normalized frame except the frequencies, which are per unit of the
 /// user's time.
 ///
+/// `cancel` reaches the integrations of the Abel-map check of the velocities.
+///
 /// Errors: a motion of another kind (the message names it; those have no
-/// 2-torus), and those of [`flow_data`] and [`real_torus_with_rates`].
-pub fn torus_of_motion(m: &Motion) -> Result<(RealTorus, [C; 2])> {
+/// 2-torus), and those of [`flow_data_with`] and [`real_torus_with_rates`].
+pub fn torus_of_motion(m: &Motion, cancel: &Cancel) -> Result<(RealTorus, [C; 2])> {
     if m.kind() == Kind::Integrated {
         return Err(Error::Unverified {
             what: "torus of this l0",
@@ -98,7 +100,7 @@ pub fn torus_of_motion(m: &Motion) -> Result<(RealTorus, [C; 2])> {
             reason: why.to_string(),
         }));
     }
-    let torus = flow_data(sol, &m.frame().second_flow_b()).and_then(|d| {
+    let torus = flow_data_with(sol, &m.frame().second_flow_b(), cancel).and_then(|d| {
         Ok((
             real_torus_with_rates(&d.tau, &d.u, &d.u2, &d.chars, d.w.as_ref())?,
             d.u2,

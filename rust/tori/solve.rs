@@ -71,6 +71,25 @@ pub fn needs_dd(curve: &HyperellipticCurve) -> bool {
 /// `δ` relative).
 pub const FREQUENCY_VELOCITY_RTOL: f64 = crate::solution::SELF_CHECK_RTOL;
 
+/// Where a solution's `U` is the theta quotients' least-squares fit at `v0`
+/// (its closed form refused), the fit is trusted for the frequencies only if
+/// the largest eigenvalue of `Im τ` is at most this; beyond it the Abel-map
+/// check decides. The quotients' terms along the eigendirection are
+/// `~exp(−π λ)` of the others, so next to a pinched curve (`λ` large) they
+/// hardly depend on one direction of `u`, and the fit can move along it by far
+/// more than its residual says: on the harsh draw (`λ` of 9.9 … 17) by up to
+/// 7e-10 of the largest lattice rate with velocity checks of ~1e-14. Away from
+/// pinched curves (`λ` ~ 1, the Clebsch contraction's tops, whose closed form
+/// refuses for their rounded `c_ij`) the fit is `U` to rounding, and the check
+/// would only cost (their stiff flows exceed its budget).
+pub const FIT_PINCHED_IM_TAU: f64 = 3.0;
+
+/// The largest eigenvalue of `Im τ` (`τ` row-major, symmetric).
+fn largest_im_tau(t: &[C; 4]) -> f64 {
+    let (p, q, r) = (t[0].im, 0.5 * (t[1].im + t[2].im), t[3].im);
+    0.5 * (p + r) + (0.25 * (p - r) * (p - r) + q * q).sqrt()
+}
+
 /// The six `c_ij` (`i < j`, state order) of `ManakovTop(a, b)` (2).
 pub fn c_pairs(a: &[f64; 4], b: &[f64; 4]) -> Result<[f64; 6]> {
     // manakov_c returns the full 4×4 matrix, row-major.
@@ -166,6 +185,11 @@ pub fn flow_data_with(sol: &Solution, b2: &[f64; 4], cancel: &Cancel) -> Result<
     } else {
         None
     };
+    // Where the solution's U is the quotients' fit (the closed form refused
+    // or missed their equations), the fit is determined only where the
+    // quotients depend on u: next to a pinched curve they hardly see one
+    // direction, and the Abel images decide (FIT_PINCHED_IM_TAU).
+    let by_abel = by_abel || (closed.is_none() && largest_im_tau(&t) > FIT_PINCHED_IM_TAU);
     let (u, u2, w) = match closed.as_ref() {
         Some(lat) => (lat.u[0], lat.u[1], Some(lat.w[0])),
         None => (sol.rate(), u2_fit, None),
@@ -200,7 +224,8 @@ pub fn flow_data_with(sol: &Solution, b2: &[f64; 4], cancel: &Cancel) -> Result<
 /// `U` and `U'` (the flows with coefficients `sol.c4()` and `c2`) checked by
 /// the Abel images of integrated states ([`abel_rate_defect`]) to
 /// [`FREQUENCY_VELOCITY_RTOL`], for a solution whose theta quotients'
-/// velocity check did not hold them to it.
+/// velocity check did not hold them to it, or whose `U` is their fit next to
+/// a pinched curve.
 fn abel_check(
     sol: &Solution,
     c2: &[f64; 6],
@@ -230,13 +255,23 @@ fn abel_check(
     } else {
         format!("the Abel images of integrated states move along them only to {worst:e} (relative)")
     };
+    let thetas = if sol.velocity_check() > FREQUENCY_VELOCITY_RTOL {
+        format!(
+            "the theta quotients move along U against Frahm's equations (1) by {:e} of the \
+             largest speed (> {FREQUENCY_VELOCITY_RTOL:e})",
+            sol.velocity_check()
+        )
+    } else {
+        "U is the theta quotients' least-squares fit at v0 (the closed form of U refused), \
+         which next to a pinched curve they leave undetermined along a direction they hardly \
+         depend on"
+            .to_string()
+    };
     Err(Error::Unverified {
         what: "frequencies",
         reason: format!(
-            "the theta quotients move along U against Frahm's equations (1) by {:e} of the \
-             largest speed (> {FREQUENCY_VELOCITY_RTOL:e}), and {abel}: U's frequencies are \
-             not vouched for to {FREQUENCY_VELOCITY_RTOL:e}",
-            sol.velocity_check()
+            "{thetas}, and {abel}: U's frequencies are not vouched for to \
+             {FREQUENCY_VELOCITY_RTOL:e}"
         ),
     })
 }
@@ -466,7 +501,12 @@ pub use crate::solution::{INCONSISTENT, QUOTIENT_RESIDUAL_RTOL};
 /// Through the dispatcher ([`crate::solution::motion::Motion`]): the torus of
 /// a genus-2 state of the normalized top, frequencies in the user's time; a
 /// state of another kind has no genus-2 torus and is refused, naming its kind.
-pub fn torus_of_state(a: &[f64; 4], b: &[f64; 4], l0: &[f64; 6]) -> Result<(RealTorus, [C; 2])> {
+pub fn torus_of_state(
+    a: &[f64; 4],
+    b: &[f64; 4],
+    l0: &[f64; 6],
+    cancel: &Cancel,
+) -> Result<(RealTorus, [C; 2])> {
     let m = crate::solution::motion::Motion::new(a, b, l0)?;
-    super::motion::torus_of_motion(&m)
+    super::motion::torus_of_motion(&m, cancel)
 }

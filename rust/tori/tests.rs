@@ -464,7 +464,7 @@ mod on_the_solution {
     #[test]
     fn frequencies_of_the_generic_top_are_positive_and_rebuild_u() {
         let (a, b, l0) = GENERIC;
-        let (t, _) = torus_of_state(&a, &b, &l0).unwrap();
+        let (t, _) = torus_of_state(&a, &b, &l0, &Cancel::never()).unwrap();
         let s = Solution::new(&a, &b, &l0).unwrap();
         let d = flow_data(&s, &second_flow_b(&a, &b)).unwrap();
         assert!(t.nu[0] > 0.0 && t.nu[1] > 0.0);
@@ -882,6 +882,54 @@ fn the_abel_map_of_integrated_states_vouches_for_u_where_the_thetas_cannot() {
     let d = abel_rate_defect(&sol, &c4, &off, &cancel).unwrap();
     assert!(d > 1e-9, "{d:e}");
     // the frequencies of `sol.torus` are the map's
-    let t = crate::tori::solve::torus_of_state(&a, &b, &l0).unwrap().0;
+    let t = crate::tori::solve::torus_of_state(&a, &b, &l0, &Cancel::never())
+        .unwrap()
+        .0;
     assert_eq!(t.nu.map(f64::to_bits), e.nu.map(f64::to_bits));
+}
+
+/// A state of the harsh draw (seed 5) next to a pinched curve (branch points
+/// spread over 1e18), whose `U` is the theta quotients' fit (the closed form
+/// misses their equations by 0.29): its frequencies need the Abel-map check.
+/// Integrated in double, its small components (down to 1e-9 of `|l0|`) carry
+/// the rounding, and the Abel images move along `U` only to 3.2e-10; in
+/// double-double to ~3e-13, as against a quadruple-precision trajectory
+/// (3.4e-13, tests/data/frequency_abel_check.py). Its spectrum puts the
+/// frequencies at 3100-3105 and 62635-62640 (tests/test_every_state.py).
+#[test]
+fn double_double_decides_where_the_double_runs_of_the_abel_check_are_off() {
+    use crate::solution::verify::{abel_rate_defect, ABEL_DD_FROM};
+    use crate::tori::solve::{state_frequencies, FREQUENCY_VELOCITY_RTOL};
+    let a = [
+        -0.10907535773028432,
+        256.5114084997023,
+        527.71611990517,
+        527.732721070654,
+    ];
+    let b = [
+        0.0583713087223785,
+        -47.56369265254456,
+        -47.60399835624438,
+        -37.35655009504283,
+    ];
+    let l0 = [
+        33.516747842930975,
+        -36.70711236162657,
+        804481.9029273331,
+        2472.88455969831,
+        -1862.481230191442,
+        -0.0010016427544778436,
+    ];
+    let e = state_frequencies(&a, &b, &l0);
+    assert_eq!(e.status, Status::Ok);
+    let mut nu = e.nu;
+    nu.sort_by(f64::total_cmp);
+    assert!(
+        (nu[0] - 3102.5).abs() <= 5.0 && (nu[1] - 62637.5).abs() <= 5.0,
+        "{nu:?}"
+    );
+    let m = crate::solution::motion::Motion::new(&a, &b, &l0).unwrap();
+    let sol = m.genus2().expect("a genus-2 motion");
+    let d = abel_rate_defect(sol, sol.c4(), &sol.rate(), &Cancel::never()).unwrap();
+    assert!(d <= ABEL_DD_FROM.min(FREQUENCY_VELOCITY_RTOL), "{d:e}");
 }

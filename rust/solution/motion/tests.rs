@@ -188,7 +188,7 @@ fn a_state_without_a_closed_form_is_integrated() {
     m.l_batch(&[], &mut [], &Cancel::never()).unwrap();
     assert_eq!(m.stand_ins().0, 1);
     // the kind has no torus: a refusal naming the step, not invalid input
-    match crate::tori::motion::torus_of_motion(&m) {
+    match crate::tori::motion::torus_of_motion(&m, &Cancel::never()) {
         Err(Error::Unverified { reason, .. }) => {
             assert!(reason.contains("repeated root"), "{reason}")
         }
