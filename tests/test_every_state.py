@@ -1137,6 +1137,45 @@ def test_the_fit_of_u_is_not_trusted_along_a_direction_the_quotients_hardly_see(
     assert err is not None and err <= WEAK_DIRECTION_BOUND
 
 
+#: Draw 842 of the same harsh draw (branch points spread over 5e26; U is the theta
+#: quotients' fit): the Abel images of integrated states follow U to 4e-14 (in
+#: double-double; the double runs leave 2.6e-6, their rounding) but U' only to ~1e-5,
+#: the fit's error along the direction the quotients hardly see. U' only fixes the real
+#: plane of the lattice basis; the frequencies are U's coordinates.
+SECOND_FLOW_FIT_STATE = (
+    [0.8848893545753787, 14.110932079377221, 95.9754886983322, 97.65906887482375],
+    [-0.22110030941623782, -0.22329686809054974, -1.3285704358971098, 852.4618943987945],
+    [
+        7.794812440562585e-06,
+        -0.16158943139260185,
+        320962.6444647513,
+        -149.0781310882631,
+        -0.4926283863625809,
+        9.53112451603823e-06,
+    ],
+)
+
+
+def test_the_second_flow_needs_only_to_fix_the_real_plane() -> None:
+    """Frequencies given (map and solution alike) with U within WEAK_DIRECTION_BOUND of
+    the slope of the Abel images of a quadruple-precision trajectory (the long-double
+    one takes too few); the earlier check, holding U' to 1e-10, refused them."""
+    a, b, l0 = SECOND_FLOW_FIT_STATE
+    top = manakov.ManakovTop(a, b)
+    sol = top.solve(l0)
+    fm = manakov.frequency_map(top, np.asarray([l0]))
+    assert int(fm.status[0]) == manakov.tori.OK
+    np.testing.assert_array_equal(fm.nu[0], sol.frequencies)
+    hy = pytest.importorskip("heyoka")
+    data = str(Path(__file__).resolve().parent / "data")
+    if data not in sys.path:
+        sys.path.insert(0, data)
+    import frequency_abel_check
+
+    err, _ = frequency_abel_check.fitted_error(top, sol, np.asarray(l0, float), hy.real128)
+    assert err is not None and err <= WEAK_DIRECTION_BOUND
+
+
 #: Draw 2569 of the same harsh draw (branch points spread over 5e19): the theta
 #: quotients' second flow at v0 disagrees with the closed form beyond rounding, so
 #: the map reported "inconsistent quotients"; the Abel images of integrated states

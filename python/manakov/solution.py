@@ -548,8 +548,8 @@ class Solution:
             ``v0`` next to a pinched curve (where its closed form refused; the
             quotients then hardly depend on one direction of ``u``, and the fit
             can be off along it), and the Abel images of integrated states
-            do not vouch for ``U`` and ``U'`` to 1e-10 either (at three of seven
-            times one to four periods out, at two integration steps;
+            do not vouch for ``U`` to 1e-10 and ``U'`` to 1e-8 either (at three
+            of thirteen times one to four periods out, at two integration steps;
             docs/degenerate.md §10). The message names the step.
         """
         self._genus2("torus", checked=True)
