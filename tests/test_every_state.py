@@ -977,6 +977,20 @@ def test_roots_of_f_clustered_at_a_branch_point_are_solved(case) -> None:
     assert err / float(np.linalg.norm(l0)) <= HARSH_BOUND
 
 
+def abel_fit_error(top, sol, l0, quad: bool = False):
+    """``max|U - U_fit|`` relative to the largest lattice rate, ``U_fit`` the slope of the
+    Abel images of a heyoka trajectory over 20 periods (long double, or quadruple
+    precision); None if too few images (tests/data/frequency_abel_check.py)."""
+    hy = pytest.importorskip("heyoka")
+    data = str(Path(__file__).resolve().parent / "data")
+    if data not in sys.path:
+        sys.path.insert(0, data)
+    import frequency_abel_check
+
+    fp = hy.real128 if quad else frequency_abel_check.LD
+    return frequency_abel_check.fitted_error(top, sol, np.asarray(l0, float), fp)[0]
+
+
 @pytest.mark.parametrize("case", SLOW_STATES[:3])
 def test_the_velocity_part_of_the_self_check_has_its_own_bound(case) -> None:
     """The slow states' velocity defect is above the shape's bound and within its
@@ -999,13 +1013,7 @@ def test_the_velocity_part_of_the_self_check_has_its_own_bound(case) -> None:
         return
     assert int(fm.status[0]) == manakov.tori.OK
     np.testing.assert_array_equal(np.sort(fm.nu[0]), np.sort(nu))
-    pytest.importorskip("heyoka")
-    data = str(Path(__file__).resolve().parent / "data")
-    if data not in sys.path:
-        sys.path.insert(0, data)
-    import frequency_abel_check
-
-    err, _ = frequency_abel_check.fitted_error(top, sol, np.asarray(l0, float))
+    err = abel_fit_error(top, sol, l0)
     assert err is not None and err <= ABEL_FIT_BOUND
 
 
@@ -1127,13 +1135,7 @@ def test_the_fit_of_u_is_not_trusted_along_a_direction_the_quotients_hardly_see(
     assert manakov.tori.STATUS_NAMES[int(fm.status[0])] == "singular"
     assert np.isnan(fm.nu[0]).all()
 
-    pytest.importorskip("heyoka")
-    data = str(Path(__file__).resolve().parent / "data")
-    if data not in sys.path:
-        sys.path.insert(0, data)
-    import frequency_abel_check
-
-    err, _ = frequency_abel_check.fitted_error(top, sol, np.asarray(l0, float))
+    err = abel_fit_error(top, sol, l0)
     assert err is not None and err <= WEAK_DIRECTION_BOUND
 
 
@@ -1166,13 +1168,7 @@ def test_the_second_flow_needs_only_to_fix_the_real_plane() -> None:
     fm = manakov.frequency_map(top, np.asarray([l0]))
     assert int(fm.status[0]) == manakov.tori.OK
     np.testing.assert_array_equal(fm.nu[0], sol.frequencies)
-    hy = pytest.importorskip("heyoka")
-    data = str(Path(__file__).resolve().parent / "data")
-    if data not in sys.path:
-        sys.path.insert(0, data)
-    import frequency_abel_check
-
-    err, _ = frequency_abel_check.fitted_error(top, sol, np.asarray(l0, float), hy.real128)
+    err = abel_fit_error(top, sol, l0, quad=True)
     assert err is not None and err <= WEAK_DIRECTION_BOUND
 
 
