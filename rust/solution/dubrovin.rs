@@ -624,8 +624,8 @@ pub const CLOSED_RESIDUAL_FLOOR: f64 = 64.0 * f64::EPSILON;
 /// on: on 24 states of the harsh draw the fit left 1e-15 … 3e-14 and the
 /// closed form 3e-14 … 3e-11, yet the fit was 1e-9 … 1e-7 away from the closed
 /// form in `V`, and the Abel images of a quadruple-precision trajectory moved
-/// along the closed form (to ~1e-13 of the largest lattice rate) while the fit
-/// was off by up to 7e-10 of it (tests/data/frequency_abel_check.txt). A wrong
+/// along the closed form (to 3e-15 … 1e-11 of the largest lattice rate, seven
+/// measured) while the fit was off by up to 7e-10 of it (tests/data/frequency_abel_check.txt). A wrong
 /// sign or constant leaves a residual of 1e-5 … 1e7 there.
 pub const CLOSED_RESIDUAL_RTOL: f64 = 1e-10;
 

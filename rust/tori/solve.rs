@@ -77,8 +77,9 @@ pub const FREQUENCY_VELOCITY_RTOL: f64 = crate::solution::SELF_CHECK_RTOL;
 /// check decides. The quotients' terms along the eigendirection are
 /// `~exp(−π λ)` of the others, so next to a pinched curve (`λ` large) they
 /// hardly depend on one direction of `u`, and the fit can move along it by far
-/// more than its residual says: on the harsh draw (`λ` of 9.9 … 17) by up to
-/// 7e-10 of the largest lattice rate with velocity checks of ~1e-14. Away from
+/// more than its residual says: on the harsh draw (`λ` ~ 10 … 17 where
+/// measured) by up to 7e-10 of the largest lattice rate with velocity checks
+/// of ~1e-14. Away from
 /// pinched curves (`λ` ~ 1, the Clebsch contraction's tops, whose closed form
 /// refuses for their rounded `c_ij`) the fit is `U` to rounding, and the check
 /// would only cost (their stiff flows exceed its budget).
@@ -234,9 +235,9 @@ pub fn flow_data_with(sol: &Solution, b2: &[f64; 4], cancel: &Cancel) -> Result<
 
 /// `U` and `U'` (the flows with coefficients `sol.c4()` and `c2`) checked by
 /// the Abel images of integrated states ([`abel_rate_defect`]) to
-/// [`FREQUENCY_VELOCITY_RTOL`] and [`ABEL_SECOND_FLOW_RTOL`], for a solution whose theta quotients'
-/// velocity check did not hold them to it, or whose `U` is their fit next to
-/// a pinched curve.
+/// [`FREQUENCY_VELOCITY_RTOL`] and [`ABEL_SECOND_FLOW_RTOL`], for a solution
+/// whose theta quotients' velocity check did not hold them to it, or whose
+/// `U` is their fit next to a pinched curve.
 fn abel_check(
     sol: &Solution,
     c2: &[f64; 6],
