@@ -991,6 +991,33 @@ def abel_fit_error(top, sol, l0, quad: bool = False):
     return frequency_abel_check.fitted_error(top, sol, np.asarray(l0, float), fp)[0]
 
 
+def frequencies_given(a, b, l0):
+    """``(top, sol)`` of a state whose solution passed its self-check and whose
+    frequencies the map gives (status ok) with the same bits as ``sol.frequencies``."""
+    top = manakov.ManakovTop(a, b)
+    sol = top.solve(l0)
+    assert sol.self_check_passed
+    fm = manakov.frequency_map(top, np.asarray([l0]))
+    assert int(fm.status[0]) == manakov.tori.OK
+    np.testing.assert_array_equal(fm.nu[0], sol.frequencies)
+    return top, sol
+
+
+def frequencies_refused(a, b, l0, match: str):
+    """The solution (passed its self-check) of a state whose frequencies both
+    ``sol.frequencies`` (ClosedFormError matching ``match``) and the map (status
+    singular, NaN) refuse."""
+    top = manakov.ManakovTop(a, b)
+    sol = top.solve(l0)
+    assert sol.self_check_passed
+    with pytest.raises(manakov.ClosedFormError, match=match):
+        _ = sol.frequencies
+    fm = manakov.frequency_map(top, np.asarray([l0]))
+    assert manakov.tori.STATUS_NAMES[int(fm.status[0])] == "singular"
+    assert np.isnan(fm.nu[0]).all()
+    return sol
+
+
 @pytest.mark.parametrize("case", SLOW_STATES[:3])
 def test_the_velocity_part_of_the_self_check_has_its_own_bound(case) -> None:
     """The slow states' velocity defect is above the shape's bound and within its
@@ -1055,22 +1082,11 @@ def test_the_abel_map_of_integrated_states_vouches_for_the_frequencies() -> None
     if the Abel images of integrated states do, by ``sol.frequencies`` and the
     frequency map alike (the same bits); otherwise both refuse, naming the check."""
     (a, b, l0), (a2, b2, l02) = ABEL_STATES
-    top = manakov.ManakovTop(a, b)
-    sol = top.solve(l0)
-    assert sol.self_check_passed and sol.velocity_check > SHAPE_CHECK_BOUND
-    fm = manakov.frequency_map(top, np.asarray([l0]))
-    assert int(fm.status[0]) == manakov.tori.OK
-    np.testing.assert_array_equal(fm.nu[0], sol.frequencies)
+    _, sol = frequencies_given(a, b, l0)
+    assert sol.velocity_check > SHAPE_CHECK_BOUND
     assert np.all(sol.frequencies > 0)
-
-    top = manakov.ManakovTop(a2, b2)
-    sol = top.solve(l02)
-    assert sol.self_check_passed and sol.velocity_check > SHAPE_CHECK_BOUND
-    with pytest.raises(manakov.ClosedFormError, match="Abel images of integrated states"):
-        _ = sol.frequencies
-    fm = manakov.frequency_map(top, np.asarray([l02]))
-    assert manakov.tori.STATUS_NAMES[int(fm.status[0])] == "singular"
-    assert np.isnan(fm.nu[0]).all()
+    sol = frequencies_refused(a2, b2, l02, "Abel images of integrated states")
+    assert sol.velocity_check > SHAPE_CHECK_BOUND
 
 
 #: Draws 1186 and 3623 of the same harsh draw (branch points spread over 2e20 and 3e25,
@@ -1119,22 +1135,10 @@ def test_the_fit_of_u_is_not_trusted_along_a_direction_the_quotients_hardly_see(
     integrated states, which refuse it on draw 3623 (by the defect the
     quadruple-precision trajectory shows)."""
     (a, b, l0), (a2, b2, l02) = WEAK_DIRECTION_STATES
-    top = manakov.ManakovTop(a, b)
-    sol = top.solve(l0)
-    assert sol.self_check_passed and sol.velocity_check <= SHAPE_CHECK_BOUND
-    fm = manakov.frequency_map(top, np.asarray([l0]))
-    assert int(fm.status[0]) == manakov.tori.OK
-    np.testing.assert_array_equal(fm.nu[0], sol.frequencies)
-
-    top2 = manakov.ManakovTop(a2, b2)
-    sol2 = top2.solve(l02)
-    assert sol2.self_check_passed and sol2.velocity_check <= SHAPE_CHECK_BOUND
-    with pytest.raises(manakov.ClosedFormError, match="least-squares fit"):
-        _ = sol2.frequencies
-    fm = manakov.frequency_map(top2, np.asarray([l02]))
-    assert manakov.tori.STATUS_NAMES[int(fm.status[0])] == "singular"
-    assert np.isnan(fm.nu[0]).all()
-
+    top, sol = frequencies_given(a, b, l0)
+    assert sol.velocity_check <= SHAPE_CHECK_BOUND
+    sol2 = frequencies_refused(a2, b2, l02, "least-squares fit")
+    assert sol2.velocity_check <= SHAPE_CHECK_BOUND
     err = abel_fit_error(top, sol, l0)
     assert err is not None and err <= WEAK_DIRECTION_BOUND
 
@@ -1163,11 +1167,7 @@ def test_the_second_flow_needs_only_to_fix_the_real_plane() -> None:
     the slope of the Abel images of a quadruple-precision trajectory (the long-double
     one takes too few); the earlier check, holding U' to 1e-10, refused them."""
     a, b, l0 = SECOND_FLOW_FIT_STATE
-    top = manakov.ManakovTop(a, b)
-    sol = top.solve(l0)
-    fm = manakov.frequency_map(top, np.asarray([l0]))
-    assert int(fm.status[0]) == manakov.tori.OK
-    np.testing.assert_array_equal(fm.nu[0], sol.frequencies)
+    top, sol = frequencies_given(a, b, l0)
     err = abel_fit_error(top, sol, l0, quad=True)
     assert err is not None and err <= WEAK_DIRECTION_BOUND
 
@@ -1192,13 +1192,7 @@ SECOND_FLOW_STATE = (
 
 
 def test_the_abel_map_decides_where_the_second_flow_disagrees() -> None:
-    a, b, l0 = SECOND_FLOW_STATE
-    top = manakov.ManakovTop(a, b)
-    sol = top.solve(l0)
-    assert sol.self_check_passed
-    fm = manakov.frequency_map(top, np.asarray([l0]))
-    assert int(fm.status[0]) == manakov.tori.OK
-    np.testing.assert_array_equal(fm.nu[0], sol.frequencies)
+    frequencies_given(*SECOND_FLOW_STATE)
 
 
 #: States of the harsh draw (seed 5) whose branch points spread over 1e18 and

@@ -79,10 +79,10 @@ pub const FREQUENCY_VELOCITY_RTOL: f64 = crate::solution::SELF_CHECK_RTOL;
 /// hardly depend on one direction of `u`, and the fit can move along it by far
 /// more than its residual says: on the harsh draw (`λ` ~ 10 … 17 where
 /// measured) by up to 7e-10 of the largest lattice rate with velocity checks
-/// of ~1e-14. Away from
-/// pinched curves (`λ` ~ 1, the Clebsch contraction's tops, whose closed form
-/// refuses for their rounded `c_ij`) the fit is `U` to rounding, and the check
-/// would only cost (their stiff flows exceed its budget).
+/// of ~1e-14. Away from pinched curves (`λ` ~ 1, the Clebsch contraction's
+/// tops, whose closed form refuses for their rounded `c_ij`) the fit is `U` to
+/// rounding, and the check would only cost (their stiff flows exceed its
+/// budget).
 pub const FIT_PINCHED_IM_TAU: f64 = 3.0;
 
 /// The bound to which the Abel-map check holds the second flow's `U'`: it
