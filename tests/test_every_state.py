@@ -358,7 +358,8 @@ def test_valid_states_always_get_a_solution() -> None:
     frequencies are refused with ClosedFormError; every genus-2 solution passed
     its self-check or is marked as not having passed it: then its phase is
     refused (its l(t), certified or stood in for by an integration, is the
-    subject of the tests above)."""
+    subject of the tests above), and its frequencies are given only where the Abel
+    images of integrated states vouch for them."""
     rng = np.random.default_rng(31)
     kinds: dict[str, int] = {}
     # 6000 states: as more of the draw is solved, 3000 came to reach only 7 refusals
@@ -392,8 +393,14 @@ def test_valid_states_always_get_a_solution() -> None:
                 or sol.velocity_check > 1e-6
                 or any(w in str(e.value) for w in ("for no velocity", "does not reduce", "(42) g"))
             )
-            with pytest.raises(manakov.ClosedFormError, match="no trustworthy"):
+            # its frequencies only where the Abel images of integrated states
+            # vouch for U and U' (they use none of the constants in doubt)
+            try:
                 _ = sol.frequencies
+            except manakov.ClosedFormError as e:
+                assert "no trustworthy" in str(e) and "frequencies" in str(e), str(e)
+            else:
+                kinds["unchecked with frequencies"] = kinds.get("unchecked with frequencies", 0) + 1
             continue
         kinds["solved"] = kinds.get("solved", 0) + 1
     # The draw does reach the states without a closed form and the unchecked
@@ -1172,6 +1179,100 @@ def test_the_second_flow_needs_only_to_fix_the_real_plane() -> None:
     assert err is not None and err <= WEAK_DIRECTION_BOUND
 
 
+#: Draws 2798 and 9958 of the same harsh draw (branch points spread over 1e31 and 6e21):
+#: their theta quotients fail the self-check (defects 3.2e-10 and 3.3e-8), and each
+#: solution is kept for its l(t), which an integration certifies at every call. The
+#: earlier code refused the frequencies of both. The frequencies use none of the
+#: quotients' constants (C_L, G, the divisor), only U, U' and the curve: on 2798 (U is
+#: the quotients' fit, the closed form refused) the Abel images of integrated states
+#: vouch for U and U', and U agrees with the slope of the Abel images of a long-double
+#: trajectory to 4.3e-15; on 9958 they move along the fit only to 1.7e-8.
+SELF_CHECK_FAILED_STATES = [
+    (
+        [0.8967390505337116, 1.7129587477520798, 900.2610221438466, 900.2623013785277],
+        [0.07035355439428859, -71.13535628477219, -71.11910858075325, -71.12983607027105],
+        [
+            0.0004849951766528374,
+            0.0007889354299606414,
+            1.2928455321372119e-06,
+            313523.29215457535,
+            1.6903647280024612e-06,
+            0.06161638452336408,
+        ],
+    ),
+    (
+        [0.722200434850111, 0.9031562348980198, 2.9414590454907303, 2.949478307698651],
+        [0.42810280649827503, -417.6450933588394, -420.5084050535709, -420.76208765806774],
+        [
+            66531.18682451487,
+            1.5689977637924342e-05,
+            -0.07039798877543015,
+            5.471320703113149e-05,
+            -84519.15723259121,
+            -5.077669142056833e-06,
+        ],
+    ),
+]
+
+
+def test_a_solution_that_fails_its_self_check_has_the_frequencies_the_abel_images_vouch_for():
+    """Frequencies given by the map and the solution alike (the same bits) where the
+    Abel images vouch for U and U'; both refuse, naming the check, where they do not."""
+    (a, b, l0), (a2, b2, l02) = SELF_CHECK_FAILED_STATES
+    top = manakov.ManakovTop(a, b)
+    sol = top.solve(l0)
+    assert not sol.self_check_passed
+    fm = manakov.frequency_map(top, np.asarray([l0]))
+    assert int(fm.status[0]) == manakov.tori.OK
+    np.testing.assert_array_equal(fm.nu[0], sol.frequencies)
+    err = abel_fit_error(top, sol, l0)
+    assert err is not None and err <= WEAK_DIRECTION_BOUND
+    top2 = manakov.ManakovTop(a2, b2)
+    sol2 = top2.solve(l02)
+    assert not sol2.self_check_passed
+    with pytest.raises(manakov.ClosedFormError, match="fail the self-check.*Abel images"):
+        _ = sol2.frequencies
+    fm2 = manakov.frequency_map(top2, np.asarray([l02]))
+    assert manakov.tori.STATUS_NAMES[int(fm2.status[0])] == "singular"
+    assert np.isnan(fm2.nu[0]).all()
+
+
+#: Draw 419 of the same harsh draw (branch points spread over 1e13): its solution fails
+#: the self-check (4.5e-10), and the frequency map gives its frequencies from the level
+#: set's closed form. The Abel-map check integrated the normalized top with its c_ij
+#: rounded to double, and the motion moves with that rounding: the Abel images moved
+#: along the closed form's U only to 6.1e-8 of the phase, and ``sol.frequencies`` was
+#: refused where the map answered ok. With the c_ij to double-double they follow U to
+#: ~6e-17.
+ROUNDED_C_STATE = (
+    [-0.372957902310908, 518.970922110997, 528.5057515053029, 528.5541475693918],
+    [0.02426807846241763, 0.02323496172665361, -170.7933971919448, -170.7944265648801],
+    [
+        0.01637482784361056,
+        42703.46123765193,
+        0.00012411891433441858,
+        0.00034999164319303113,
+        4.946118404808643e-05,
+        -2920.9334950443185,
+    ],
+)
+
+
+def test_the_abel_map_check_integrates_the_unrounded_top() -> None:
+    """The map and the solution give the same frequencies, and U agrees with the slope
+    of the Abel images of a quadruple-precision trajectory of the exact top (measured
+    6.5e-16; the long-double one leaves too few images that fit)."""
+    a, b, l0 = ROUNDED_C_STATE
+    top = manakov.ManakovTop(a, b)
+    sol = top.solve(l0)
+    assert not sol.self_check_passed
+    fm = manakov.frequency_map(top, np.asarray([l0]))
+    assert int(fm.status[0]) == manakov.tori.OK
+    np.testing.assert_array_equal(fm.nu[0], sol.frequencies)
+    err = abel_fit_error(top, sol, l0, quad=True)
+    assert err is not None and err <= WEAK_DIRECTION_BOUND
+
+
 #: Draw 2569 of the same harsh draw (branch points spread over 5e19): the theta
 #: quotients' second flow at v0 disagrees with the closed form beyond rounding, so
 #: the map reported "inconsistent quotients"; the Abel images of integrated states
@@ -1322,11 +1423,15 @@ UNCHECKED_STATES = [
     "k", [0, 1, 2, 3], ids=["right", "wrong", "no-velocity-at-v0", "h0-structure"]
 )
 def test_a_closed_form_failing_its_self_check_gives_only_certified_l(k: int) -> None:
-    """``solve`` keeps the closed form, marked: its phase (U, frequencies) is
-    refused, and l(t) is returned where an integration certifies it, within
-    HARSH_BOUND of the long-double reference; where the closed form is wrong the
-    confirmed integration stands in, with a warning, never the closed form (the
-    earlier code refused all four at ``solve``, then refused the wrong one's l)."""
+    """``solve`` keeps the closed form, marked: its phase (U, u0) is refused, and
+    l(t) is returned where an integration certifies it, within HARSH_BOUND of the
+    long-double reference; where the closed form is wrong the confirmed integration
+    stands in, with a warning, never the closed form (the earlier code refused all
+    four at ``solve``, then refused the wrong one's l). The frequencies, which use
+    none of the constants in doubt, are given only where the Abel images of
+    integrated states vouch for U and U': on the second (U within 3.4e-12 of the
+    slope of the Abel images of a quadruple-precision trajectory), by the map and
+    the solution alike; the others refuse them."""
     pytest.importorskip("heyoka")
     data = str(Path(__file__).resolve().parent / "data")
     if data not in sys.path:
@@ -1338,11 +1443,18 @@ def test_a_closed_form_failing_its_self_check_gives_only_certified_l(k: int) -> 
     assert sol.kind == "genus2" and not sol.self_check_passed
     assert (sol.self_check > 1e-10) == (k != 2)
     assert "self-check failed" in repr(sol)
-    for what in ("U", "u0", "frequencies", "torus"):
+    for what in ("U", "u0") + (() if k == 1 else ("frequencies", "torus")):
         with pytest.raises(
             manakov.ClosedFormError, match="self-check|for no velocity|does not reduce"
         ):
             getattr(sol, what)
+    if k == 1:
+        top = manakov.ManakovTop(a, b)
+        fm = manakov.frequency_map(top, np.asarray([l0]))
+        assert int(fm.status[0]) == manakov.tori.OK
+        np.testing.assert_array_equal(fm.nu[0], sol.frequencies)
+        err = abel_fit_error(top, sol, l0, quad=True)
+        assert err is not None and err <= ABEL_FIT_BOUND
     t = np.linspace(0.0, float(t_end), 51)
     # the second state's long-double trajectory is itself off by 4e-3 |l0| (its
     # components span seven orders of magnitude); quadruple precision decides

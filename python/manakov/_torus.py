@@ -186,6 +186,9 @@ def torus_of_state(a: Any, b: Any, l0: Any) -> tuple[Torus, np.ndarray]:
     ValueError
         On a singular level set (the solution's message names the case) or
         when the lattice of periods has no rank-2 part in the real plane.
+    ClosedFormError
+        The torus of this (valid) state could not be verified (as
+        :attr:`Solution.torus <manakov.Solution.torus>`; the message names the step).
 
     Examples
     --------

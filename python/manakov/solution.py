@@ -169,8 +169,11 @@ class Solution:
     fail the reduction's consistency checks) is returned marked
     (:attr:`self_check_passed` is False): its :meth:`l` is then certified by an
     integration at every call, or replaced by it where it is off, and what depends
-    on its phase (:attr:`U`, :attr:`u0`, :attr:`torus`, :attr:`frequencies`,
-    :attr:`constants`, the quotients) is refused with ``ClosedFormError``.
+    on its phase (:attr:`U`, :attr:`u0`, :attr:`constants`, the quotients) is
+    refused with ``ClosedFormError``. Its :attr:`torus` and :attr:`frequencies`,
+    which use none of the quotients' constants (only ``U``, ``U'`` and the
+    curve), are given where the Abel images of integrated states vouch for ``U``
+    and ``U'`` (:attr:`torus`), else refused alike.
 
     **Frames.** The solution is built on normalized data: ``l0' = l0/s``,
     ``a' = (a − κ)/σ``, ``c' = (c − μ)/λ`` (:attr:`state_scale`,
@@ -547,12 +550,17 @@ class Solution:
             frequencies would carry, or ``U`` is the theta quotients' fit at
             ``v0`` next to a pinched curve (where its closed form refused; the
             quotients then hardly depend on one direction of ``u``, and the fit
-            can be off along it), and the Abel images of integrated states
-            do not vouch for ``U`` to 1e-10 and ``U'`` to 1e-8 either (at three
-            of thirteen times one to four periods out, at two integration steps;
-            docs/degenerate.md §10). The message names the step.
+            can be off along it), or the solution failed its self-check
+            (:attr:`self_check_passed` is False: its constants are in doubt,
+            though the frequencies use none of them), and the Abel images of
+            integrated states do not vouch for ``U`` to 1e-10 and ``U'`` to 1e-8
+            either (at three of thirteen times one to four periods out, at two
+            integration steps; docs/degenerate.md §10). The message names the
+            step.
         """
-        self._genus2("torus", checked=True)
+        # A solution that failed its self-check still has a torus where the Abel
+        # images of integrated states vouch for its U and U' (the core decides).
+        self._genus2("torus")
         if self._torus is None:
             lam, coords, nu, _ = self._motion.torus()
             self._torus = Torus(_frozen(lam), _frozen(coords), _frozen(nu))

@@ -400,6 +400,13 @@ impl Solution {
         &self.c4
     }
 
+    /// The rounding errors of [`Solution::c4`]: `c4 + c4_lo` are the top's
+    /// `c_ij` to double-double accuracy (zero where the solution was built
+    /// from `c4` alone).
+    pub fn c4_lo(&self) -> &[f64; 6] {
+        &self.c4_lo
+    }
+
     /// The level-set constants of the reduction (fixed branches).
     pub fn kotter(&self) -> &KotterConstants {
         &self.kotter

@@ -524,7 +524,8 @@ pub const ABEL_DD_FROM: f64 = 1e-10;
 /// cancellation token is checked at every step).
 pub const ABEL_CHECK_MAX_DD_STEPS: f64 = 1e5;
 
-/// The velocity `u` of the flow (1) with coefficients `c4` (state order) on
+/// The velocity `u` of the flow (1) with coefficients `c4` (state order;
+/// `c4 + c4_lo` in double-double, `c4_lo` their rounding errors or zero) on
 /// the level set of `sol`, checked without theta functions: `l0` is
 /// integrated (Gauss–Legendre order 16, at the default step and at half of
 /// it; again in double-double where the two leave more than [`ABEL_DD_FROM`])
@@ -552,6 +553,7 @@ pub const ABEL_CHECK_MAX_DD_STEPS: f64 = 1e5;
 pub fn abel_rate_defect(
     sol: &super::Solution,
     c4: &[f64; 6],
+    c4_lo: &[f64; 6],
     u: &[num_complex::Complex64; 2],
     cancel: &Cancel,
 ) -> Result<f64> {
@@ -625,7 +627,12 @@ pub fn abel_rate_defect(
     }
     // The double integrations may be the ones that are off: double-double
     // decides (the same steps, and every step halved).
-    let c = c4.map(Dd::new);
+    // The coefficients to double-double (`c4 + c4_lo`): next to pinched
+    // curves the Abel images move with the rounding of `c4` by far more than
+    // ε (on a state of the harsh draw by 6e-8 of the phase, which
+    // `c4 + c4_lo` brings to 6e-17, as a quadruple-precision trajectory of
+    // the exact top confirms).
+    let c: [Dd; 6] = std::array::from_fn(|q| Dd::sum(c4[q], c4_lo[q]));
     let mut worst_dd = 0.0f64;
     for split in [1, 2] {
         let y = match gauss16_dd_so4(&c, l0, &times, dt, split, cancel) {

@@ -57,8 +57,14 @@ pub fn state_frequencies_in_with(frame: &TopFrame, l0: &[f64; 6], cancel: &Cance
             }
         }
         Kind::Genus2 => {
-            let entry =
-                level_set_entry_with(&frame.a, &frame.c4, &frame.second_flow_b(), &ln, cancel);
+            let entry = level_set_entry_with(
+                &frame.a,
+                &frame.c4,
+                &frame.c4_lo,
+                &frame.second_flow_b(),
+                &ln,
+                cancel,
+            );
             if entry.status == Status::Ok && t_scale != 1.0 {
                 MapEntry {
                     status: Status::Ok,
@@ -94,12 +100,6 @@ pub fn torus_of_motion(m: &Motion, cancel: &Cancel) -> Result<(RealTorus, [C; 2]
             m.kind().name()
         ),
     })?;
-    if let Some(why) = sol.certify_every() {
-        return Err(torus_refusal(Error::Unverified {
-            what: "solution of l0",
-            reason: why.to_string(),
-        }));
-    }
     let torus = flow_data_with(sol, &m.frame().second_flow_b(), cancel).and_then(|d| {
         Ok((
             real_torus_with_rates(&d.tau, &d.u, &d.u2, &d.chars, d.w.as_ref())?,

@@ -123,8 +123,17 @@ pub fn flow_data_with(sol: &Solution, b2: &[f64; 4], cancel: &Cancel) -> Result<
     // quotients' derivatives are sums of nearly cancelling terms), U and U'
     // are vouched for only if the Abel images of integrated states move along
     // them ([`abel_rate_defect`], at the end).
-    let by_abel = sol.velocity_check() > FREQUENCY_VELOCITY_RTOL;
-    if sol.velocity_check() > VELOCITY_CHECK_RTOL {
+    //
+    // A solution that failed its self-check (kept for its certified l(t),
+    // [`Solution::certify_every`]) has its constants C_L, G or divisor in
+    // doubt, none of which the frequencies use: they are the coordinates of U
+    // in the lattice of the curve's periods. Its U and U' stand only where
+    // the Abel images of integrated states vouch for them, which is a check of
+    // the curve as well (on a wrong curve the images of the motion do not lie
+    // on a line), whether they are the closed forms or the quotients' fits.
+    let soft = sol.certify_every();
+    let by_abel = soft.is_some() || sol.velocity_check() > FREQUENCY_VELOCITY_RTOL;
+    if soft.is_none() && sol.velocity_check() > VELOCITY_CHECK_RTOL {
         // (not reached from a solution that passed its self-check)
         return Err(Error::Unverified {
             what: "frequencies",
@@ -142,6 +151,8 @@ pub fn flow_data_with(sol: &Solution, b2: &[f64; 4], cancel: &Cancel) -> Result<
         .map(|(a, b)| [a[0], a[1], b[0], b[1]])
         .collect();
     let c2 = c_pairs(sol.a(), b2)?;
+    // their rounding errors, for the Abel-map check's integrations
+    let c2_lo = crate::solution::normalize::c_rounding(sol.a(), b2, &c2);
     // The velocities themselves in closed form (the solution's sign
     // convention), in double or DD by the curve's spread ([`needs_dd`]), as
     // the frequency map takes them (the same numbers, so the two routes give
@@ -216,13 +227,13 @@ pub fn flow_data_with(sol: &Solution, b2: &[f64; 4], cancel: &Cancel) -> Result<
         if closed.is_none() {
             return Err(refusal);
         }
-        match abel_check(sol, &c2, &u, &u2, cancel) {
+        match abel_check(sol, (&c2, &c2_lo), &u, &u2, closed.is_some(), cancel) {
             Ok(()) => {}
             Err(Error::Unverified { .. }) => return Err(refusal),
             Err(e) => return Err(e),
         }
     } else if by_abel {
-        abel_check(sol, &c2, &u, &u2, cancel)?;
+        abel_check(sol, (&c2, &c2_lo), &u, &u2, closed.is_some(), cancel)?;
     }
     Ok(FlowData {
         tau: [[t[0], t[1]], [t[2], t[3]]],
@@ -240,14 +251,15 @@ pub fn flow_data_with(sol: &Solution, b2: &[f64; 4], cancel: &Cancel) -> Result<
 /// `U` is their fit next to a pinched curve.
 fn abel_check(
     sol: &Solution,
-    c2: &[f64; 6],
+    (c2, c2_lo): (&[f64; 6], &[f64; 6]),
     u: &[C; 2],
     u2: &[C; 2],
+    u_closed: bool,
     cancel: &Cancel,
 ) -> Result<()> {
-    let d1 = abel_rate_defect(sol, sol.c4(), u, cancel)?;
+    let d1 = abel_rate_defect(sol, sol.c4(), sol.c4_lo(), u, cancel)?;
     let d2 = if d1 <= FREQUENCY_VELOCITY_RTOL {
-        abel_rate_defect(sol, c2, u2, cancel)?
+        abel_rate_defect(sol, c2, c2_lo, u2, cancel)?
     } else {
         f64::NAN
     };
@@ -271,7 +283,16 @@ fn abel_check(
              (relative, > {bound:e})"
         )
     };
-    let thetas = if sol.velocity_check() > FREQUENCY_VELOCITY_RTOL {
+    let thetas = if let Some(why) = sol.certify_every() {
+        format!(
+            "{why}; U is {}",
+            if u_closed {
+                "its closed form"
+            } else {
+                "the theta quotients' fit at v0"
+            }
+        )
+    } else if sol.velocity_check() > FREQUENCY_VELOCITY_RTOL {
         format!(
             "the theta quotients move along U against Frahm's equations (1) by {:e} of the \
              largest speed (> {FREQUENCY_VELOCITY_RTOL:e})",
@@ -437,13 +458,17 @@ pub fn state_frequencies_level_set(a: &[f64; 4], b: &[f64; 4], l0: &[f64; 6]) ->
 /// a consensus on the velocities, through the Theorem's solution
 /// ([`flow_data`]).
 pub fn level_set_entry(a: &[f64; 4], c4: &[f64; 6], b2: &[f64; 4], l0: &[f64; 6]) -> MapEntry {
-    level_set_entry_with(a, c4, b2, l0, &Cancel::never())
+    level_set_entry_with(a, c4, &[0.0; 6], b2, l0, &Cancel::never())
 }
 
-/// [`level_set_entry`] with a cancellation token ([`flow_data_with`]).
+/// [`level_set_entry`] with a cancellation token ([`flow_data_with`]) and the
+/// rounding errors `c4_lo` of `c4`, which the Theorem's solution takes where
+/// the level set gives no velocities ([`Solution::with_c4_lo_certifying`], as
+/// `sol.torus` does: the two give the same frequencies).
 pub fn level_set_entry_with(
     a: &[f64; 4],
     c4: &[f64; 6],
+    c4_lo: &[f64; 6],
     b2: &[f64; 4],
     l0: &[f64; 6],
     cancel: &Cancel,
@@ -458,7 +483,8 @@ pub fn level_set_entry_with(
             Err(Error::Singular {
                 kind: SingularKind::NoVelocityConsensus,
                 ..
-            }) => Solution::with_c4(a, c4, l).and_then(|s| flow_data_with(&s, b2, cancel)),
+            }) => Solution::with_c4_lo_certifying(a, c4, c4_lo, l)
+                .and_then(|s| flow_data_with(&s, b2, cancel)),
             other => other,
         },
         classify,

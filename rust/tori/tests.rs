@@ -876,10 +876,10 @@ fn the_abel_map_of_integrated_states_vouches_for_u_where_the_thetas_cannot() {
         assert!(y[k].abs() <= 1e-10 * x_ref[0].abs(), "{y:?}");
     }
     let cancel = Cancel::never();
-    let d = abel_rate_defect(&sol, &c4, &u, &cancel).unwrap();
+    let d = abel_rate_defect(&sol, &c4, sol.c4_lo(), &u, &cancel).unwrap();
     assert!(d <= FREQUENCY_VELOCITY_RTOL, "{d:e}");
     let off = [u[0] * (1.0 + 1e-8), u[1]];
-    let d = abel_rate_defect(&sol, &c4, &off, &cancel).unwrap();
+    let d = abel_rate_defect(&sol, &c4, sol.c4_lo(), &off, &cancel).unwrap();
     assert!(d > 1e-9, "{d:e}");
     // the frequencies of `sol.torus` are the map's
     let t = crate::tori::solve::torus_of_state(&a, &b, &l0, &Cancel::never())
@@ -930,6 +930,104 @@ fn double_double_decides_where_the_double_runs_of_the_abel_check_are_off() {
     );
     let m = crate::solution::motion::Motion::new(&a, &b, &l0).unwrap();
     let sol = m.genus2().expect("a genus-2 motion");
-    let d = abel_rate_defect(sol, sol.c4(), &sol.rate(), &Cancel::never()).unwrap();
+    let d = abel_rate_defect(sol, sol.c4(), sol.c4_lo(), &sol.rate(), &Cancel::never()).unwrap();
     assert!(d <= FREQUENCY_VELOCITY_RTOL, "{d:e}");
+}
+
+/// Draw 927 of the harsh draw (tests/data/every_state_harsh.py, seed 20261125;
+/// branch points spread over 1e26): its theta quotients fail the self-check
+/// (defect 2.0e-10), so its solution is kept for its certified `l(t)`, and the
+/// earlier code refused its torus. The frequencies use none of the quotients'
+/// constants: the Abel images of integrated states vouch for the closed form's
+/// `U` and `U'`, and `U` agrees with the slope of the Abel images of a
+/// long-double trajectory over 20 periods to 5.6e-16 of the largest lattice
+/// rate (tests/data/frequency_abel_check.py).
+#[test]
+fn a_solution_that_fails_its_self_check_has_the_frequencies_the_abel_images_vouch_for() {
+    use crate::solution::motion::Motion;
+    use crate::tori::solve::{state_frequencies, torus_of_state};
+    let a = [
+        -0.7602688355914728,
+        -0.7581946759199528,
+        58.01446061429555,
+        58.02456787736087,
+    ];
+    let b = [
+        -0.28375241315964983,
+        -0.30510857946001957,
+        -0.29813703787396717,
+        -0.3002112913105826,
+    ];
+    let l0 = [
+        -5.567493763149003e-06,
+        -1.079508644208164,
+        675.3544042539954,
+        -152399.66258918872,
+        1.2270140457595652e-06,
+        0.35257708939333,
+    ];
+    // the long-double Abel fit's lattice rates (normalized frame)
+    let x_ref: [f64; 2] = [-0.02263767538871286, 0.000996531291781728];
+    let m = Motion::new(&a, &b, &l0).unwrap();
+    let sol = m.genus2().expect("a genus-2 motion");
+    assert!(sol.certify_every().is_some());
+    let (t, _) = torus_of_state(&a, &b, &l0, &Cancel::never()).unwrap();
+    let e = state_frequencies(&a, &b, &l0);
+    assert_eq!(e.status, Status::Ok);
+    assert_eq!(t.nu.map(f64::to_bits), e.nu.map(f64::to_bits));
+    // U T = ν1 λ1 + ν2 λ2
+    let u: [num_complex::Complex64; 2] = std::array::from_fn(|k| {
+        (t.lambda[0][k] * t.nu[0] + t.lambda[1][k] * t.nu[1]) / m.time_scale()
+    });
+    let (x, y) = sol.curve().lattice_coordinates(&u);
+    for k in 0..2 {
+        assert!((x[k] - x_ref[k]).abs() <= 1e-12 * x_ref[0].abs(), "{x:?}");
+        assert!(y[k].abs() <= 1e-12 * x_ref[0].abs(), "{y:?}");
+    }
+}
+
+/// Draw 419 of the same harsh draw (branch points spread over 1e13; its
+/// solution fails the self-check): the motion moves with the rounding of the
+/// normalized `c_ij` by far more than ε. Integrated with `c4` as rounded, the
+/// Abel images move along the closed form's `U` only to 6.1e-8 of the phase
+/// (and `sol.torus` refused what the frequency map gave); with `c4 + c4_lo` in
+/// double-double to ~6e-17, as a quadruple-precision trajectory of the exact
+/// top agrees with `U` to 6.5e-16 (tests/test_every_state.py).
+#[test]
+fn the_abel_map_check_integrates_the_unrounded_top() {
+    use crate::solution::motion::Motion;
+    use crate::solution::verify::abel_rate_defect;
+    use crate::tori::solve::{state_frequencies, torus_of_state, FREQUENCY_VELOCITY_RTOL};
+    let a = [
+        -0.372957902310908,
+        518.970922110997,
+        528.5057515053029,
+        528.5541475693918,
+    ];
+    let b = [
+        0.02426807846241763,
+        0.02323496172665361,
+        -170.7933971919448,
+        -170.7944265648801,
+    ];
+    let l0 = [
+        0.01637482784361056,
+        42703.46123765193,
+        0.00012411891433441858,
+        0.00034999164319303113,
+        4.946118404808643e-05,
+        -2920.9334950443185,
+    ];
+    let m = Motion::new(&a, &b, &l0).unwrap();
+    let sol = m.genus2().expect("a genus-2 motion");
+    assert!(sol.certify_every().is_some());
+    let cancel = Cancel::never();
+    let exact = abel_rate_defect(sol, sol.c4(), sol.c4_lo(), &sol.rate(), &cancel).unwrap();
+    assert!(exact <= 1e-12, "{exact:e}");
+    let rounded = abel_rate_defect(sol, sol.c4(), &[0.0; 6], &sol.rate(), &cancel).unwrap();
+    assert!(rounded > FREQUENCY_VELOCITY_RTOL, "{rounded:e}");
+    let (t, _) = torus_of_state(&a, &b, &l0, &cancel).unwrap();
+    let e = state_frequencies(&a, &b, &l0);
+    assert_eq!(e.status, Status::Ok);
+    assert_eq!(t.nu.map(f64::to_bits), e.nu.map(f64::to_bits));
 }
