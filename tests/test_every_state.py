@@ -1239,11 +1239,10 @@ def test_a_solution_that_fails_its_self_check_has_the_frequencies_the_abel_image
 
 #: Draw 419 of the same harsh draw (branch points spread over 1e13): its solution fails
 #: the self-check (4.5e-10), and the frequency map gives its frequencies from the level
-#: set's closed form. The Abel-map check integrated the normalized top with its c_ij
-#: rounded to double, and the motion moves with that rounding: the Abel images moved
-#: along the closed form's U only to 6.1e-8 of the phase, and ``sol.frequencies`` was
-#: refused where the map answered ok. With the c_ij to double-double they follow U to
-#: ~6e-17.
+#: set's closed form, which ``sol.frequencies`` refused. It now takes the same closed
+#: form. (Its Abel-map check, which this state no longer needs, integrated the top with
+#: its c_ij rounded to double and found the images off by 6.1e-8 of the phase; the
+#: Rust test of the same name shows the check with the c_ij to double-double.)
 ROUNDED_C_STATE = (
     [-0.372957902310908, 518.970922110997, 528.5057515053029, 528.5541475693918],
     [0.02426807846241763, 0.02323496172665361, -170.7933971919448, -170.7944265648801],
@@ -1258,7 +1257,7 @@ ROUNDED_C_STATE = (
 )
 
 
-def test_the_abel_map_check_integrates_the_unrounded_top() -> None:
+def test_a_solution_that_fails_its_self_check_takes_the_maps_closed_form() -> None:
     """The map and the solution give the same frequencies, and U agrees with the slope
     of the Abel images of a quadruple-precision trajectory of the exact top (measured
     6.5e-16; the long-double one leaves too few images that fit)."""
@@ -1428,10 +1427,12 @@ def test_a_closed_form_failing_its_self_check_gives_only_certified_l(k: int) -> 
     long-double reference; where the closed form is wrong the confirmed integration
     stands in, with a warning, never the closed form (the earlier code refused all
     four at ``solve``, then refused the wrong one's l). The frequencies, which use
-    none of the constants in doubt, are given only where the Abel images of
-    integrated states vouch for U and U': on the second (U within 3.4e-12 of the
-    slope of the Abel images of a quadruple-precision trajectory), by the map and
-    the solution alike; the others refuse them."""
+    none of the constants in doubt, are given as the frequency map gives them: on
+    the first from the level set's closed form (branch points spread over 5e8), on
+    the second where the Abel images of integrated states vouch for U and U' (U
+    within 9.8e-17 and 3.4e-12 of the slope of the Abel images of a
+    quadruple-precision trajectory); on the last two both refuse them (the
+    quotients' second flow fits no velocity; H0 fails its structure check)."""
     pytest.importorskip("heyoka")
     data = str(Path(__file__).resolve().parent / "data")
     if data not in sys.path:
@@ -1443,12 +1444,12 @@ def test_a_closed_form_failing_its_self_check_gives_only_certified_l(k: int) -> 
     assert sol.kind == "genus2" and not sol.self_check_passed
     assert (sol.self_check > 1e-10) == (k != 2)
     assert "self-check failed" in repr(sol)
-    for what in ("U", "u0") + (() if k == 1 else ("frequencies", "torus")):
+    for what in ("U", "u0") + (() if k in (0, 1) else ("frequencies", "torus")):
         with pytest.raises(
             manakov.ClosedFormError, match="self-check|for no velocity|does not reduce"
         ):
             getattr(sol, what)
-    if k == 1:
+    if k in (0, 1):
         top = manakov.ManakovTop(a, b)
         fm = manakov.frequency_map(top, np.asarray([l0]))
         assert int(fm.status[0]) == manakov.tori.OK

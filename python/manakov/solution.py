@@ -172,8 +172,9 @@ class Solution:
     on its phase (:attr:`U`, :attr:`u0`, :attr:`constants`, the quotients) is
     refused with ``ClosedFormError``. Its :attr:`torus` and :attr:`frequencies`,
     which use none of the quotients' constants (only ``U``, ``U'`` and the
-    curve), are given where the Abel images of integrated states vouch for ``U``
-    and ``U'`` (:attr:`torus`), else refused alike.
+    curve), are those of :func:`manakov.frequency_map`: the level set's closed
+    form where the map takes it unchecked, else given only where the Abel images
+    of integrated states vouch for ``U`` and ``U'`` (:attr:`torus`).
 
     **Frames.** The solution is built on normalized data: ``l0' = l0/s``,
     ``a' = (a − κ)/σ``, ``c' = (c − μ)/λ`` (:attr:`state_scale`,
@@ -558,8 +559,8 @@ class Solution:
             integration steps; docs/degenerate.md §10). The message names the
             step.
         """
-        # A solution that failed its self-check still has a torus where the Abel
-        # images of integrated states vouch for its U and U' (the core decides).
+        # A solution that failed its self-check still has the frequency map's torus
+        # (the level set's closed form, or U and U' the Abel images vouch for).
         self._genus2("torus")
         if self._torus is None:
             lam, coords, nu, _ = self._motion.torus()

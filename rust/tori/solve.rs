@@ -131,7 +131,20 @@ pub fn flow_data_with(sol: &Solution, b2: &[f64; 4], cancel: &Cancel) -> Result<
     // the Abel images of integrated states vouch for them, which is a check of
     // the curve as well (on a wrong curve the images of the motion do not lie
     // on a line), whether they are the closed forms or the quotients' fits.
+    //
+    // Where the frequency map takes the level set's closed form unchecked
+    // (branch points spread over at most CLOSED_FORM_SPREAD), such a solution
+    // takes it too: the same numbers, so `sol.torus` and the map agree.
     let soft = sol.certify_every();
+    if soft.is_some() {
+        match level_set_flow_data_c4(sol.a(), sol.c4(), &c_pairs(sol.a(), b2)?, sol.l0()) {
+            Err(Error::Singular {
+                kind: SingularKind::NoVelocityConsensus,
+                ..
+            }) => {}
+            other => return other,
+        }
+    }
     let by_abel = soft.is_some() || sol.velocity_check() > FREQUENCY_VELOCITY_RTOL;
     if soft.is_none() && sol.velocity_check() > VELOCITY_CHECK_RTOL {
         // (not reached from a solution that passed its self-check)

@@ -990,7 +990,7 @@ fn a_solution_that_fails_its_self_check_has_the_frequencies_the_abel_images_vouc
 /// solution fails the self-check): the motion moves with the rounding of the
 /// normalized `c_ij` by far more than ε. Integrated with `c4` as rounded, the
 /// Abel images move along the closed form's `U` only to 6.1e-8 of the phase
-/// (and `sol.torus` refused what the frequency map gave); with `c4 + c4_lo` in
+/// (which would refuse what the frequency map gives); with `c4 + c4_lo` in
 /// double-double to ~6e-17, as a quadruple-precision trajectory of the exact
 /// top agrees with `U` to 6.5e-16 (tests/test_every_state.py).
 #[test]

@@ -17,12 +17,13 @@ is ``ok`` and whose solution passed its self-check with a velocity check above 1
 has branch points spread over more than 1e14 (there the map takes the solution's route:
 the theta quotients or the Abel images vouch for ``U``), or whose solution failed its
 self-check (it is kept for its ``l(t)``, which an integration certifies at every call;
-its frequencies stand only where the Abel images vouch for ``U`` and ``U'``, whatever
-the theta quotients' constants), integrates it with heyoka in 80-bit long double over 20
-periods (201 samples), takes the Abel image of every sample (``sol.abel``; samples whose
-image misses the lattice by more than 1e-8 are set aside: points next to branch points),
-and fits the slope of the unwrapped images: the true velocity in lattice coordinates.
-``U`` is the rate the frequencies are the coordinates of (``U T = ν1 λ1 + ν2 λ2`` on
+its frequencies are the map's: the level set's closed form up to a spread of 1e14,
+beyond it only where the Abel images vouch for ``U`` and ``U'``, whatever the theta
+quotients' constants), integrates it with heyoka in 80-bit long double over 20 periods
+(201 samples), takes the Abel image of every sample (``sol.abel``; samples whose image
+misses the lattice by more than 1e-8 are set aside: points next to branch points), and
+fits the slope of the unwrapped images: the true velocity in lattice coordinates. ``U``
+is the rate the frequencies are the coordinates of (``U T = ν1 λ1 + ν2 λ2`` on
 ``sol.torus``). Reported per state: ``max|U - U_fit|`` relative to the largest lattice
 rate; then median and maximum for the three groups. The long-double trajectory is not a
 reference beyond its own accuracy: on these states (components spanning up to twelve
@@ -176,8 +177,8 @@ def main(n: int = 10_000) -> None:
             errs_spread,
         ),
         (
-            "solution failed its self-check (its l(t) certified by integration; the Abel "
-            "images vouched for U)",
+            "solution failed its self-check (its l(t) certified by integration; U the "
+            "level set's closed form, or vouched for by the Abel images)",
             errs_failed,
         ),
     ):
