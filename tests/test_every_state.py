@@ -1272,6 +1272,34 @@ def test_a_solution_that_fails_its_self_check_takes_the_maps_closed_form() -> No
     assert err is not None and err <= WEAK_DIRECTION_BOUND
 
 
+#: Draw 989 of the same harsh draw (branch points spread over 6e31; U is the theta
+#: quotients' fit next to a pinched curve, largest eigenvalue of Im tau 17): the Abel
+#: images of integrated states vouch for U, but the second flow's integration exceeds the
+#: check's budget, and the frequencies were refused for want of a check of U'. U' only
+#: fixes the real plane, in which the lattice basis must be integral to 1e-7; a plane off
+#: by more holds no such lattice (the torus is then refused). U agrees with the slope of
+#: the Abel images of a quadruple-precision trajectory to 1.8e-12.
+UNCHECKED_SECOND_FLOW_STATE = (
+    [-0.13897539582017626, 83.64154129404191, 83.64492743384096, 83.64709272192884],
+    [-0.10081634421509844, -2.377322434312812, -136.56366274243945, -135.3452112223749],
+    [
+        -1.080358529308542e-06,
+        2.636230535279978e-05,
+        0.0006467681230083904,
+        26581.587676304684,
+        0.6550686225480357,
+        -0.0013776500821983681,
+    ],
+)
+
+
+def test_the_lattice_basis_decides_where_the_second_flow_cannot_be_checked() -> None:
+    a, b, l0 = UNCHECKED_SECOND_FLOW_STATE
+    top, sol = frequencies_given(a, b, l0)
+    err = abel_fit_error(top, sol, l0, quad=True)
+    assert err is not None and err <= ABEL_FIT_BOUND
+
+
 #: Draw 2569 of the same harsh draw (branch points spread over 5e19): the theta
 #: quotients' second flow at v0 disagrees with the closed form beyond rounding, so
 #: the map reported "inconsistent quotients"; the Abel images of integrated states

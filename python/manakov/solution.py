@@ -556,8 +556,9 @@ class Solution:
             though the frequencies use none of them), and the Abel images of
             integrated states do not vouch for ``U`` to 1e-10 and ``U'`` to 1e-8
             either (at three of thirteen times one to four periods out, at two
-            integration steps; docs/degenerate.md §10). The message names the
-            step.
+            integration steps; where ``U'`` cannot be checked, the lattice basis
+            it fixes must be integral to 1e-7; docs/degenerate.md §10). The
+            message names the step.
         """
         # A solution that failed its self-check still has the frequency map's torus
         # (the level set's closed form, or U and U' the Abel images vouch for).

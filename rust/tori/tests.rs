@@ -1031,3 +1031,51 @@ fn the_abel_map_check_integrates_the_unrounded_top() {
     assert_eq!(e.status, Status::Ok);
     assert_eq!(t.nu.map(f64::to_bits), e.nu.map(f64::to_bits));
 }
+
+/// Draw 989 of the same harsh draw (branch points spread over 6e31; `U` the
+/// theta quotients' fit next to a pinched curve): the Abel images of
+/// integrated states vouch for `U`, but the second flow's integration exceeds
+/// the check's budget, so `U'` cannot be checked. The lattice basis decides:
+/// it must be integral to `RATIONAL_TOL` in the plane `U'` fixes, which a
+/// plane off by more does not allow. `U` agrees with a quadruple-precision
+/// Abel fit to 1.8e-12 (tests/test_every_state.py).
+#[test]
+fn the_lattice_basis_decides_where_the_second_flow_cannot_be_checked() {
+    use crate::solution::motion::Motion;
+    use crate::solution::normalize::c_rounding;
+    use crate::solution::verify::abel_rate_defect;
+    use crate::tori::solve::{c_pairs, state_frequencies, torus_of_state, FREQUENCY_VELOCITY_RTOL};
+    let a = [
+        -0.13897539582017626,
+        83.64154129404191,
+        83.64492743384096,
+        83.64709272192884,
+    ];
+    let b = [
+        -0.10081634421509844,
+        -2.377322434312812,
+        -136.56366274243945,
+        -135.3452112223749,
+    ];
+    let l0 = [
+        -1.080358529308542e-06,
+        2.636230535279978e-05,
+        0.0006467681230083904,
+        26581.587676304684,
+        0.6550686225480357,
+        -0.0013776500821983681,
+    ];
+    let cancel = Cancel::never();
+    let (t, u2) = torus_of_state(&a, &b, &l0, &cancel).unwrap();
+    let e = state_frequencies(&a, &b, &l0);
+    assert_eq!(e.status, Status::Ok);
+    assert_eq!(t.nu.map(f64::to_bits), e.nu.map(f64::to_bits));
+    let m = Motion::new(&a, &b, &l0).unwrap();
+    let sol = m.genus2().expect("a genus-2 motion");
+    let d1 = abel_rate_defect(sol, sol.c4(), sol.c4_lo(), &sol.rate(), &cancel).unwrap();
+    assert!(d1 <= FREQUENCY_VELOCITY_RTOL, "{d1:e}");
+    let b2 = m.frame().second_flow_b();
+    let c2 = c_pairs(sol.a(), &b2).unwrap();
+    let d2 = abel_rate_defect(sol, &c2, &c_rounding(sol.a(), &b2, &c2), &u2, &cancel).unwrap();
+    assert!(d2.is_nan(), "{d2:e}");
+}
