@@ -998,12 +998,13 @@ def abel_fit_error(top, sol, l0, quad: bool = False):
     return frequency_abel_check.fitted_error(top, sol, np.asarray(l0, float), fp)[0]
 
 
-def frequencies_given(a, b, l0):
-    """``(top, sol)`` of a state whose solution passed its self-check and whose
-    frequencies the map gives (status ok) with the same bits as ``sol.frequencies``."""
+def frequencies_given(a, b, l0, passed: bool = True):
+    """``(top, sol)`` of a state whose solution passed its self-check (or, with
+    ``passed=False``, failed it) and whose frequencies the map gives (status ok) with
+    the same bits as ``sol.frequencies``."""
     top = manakov.ManakovTop(a, b)
     sol = top.solve(l0)
-    assert sol.self_check_passed
+    assert sol.self_check_passed == passed
     fm = manakov.frequency_map(top, np.asarray([l0]))
     assert int(fm.status[0]) == manakov.tori.OK
     np.testing.assert_array_equal(fm.nu[0], sol.frequencies)
@@ -1219,12 +1220,7 @@ def test_a_solution_that_fails_its_self_check_has_the_frequencies_the_abel_image
     """Frequencies given by the map and the solution alike (the same bits) where the
     Abel images vouch for U and U'; both refuse, naming the check, where they do not."""
     (a, b, l0), (a2, b2, l02) = SELF_CHECK_FAILED_STATES
-    top = manakov.ManakovTop(a, b)
-    sol = top.solve(l0)
-    assert not sol.self_check_passed
-    fm = manakov.frequency_map(top, np.asarray([l0]))
-    assert int(fm.status[0]) == manakov.tori.OK
-    np.testing.assert_array_equal(fm.nu[0], sol.frequencies)
+    top, sol = frequencies_given(a, b, l0, passed=False)
     err = abel_fit_error(top, sol, l0)
     assert err is not None and err <= WEAK_DIRECTION_BOUND
     top2 = manakov.ManakovTop(a2, b2)
@@ -1261,14 +1257,8 @@ def test_a_solution_that_fails_its_self_check_takes_the_maps_closed_form() -> No
     """The map and the solution give the same frequencies, and U agrees with the slope
     of the Abel images of a quadruple-precision trajectory of the exact top (measured
     6.5e-16; the long-double one leaves too few images that fit)."""
-    a, b, l0 = ROUNDED_C_STATE
-    top = manakov.ManakovTop(a, b)
-    sol = top.solve(l0)
-    assert not sol.self_check_passed
-    fm = manakov.frequency_map(top, np.asarray([l0]))
-    assert int(fm.status[0]) == manakov.tori.OK
-    np.testing.assert_array_equal(fm.nu[0], sol.frequencies)
-    err = abel_fit_error(top, sol, l0, quad=True)
+    top, sol = frequencies_given(*ROUNDED_C_STATE, passed=False)
+    err = abel_fit_error(top, sol, l0=ROUNDED_C_STATE[2], quad=True)
     assert err is not None and err <= WEAK_DIRECTION_BOUND
 
 
@@ -1478,10 +1468,7 @@ def test_a_closed_form_failing_its_self_check_gives_only_certified_l(k: int) -> 
         ):
             getattr(sol, what)
     if k in (0, 1):
-        top = manakov.ManakovTop(a, b)
-        fm = manakov.frequency_map(top, np.asarray([l0]))
-        assert int(fm.status[0]) == manakov.tori.OK
-        np.testing.assert_array_equal(fm.nu[0], sol.frequencies)
+        top, sol = frequencies_given(a, b, l0, passed=False)
         err = abel_fit_error(top, sol, l0, quad=True)
         assert err is not None and err <= ABEL_FIT_BOUND
     t = np.linspace(0.0, float(t_end), 51)
