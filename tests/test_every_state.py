@@ -1290,6 +1290,34 @@ def test_the_lattice_basis_decides_where_the_second_flow_cannot_be_checked() -> 
     assert err is not None and err <= ABEL_FIT_BOUND
 
 
+#: Draw 7055 of the same harsh draw (branch points spread over 1e9): its solution passed
+#: the self-check with a velocity defect of 2.2e-9, and the frequency map gave its
+#: frequencies from the level set's closed form (taken unchecked below a spread of 1e14)
+#: while ``sol.frequencies`` refused them (the Abel images could not check U within
+#: their budget). The solution now takes the map's numbers there; U agrees with the
+#: slope of the Abel images of a quadruple-precision trajectory to rounding.
+LEVEL_SET_STATE = (
+    [-0.28337256565603575, 759.0420747160538, 1130.2029124915123, 1130.2069620077514],
+    [0.3692402784507589, 0.1405591810079745, 2.2460710364662333, 1.4085420561960569],
+    [
+        -37493.52844808114,
+        -3.6199737328349852e-06,
+        29.096425089221867,
+        -2.1845788779802537e-05,
+        0.07008759657594497,
+        -0.00012500561776882294,
+    ],
+)
+
+
+def test_the_solution_takes_the_maps_closed_form_where_the_map_does() -> None:
+    a, b, l0 = LEVEL_SET_STATE
+    top, sol = frequencies_given(a, b, l0)
+    assert sol.velocity_check > SHAPE_CHECK_BOUND
+    err = abel_fit_error(top, sol, l0, quad=True)
+    assert err is not None and err <= WEAK_DIRECTION_BOUND
+
+
 #: Draw 2569 of the same harsh draw (branch points spread over 5e19): the theta
 #: quotients' second flow at v0 disagrees with the closed form beyond rounding, so
 #: the map reported "inconsistent quotients"; the Abel images of integrated states

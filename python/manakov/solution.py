@@ -539,7 +539,10 @@ class Solution:
         The frequencies come from the lattice coordinates of ``U`` in closed
         form, in double-double where the branch points of (8) spread over more
         than two orders of magnitude; they are those of
-        :func:`manakov.frequency_map` to the bit.
+        :func:`manakov.frequency_map` to the bit. Where the branch points spread
+        over at most 1e14 both take the level set's closed form, and the torus is
+        refused only where the map reports a failure; beyond that both take the
+        solution's ``U``, with the checks below.
 
         Raises
         ------
@@ -560,7 +563,7 @@ class Solution:
             it fixes must be integral to 1e-7; docs/degenerate.md §10). The
             message names the step.
         """
-        # A solution that failed its self-check still has the frequency map's torus
+        # Even a solution that failed its self-check has the frequency map's torus
         # (the level set's closed form, or U and U' the Abel images vouch for).
         self._genus2("torus")
         if self._torus is None:

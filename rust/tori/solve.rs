@@ -10,12 +10,16 @@
 //!   divisors of [`crate::solution::velocity`]). No theta function, no divisor
 //!   of `l0`, no Abel map: the frequencies are a property of the level set.
 //!   Where neither gives the velocities, the state takes the second route.
-//! * [`flow_data`] on a [`Solution`] (`sol.torus`): the solution's `U` and the
+//! * [`flow_data`] on a [`Solution`] (`sol.torus`): where the first route
+//!   gives the velocities, its numbers; else the solution's `U` and the
 //!   closed form of `U'` in the solution's sign convention, each checked
-//!   against the theta quotients' fit at `v0`.
+//!   against the theta quotients' fit at `v0`, and for a solution that failed
+//!   its self-check (kept for its certified `l(t)`) by the Abel images of
+//!   integrated states alone.
 //!
 //! Both take the same closed form on the same curve, so they agree to the
-//! last bits (`tests/data/closed_u_frequencies.py`).
+//! last bits (`tests/data/closed_u_frequencies.py`), and neither refuses what
+//! the other gives.
 
 use num_complex::Complex64 as C;
 
@@ -120,11 +124,23 @@ pub fn flow_data(sol: &Solution, b2: &[f64; 4]) -> Result<FlowData> {
 /// [`flow_data`] with a cancellation token, checked inside the integrations
 /// of the Abel-map check of the velocities ([`abel_rate_defect`]).
 pub fn flow_data_with(sol: &Solution, b2: &[f64; 4], cancel: &Cancel) -> Result<FlowData> {
-    // The frequencies come from U: where its self-check left a velocity
-    // defect above the shape's bound (next to pinched curves, where the theta
-    // quotients' derivatives are sums of nearly cancelling terms), U and U'
-    // are vouched for only if the Abel images of integrated states move along
-    // them ([`abel_rate_defect`], at the end).
+    // Where the frequency map takes the level set's closed form unchecked
+    // (branch points spread over at most CLOSED_FORM_SPREAD, and the half
+    // periods or the auxiliary divisors give the velocities), the solution
+    // takes the same numbers: `sol.torus` and the map agree to the bit, and
+    // neither refuses what the other gives.
+    match level_set_flow_data_c4(sol.a(), sol.c4(), &c_pairs(sol.a(), b2)?, sol.l0()) {
+        Err(Error::Singular {
+            kind: SingularKind::NoVelocityConsensus,
+            ..
+        }) => {}
+        other => return other,
+    }
+    // Beyond it the frequencies come from U: where its self-check left a
+    // velocity defect above the shape's bound (next to pinched curves, where
+    // the theta quotients' derivatives are sums of nearly cancelling terms),
+    // U and U' are vouched for only if the Abel images of integrated states
+    // move along them ([`abel_rate_defect`], at the end).
     //
     // A solution that failed its self-check (kept for its certified l(t),
     // [`Solution::certify_every`]) has its constants C_L, G or divisor in
@@ -133,20 +149,7 @@ pub fn flow_data_with(sol: &Solution, b2: &[f64; 4], cancel: &Cancel) -> Result<
     // the Abel images of integrated states vouch for them, which is a check of
     // the curve as well (on a wrong curve the images of the motion do not lie
     // on a line), whether they are the closed forms or the quotients' fits.
-    //
-    // Where the frequency map takes the level set's closed form unchecked
-    // (branch points spread over at most CLOSED_FORM_SPREAD), such a solution
-    // takes it too: the same numbers, so `sol.torus` and the map agree.
     let soft = sol.certify_every();
-    if soft.is_some() {
-        match level_set_flow_data_c4(sol.a(), sol.c4(), &c_pairs(sol.a(), b2)?, sol.l0()) {
-            Err(Error::Singular {
-                kind: SingularKind::NoVelocityConsensus,
-                ..
-            }) => {}
-            other => return other,
-        }
-    }
     let by_abel = soft.is_some() || sol.velocity_check() > FREQUENCY_VELOCITY_RTOL;
     if soft.is_none() && sol.velocity_check() > VELOCITY_CHECK_RTOL {
         // (not reached from a solution that passed its self-check)
