@@ -557,7 +557,7 @@ class Solution:
             can be off along it), or the solution failed its self-check
             (:attr:`self_check_passed` is False: its constants are in doubt,
             though the frequencies use none of them), and the Abel images of
-            integrated states do not vouch for ``U`` to 1e-10 and ``U'`` to 1e-8
+            integrated states do not vouch for ``U`` to 5e-11 and ``U'`` to 1e-8
             either (at three of thirteen times one to four periods out, at two
             integration steps; where ``U'`` cannot be checked, the lattice basis
             it fixes must be integral to 1e-7; docs/degenerate.md §10). The

@@ -510,14 +510,15 @@ const ABEL_AGREEING: usize = 3;
 pub const ABEL_CHECK_MAX_STEPS: f64 = 1e5;
 
 /// Where the double runs of [`abel_rate_defect`] leave a defect above this
-/// (the frequencies' bound), the same integrations are repeated in
+/// (the bound the check holds `U` to, `tori::solve::ABEL_RATE_RTOL`), the
+/// same integrations are repeated in
 /// double-double: on states whose components span many orders of magnitude
 /// the rounding of Gauss–Legendre in double (`~1e-16 |l0|` a step) is a large
 /// relative change of the small components, which moves the Abel images (a
 /// state of the harsh draw next to a pinched curve: 3.2e-10 from the double
 /// runs, 3e-13 from double-double, 3.4e-13 against a quadruple-precision
 /// trajectory).
-pub const ABEL_DD_FROM: f64 = 1e-10;
+pub const ABEL_DD_FROM: f64 = 5e-11;
 
 /// Most steps (both runs together) of the double-double integrations of
 /// [`abel_rate_defect`], `~20 µs` a step: `~2 s` per flow at most (the

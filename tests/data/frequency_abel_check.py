@@ -6,7 +6,7 @@ Where the theta quotients' own velocity check leaves a defect above 1e-10 (next 
 pinched curves), ``frequency_map`` and ``sol.frequencies`` give the frequencies only if
 the Abel images of integrated states (phases of one to four periods of the fastest
 lattice coordinate in quarter periods, integrated at the default step and at half of it;
-three of the thirteen phases in each run) lie on ``u0 + U t`` to 1e-10 of the phase
+three of the thirteen phases in each run) lie on ``u0 + U t`` to 5e-11 of the phase
 advanced (and those of the second flow on ``u0 + U' t`` to 1e-8: ``U'`` only fixes the
 real plane); so does it where the quotients' second flow at ``v0`` disagrees with the
 closed form, and where ``U`` is the quotients' least-squares fit at ``v0`` rather than
