@@ -273,9 +273,11 @@ pub fn flow_data_with(sol: &Solution, b2: &[f64; 4], cancel: &Cancel) -> Result<
 
 /// `U` and `U'` (the flows with coefficients `sol.c4()` and `c2`) checked by
 /// the Abel images of integrated states ([`abel_rate_defect`]) to
-/// [`ABEL_RATE_RTOL`] and [`ABEL_SECOND_FLOW_RTOL`], for a solution
-/// whose theta quotients' velocity check did not hold them to it, or whose
-/// `U` is their fit next to a pinched curve.
+/// [`ABEL_RATE_RTOL`] and [`ABEL_SECOND_FLOW_RTOL`] (an unchecked `U'`
+/// left to the lattice basis), for a solution whose theta quotients'
+/// velocity check did not hold them to it, whose `U` is their fit next to a
+/// pinched curve, or that failed its self-check (`u_closed`: whether `U` is
+/// the closed form, for the message).
 fn abel_check(
     sol: &Solution,
     (c2, c2_lo): (&[f64; 6], &[f64; 6]),
