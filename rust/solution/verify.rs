@@ -235,7 +235,7 @@ pub(super) fn certify(
     if dd_steps > VERIFY_DD_MAX_STEPS {
         return Ok(Outcome::DisagreeDdOverBudget(worst.0, worst.1, dd_steps));
     }
-    let c: [Dd; 6] = std::array::from_fn(|q| Dd::sum(sign * c4[q], sign * c4_lo[q]));
+    let c = c_dd(c4, c4_lo, sign);
     let y = match converged(gauss16_dd_so4(&c, l0, &s, dt, 1, cancel))? {
         Ok(y) => y,
         Err(o) => return Ok(o),
@@ -462,7 +462,7 @@ pub(super) fn integrate_confirmed(
     times: Vec<f64>,
     cancel: &Cancel,
 ) -> Result<std::result::Result<StandIn, String>> {
-    let c: [Dd; 6] = std::array::from_fn(|q| Dd::sum(sign * c4[q], sign * c4_lo[q]));
+    let c = c_dd(c4, c4_lo, sign);
     let dt = default_dt(c4, size);
     let outcome = stand_in(
         &c,
@@ -483,6 +483,12 @@ pub(super) fn integrate_confirmed(
             Err("the integration found nothing to confirm".into())
         }
     })
+}
+
+/// The coefficients `sign (c4 + c4_lo)` in double-double (`c4_lo` the
+/// rounding errors of `c4`; `sign` ±1 for the direction of time).
+fn c_dd(c4: &[f64; 6], c4_lo: &[f64; 6], sign: f64) -> [Dd; 6] {
+    std::array::from_fn(|q| Dd::sum(sign * c4[q], sign * c4_lo[q]))
 }
 
 /// Phases, in lattice periods of the fastest coordinate, at which
@@ -627,13 +633,12 @@ pub fn abel_rate_defect(
         return Ok(f64::NAN);
     }
     // The double integrations may be the ones that are off: double-double
-    // decides (the same steps, and every step halved).
-    // The coefficients to double-double (`c4 + c4_lo`): next to pinched
-    // curves the Abel images move with the rounding of `c4` by far more than
-    // ε (on a state of the harsh draw by 6e-8 of the phase, which
-    // `c4 + c4_lo` brings to 6e-17, as a quadruple-precision trajectory of
-    // the exact top confirms).
-    let c: [Dd; 6] = std::array::from_fn(|q| Dd::sum(c4[q], c4_lo[q]));
+    // decides (the same steps, and every step halved), with the coefficients
+    // unrounded (`c4 + c4_lo`): next to pinched curves the Abel images move
+    // with the rounding of `c4` by far more than ε (on a state of the harsh
+    // draw by 6e-8 of the phase, which `c4 + c4_lo` brings to 6e-17, as a
+    // quadruple-precision trajectory of the exact top confirms).
+    let c = c_dd(c4, c4_lo, 1.0);
     let mut worst_dd = 0.0f64;
     for split in [1, 2] {
         let y = match gauss16_dd_so4(&c, l0, &times, dt, split, cancel) {

@@ -138,18 +138,29 @@ pub fn flow_data_with(sol: &Solution, b2: &[f64; 4], cancel: &Cancel) -> Result<
     // periods or the auxiliary divisors give the velocities), the solution
     // takes the same numbers: `sol.torus` and the map agree to the bit, and
     // neither refuses what the other gives.
-    match level_set_flow_data_c4(sol.a(), sol.c4(), &c_pairs(sol.a(), b2)?, sol.l0()) {
+    let c2 = c_pairs(sol.a(), b2)?;
+    match level_set_flow_data_c4(sol.a(), sol.c4(), &c2, sol.l0()) {
         Err(Error::Singular {
             kind: SingularKind::NoVelocityConsensus,
             ..
-        }) => {}
-        other => return other,
+        }) => solution_flow_data(sol, b2, c2, cancel),
+        other => other,
     }
-    // Beyond it the frequencies come from U: where its self-check left a
-    // velocity defect above the shape's bound (next to pinched curves, where
-    // the theta quotients' derivatives are sums of nearly cancelling terms),
-    // U and U' are vouched for only if the Abel images of integrated states
-    // move along them ([`abel_rate_defect`], at the end).
+}
+
+/// [`flow_data_with`] where the level set gives no velocities unchecked
+/// (`c2`: the second flow's `c_ij`, state order): from the solution.
+fn solution_flow_data(
+    sol: &Solution,
+    b2: &[f64; 4],
+    c2: [f64; 6],
+    cancel: &Cancel,
+) -> Result<FlowData> {
+    // The frequencies come from U: where its self-check left a velocity
+    // defect above the shape's bound (next to pinched curves, where the theta
+    // quotients' derivatives are sums of nearly cancelling terms), U and U'
+    // are vouched for only if the Abel images of integrated states move along
+    // them ([`abel_rate_defect`], at the end).
     //
     // A solution that failed its self-check (kept for its certified l(t),
     // [`Solution::certify_every`]) has its constants C_L, G or divisor in
@@ -177,8 +188,7 @@ pub fn flow_data_with(sol: &Solution, b2: &[f64; 4], cancel: &Cancel) -> Result<
         .iter()
         .map(|(a, b)| [a[0], a[1], b[0], b[1]])
         .collect();
-    let c2 = c_pairs(sol.a(), b2)?;
-    // their rounding errors, for the Abel-map check's integrations
+    // the second flow's rounding errors, for the Abel-map check's integrations
     let c2_lo = crate::solution::normalize::c_rounding(sol.a(), b2, &c2);
     // The velocities themselves in closed form (the solution's sign
     // convention), in double or DD by the curve's spread ([`needs_dd`]), as
@@ -520,7 +530,7 @@ pub fn level_set_entry_with(
                 kind: SingularKind::NoVelocityConsensus,
                 ..
             }) => Solution::with_c4_lo_certifying(a, c4, c4_lo, l)
-                .and_then(|s| flow_data_with(&s, b2, cancel)),
+                .and_then(|s| solution_flow_data(&s, b2, c2, cancel)),
             other => other,
         },
         classify,
