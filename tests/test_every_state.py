@@ -1290,6 +1290,60 @@ def test_the_lattice_basis_decides_where_the_second_flow_cannot_be_checked() -> 
     assert err is not None and err <= ABEL_FIT_BOUND
 
 
+#: Draw 1724 of the same harsh draw (branch points spread over 1e14 and more): its
+#: solution passed the self-check with a velocity defect of 3.1e-9, and the Abel images
+#: of integrated states moved along U only to ~1e-9: the frequencies were refused. The
+#: images lie on a line to ~1e-14, whose slope is the velocity; the frequencies are its
+#: coordinates. Against the Abel images of a quadruple-precision trajectory over 20
+#: periods it is off by 6.5e-14.
+FITTED_VELOCITY_STATE = (
+    [-0.5418066723731292, 5.489311414050225, 7.892608735593191, 8.482776549852908],
+    [-0.5061151963599513, -0.16699530284397474, -0.17447762438702374, -0.40448708043917325],
+    [
+        6.665991411962938e-05,
+        -0.00017742300824603844,
+        -38703.052749430375,
+        0.0005861107858978626,
+        13989.820985456234,
+        -5.125851437021158e-06,
+    ],
+)
+
+
+def test_the_frequencies_rest_on_the_velocity_the_abel_images_move_at() -> None:
+    a, b, l0 = FITTED_VELOCITY_STATE
+    top, sol = frequencies_given(a, b, l0)
+    assert sol.velocity_check > SHAPE_CHECK_BOUND
+    err = abel_fit_error(top, sol, l0, quad=True)
+    assert err is not None and err <= ABEL_FIT_BOUND
+
+
+#: Draw 6914 of the same harsh draw: a lattice rate slow against the stiffness of the
+#: top, so that the check of U by the Abel images (four periods, at the default step and
+#: at half of it) takes 1.4e6 steps, beyond the 1e5 it was allowed; the frequencies were
+#: refused. U agrees with a quadruple-precision Abel fit to 1.5e-16.
+SLOW_RATE_STATE = (
+    [0.9034921500183282, 17.868836332939345, 662.1442958304706, 662.1631067307575],
+    [0.24800803026363338, 0.35887936748084137, 0.3605607554876055, 86.7973374766811],
+    [
+        383.94146823494424,
+        1.3963918913723904e-06,
+        -1.7275482630727348e-05,
+        -0.00015156676462081193,
+        -0.0010082598851356211,
+        4.3990884056517584e-05,
+    ],
+)
+
+
+def test_a_slow_lattice_rate_on_a_stiff_top_is_checked() -> None:
+    a, b, l0 = SLOW_RATE_STATE
+    top, sol = frequencies_given(a, b, l0)
+    assert sol.velocity_check > SHAPE_CHECK_BOUND
+    err = abel_fit_error(top, sol, l0, quad=True)
+    assert err is not None and err <= WEAK_DIRECTION_BOUND
+
+
 #: Draw 7055 of the same harsh draw (branch points spread over 1e9): its solution passed
 #: the self-check with a velocity defect of 2.2e-9, and the frequency map gave its
 #: frequencies from the level set's closed form (taken unchecked below a spread of 1e14)

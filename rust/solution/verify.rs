@@ -28,7 +28,8 @@
 //!
 //! The velocity `U` itself, where the theta quotients' velocity check cannot
 //! vouch for it to the frequencies' accuracy, is checked the same way, by
-//! the Abel images of integrated states ([`abel_rate_defect`]).
+//! the Abel images of integrated states ([`abel_rate`]), or fitted to them
+//! where they move along another.
 
 use crate::error::{Error, Result};
 use crate::integrate::gauss_dd::{gauss16_dd_so4, gauss16_dd_steps};
@@ -492,7 +493,7 @@ fn c_dd(c4: &[f64; 6], c4_lo: &[f64; 6], sign: f64) -> [Dd; 6] {
 }
 
 /// Phases, in lattice periods of the fastest coordinate, at which
-/// [`abel_rate_defect`] compares: from one period to four, so that a wrong
+/// [`abel_rate`] compares: from one period to four, so that a wrong
 /// velocity shows as a defect growing with time, at every one of them; in
 /// quarter periods, for more chances of [`ABEL_AGREEING`] images away from
 /// branch points (Abel evaluations are cheap next to the integration: on the
@@ -510,12 +511,14 @@ const ABEL_PHASES: [f64; 13] = [
 /// velocity is not: it is off by the same relative amount at every phase.
 const ABEL_AGREEING: usize = 3;
 
-/// Most steps (both runs together) of the integrations of
-/// [`abel_rate_defect`]: Gauss–Legendre order 16 in double, `~1 µs` a step,
-/// so `~0.1 s` per flow.
-pub const ABEL_CHECK_MAX_STEPS: f64 = 1e5;
+/// Most steps (both runs together) of the integrations of [`abel_rate`]:
+/// Gauss–Legendre order 16 in double, `~0.5 µs` a step, so `~1 s` per flow.
+/// Slow lattice rates on stiff tops need this many: on the harsh draw 22
+/// states whose check was beyond 1e5 steps needed up to 1.4e6, and all but
+/// one of them have their frequencies with it.
+pub const ABEL_CHECK_MAX_STEPS: f64 = 2e6;
 
-/// Where the double runs of [`abel_rate_defect`] leave a defect above this
+/// Where the double runs of [`abel_rate`] leave a defect above this
 /// (the bound the check holds `U` to, `tori::solve::ABEL_RATE_RTOL`), the
 /// same integrations are repeated in
 /// double-double: on states whose components span many orders of magnitude
@@ -527,9 +530,64 @@ pub const ABEL_CHECK_MAX_STEPS: f64 = 1e5;
 pub const ABEL_DD_FROM: f64 = 5e-11;
 
 /// Most steps (both runs together) of the double-double integrations of
-/// [`abel_rate_defect`], `~20 µs` a step: `~2 s` per flow at most (the
-/// cancellation token is checked at every step).
-pub const ABEL_CHECK_MAX_DD_STEPS: f64 = 1e5;
+/// [`abel_rate`], `~20 µs` a step: `~20 s` per flow at most, taken only by
+/// states whose check in double failed (the cancellation token is checked at
+/// every step).
+pub const ABEL_CHECK_MAX_DD_STEPS: f64 = 1e6;
+
+/// Fewest of the [`ABEL_PHASES`] whose Abel images must lie on one line in
+/// each double-double run for a velocity fitted to them to stand
+/// ([`AbelRate::fit`]): a majority. With the line's eight parameters (an
+/// offset and a slope in four lattice coordinates) fitted, seven images give
+/// 28 numbers for it to explain, where a velocity given beforehand needs
+/// [`ABEL_AGREEING`].
+pub const ABEL_FIT_AGREEING: usize = 7;
+
+/// Least span, in periods of the fastest lattice coordinate, of the phases
+/// of the images a fitted velocity rests on: its error is the images' scatter
+/// divided by about the span.
+const ABEL_FIT_SPAN: f64 = 2.0;
+
+/// Tolerance, in periods, within which images count as on the line through
+/// a pair of them (the first, robust, step of the fit; the least-squares line
+/// through those images is then held to the caller's bound).
+const ABEL_FIT_CONSENSUS: f64 = 1e-8;
+
+/// A velocity is fitted only where the given one's defect is at most this:
+/// its images are unwrapped modulo the lattice against it, which needs its
+/// drift over the last of [`ABEL_PHASES`] well below half a period.
+const ABEL_FIT_FROM_MAX: f64 = 1e-2;
+
+/// What the Abel images of integrated states say about a velocity `u`
+/// ([`abel_rate`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct AbelRate {
+    /// The relative defect of `u` ([`abel_rate`]); NaN where the comparison
+    /// cannot be made.
+    pub defect: f64,
+    /// Where the defect is above the caller's bound and the double-double
+    /// runs were made: the velocity the images move at, as lattice
+    /// coordinates `(X1, X2, Y1, Y2)` (`U = X + τY`), and the bound on its
+    /// relative error (the images' least-squares residual times the fit's
+    /// sensitivity to it, or the two runs' disagreement, the larger).
+    pub fit: Option<([f64; 4], f64)>,
+}
+
+/// Images of one run: the phase of each image the Abel map took, and its
+/// offset from `u0 + u t_k` in lattice coordinates, reduced to the nearest
+/// lattice vector.
+type Images = Vec<(f64, [f64; 4])>;
+
+/// [`abel_rate`]'s defect of `u` alone.
+pub fn abel_rate_defect(
+    sol: &super::Solution,
+    c4: &[f64; 6],
+    c4_lo: &[f64; 6],
+    u: &[num_complex::Complex64; 2],
+    cancel: &Cancel,
+) -> Result<f64> {
+    Ok(abel_rate(sol, c4, c4_lo, u, 0.0, cancel)?.defect)
+}
 
 /// The velocity `u` of the flow (1) with coefficients `c4` (state order;
 /// `c4 + c4_lo` in double-double, `c4_lo` their rounding errors or zero) on
@@ -541,12 +599,19 @@ pub const ABEL_CHECK_MAX_DD_STEPS: f64 = 1e5;
 /// state, `u(P1(t_k)) + u(P2(t_k))` ([`super::Solution::abel`]: the reduction of the
 /// integrated state and Abel integrals on the curve), is compared with
 /// `u0 + u t_k` modulo the lattice, in lattice coordinates and divided by the
-/// phase advanced. Returns, over both runs, the largest of each run's
+/// phase advanced. The defect is, over both runs, the largest of each run's
 /// [`ABEL_AGREEING`]-th smallest such defect: `u` is off by at most that
 /// (relative), or [`ABEL_AGREEING`] Abel images would have to be off by the
 /// same amount as `u`. NaN where the comparison cannot be made (an
 /// integration over budget or not converged, fewer than [`ABEL_AGREEING`]
 /// states the Abel map takes).
+///
+/// Where that defect is above `rtol` (the caller's bound) and the runs were
+/// made in double-double, the velocity the images move at is fitted to them
+/// ([`AbelRate::fit`]): the images are a line in time, `α + U t`, whatever
+/// `u` is, and its slope needs neither the theta quotients nor `u0`. Next to
+/// pinched curves the closed form's and the quotients' `U` can be off by
+/// 1e-10 … 1e-6 while the images still lie on a line to 1e-13.
 ///
 /// The theta quotients' own velocity check ([`super::Solution::velocity_check`]) is
 /// ill-conditioned where the curve is nearly pinched (its thetas are sums of
@@ -557,33 +622,37 @@ pub const ABEL_CHECK_MAX_DD_STEPS: f64 = 1e5;
 /// than a period per period (the velocity check within
 /// [`super::check::VELOCITY_CHECK_RTOL`]), so the nearest lattice vector is
 /// the right one.
-pub fn abel_rate_defect(
+pub fn abel_rate(
     sol: &super::Solution,
     c4: &[f64; 6],
     c4_lo: &[f64; 6],
     u: &[num_complex::Complex64; 2],
+    rtol: f64,
     cancel: &Cancel,
-) -> Result<f64> {
+) -> Result<AbelRate> {
+    let unchecked = AbelRate {
+        defect: f64::NAN,
+        fit: None,
+    };
     let (curve, l0) = (sol.curve(), &sol.l0);
     let (x, y) = curve.lattice_coordinates(u);
     let rate = nan_max(x.iter().chain(&y).map(|v| v.abs()));
     if !(rate > 0.0 && rate.is_finite()) {
-        return Ok(f64::NAN);
+        return Ok(unchecked);
     }
     let times = ABEL_PHASES.map(|f| f / rate);
     let t_end = times[ABEL_PHASES.len() - 1];
     let dt = default_dt(c4, sol.size);
     let steps = 3.0 * t_end / dt;
     if steps.is_nan() || steps > ABEL_CHECK_MAX_STEPS {
-        return Ok(f64::NAN);
+        return Ok(unchecked);
     }
     // the Abel image of l0 by the same route as the integrated states'
     let Ok(u0) = sol.abel(l0) else {
-        return Ok(f64::NAN);
+        return Ok(unchecked);
     };
-    // each run's ABEL_AGREEING-th smallest defect (None: too few Abel images)
-    let defect_of = |y: &[f64]| -> Option<f64> {
-        let mut defects: Vec<f64> = Vec::with_capacity(times.len());
+    let images_of = |y: &[f64]| -> Images {
+        let mut images = Vec::with_capacity(times.len());
         for (k, l) in y.chunks_exact(6).enumerate() {
             let l: [f64; 6] = l.try_into().expect("rows of 6");
             let Ok(w) = sol.abel(&l) else {
@@ -594,11 +663,19 @@ pub fn abel_rate_defect(
                 w[1] - u0[1] - u[1] * times[k],
             ];
             let (dx, dy) = curve.lattice_coordinates(&d);
-            let off = nan_max(dx.iter().chain(&dy).map(|v| (v - v.round()).abs()));
-            if off.is_finite() {
-                defects.push(off / ABEL_PHASES[k]);
+            let r = [dx[0], dx[1], dy[0], dy[1]].map(|v| v - v.round());
+            if r.iter().all(|v| v.is_finite()) {
+                images.push((ABEL_PHASES[k], r));
             }
         }
+        images
+    };
+    // each run's ABEL_AGREEING-th smallest defect (None: too few Abel images)
+    let defect_of = |images: &Images| -> Option<f64> {
+        let mut defects: Vec<f64> = images
+            .iter()
+            .map(|(p, r)| nan_max(r.iter().map(|v| v.abs())) / p)
+            .collect();
         if defects.len() < ABEL_AGREEING {
             return None;
         }
@@ -617,20 +694,23 @@ pub fn abel_rate_defect(
         };
         let tr = match integrate_with(&top, l0, 0.0, &times, &opts, cancel) {
             Ok(tr) => tr,
-            Err(Error::NoConvergence { .. }) => return Ok(f64::NAN),
+            Err(Error::NoConvergence { .. }) => return Ok(unchecked),
             Err(e) => return Err(e),
         };
-        let Some(d) = defect_of(&tr.y) else {
-            return Ok(f64::NAN);
+        let Some(d) = defect_of(&images_of(&tr.y)) else {
+            return Ok(unchecked);
         };
         worst = worst.max(d);
     }
     if worst <= ABEL_DD_FROM {
-        return Ok(worst);
+        return Ok(AbelRate {
+            defect: worst,
+            fit: None,
+        });
     }
     if 3.0 * gauss16_dd_steps(&times, dt, 1) > ABEL_CHECK_MAX_DD_STEPS {
         // the double runs' defect may be theirs, not u's
-        return Ok(f64::NAN);
+        return Ok(unchecked);
     }
     // The double integrations may be the ones that are off: double-double
     // decides (the same steps, and every step halved), with the coefficients
@@ -640,16 +720,179 @@ pub fn abel_rate_defect(
     // quadruple-precision trajectory of the exact top confirms).
     let c = c_dd(c4, c4_lo, 1.0);
     let mut worst_dd = 0.0f64;
+    let mut runs: Vec<Images> = Vec::with_capacity(2);
     for split in [1, 2] {
         let y = match gauss16_dd_so4(&c, l0, &times, dt, split, cancel) {
             Ok(y) => y,
-            Err(Error::NoConvergence { .. }) => return Ok(f64::NAN),
+            Err(Error::NoConvergence { .. }) => return Ok(unchecked),
             Err(e) => return Err(e),
         };
-        let Some(d) = defect_of(&y) else {
-            return Ok(f64::NAN);
-        };
-        worst_dd = worst_dd.max(d);
+        let images = images_of(&y);
+        match defect_of(&images) {
+            Some(d) => worst_dd = worst_dd.max(d),
+            // too few images for the defect leaves too few for a fit as well
+            None => return Ok(unchecked),
+        }
+        runs.push(images);
     }
-    Ok(worst_dd)
+    let fit = if worst_dd > rtol && worst_dd <= ABEL_FIT_FROM_MAX {
+        fitted_rate(&runs, rtol).map(|(slope, bound)| {
+            let w0 = [x[0], x[1], y[0], y[1]];
+            (std::array::from_fn(|q| w0[q] + slope[q] * rate), bound)
+        })
+    } else {
+        None
+    };
+    Ok(AbelRate {
+        defect: worst_dd,
+        fit,
+    })
+}
+
+/// The slope (lattice coordinates per period of phase, so the relative
+/// correction to the velocity) of the line the images of every run lie on,
+/// and the bound on its error: per run, the pair of images whose line the
+/// most images lie on within [`ABEL_FIT_CONSENSUS`], the least-squares line
+/// through those, trimmed of its worst image while its bound is above `rtol`
+/// (at least [`ABEL_FIT_AGREEING`] images over [`ABEL_FIT_SPAN`] periods);
+/// the bound is the largest residual times the least-squares slope's
+/// sensitivity to it, or the runs' largest disagreement, the larger, and the
+/// slope their mean. None where a run leaves too few images on a line.
+fn fitted_rate(runs: &[Images], rtol: f64) -> Option<([f64; 4], f64)> {
+    let mut slopes: Vec<[f64; 4]> = Vec::with_capacity(runs.len());
+    let mut bound = 0.0f64;
+    for images in runs {
+        let (slope, b) = fitted_line(images, rtol)?;
+        slopes.push(slope);
+        bound = bound.max(b);
+    }
+    let n = slopes.len() as f64;
+    let mean: [f64; 4] = std::array::from_fn(|q| slopes.iter().map(|s| s[q]).sum::<f64>() / n);
+    for s in &slopes {
+        for t in &slopes {
+            bound = bound.max(nan_max((0..4).map(|q| (s[q] - t[q]).abs())));
+        }
+    }
+    (bound.is_finite()).then_some((mean, bound))
+}
+
+/// One run's line ([`fitted_rate`]): its slope and error bound.
+fn fitted_line(images: &Images, rtol: f64) -> Option<([f64; 4], f64)> {
+    let off = |(p, r): &(f64, [f64; 4]), a: &[f64; 4], s: &[f64; 4]| {
+        nan_max((0..4).map(|q| (r[q] - a[q] - s[q] * p).abs()))
+    };
+    // the robust start: the pair whose line the most images lie on
+    let mut best: Vec<usize> = Vec::new();
+    for i in 0..images.len() {
+        for j in i + 1..images.len() {
+            let ((pi, ri), (pj, rj)) = (images[i], images[j]);
+            if pj - pi < 0.5 {
+                continue;
+            }
+            let s: [f64; 4] = std::array::from_fn(|q| (rj[q] - ri[q]) / (pj - pi));
+            let a: [f64; 4] = std::array::from_fn(|q| ri[q] - s[q] * pi);
+            let on: Vec<usize> = (0..images.len())
+                .filter(|&k| off(&images[k], &a, &s) <= ABEL_FIT_CONSENSUS)
+                .collect();
+            if on.len() > best.len() {
+                best = on;
+            }
+        }
+    }
+    loop {
+        if best.len() < ABEL_FIT_AGREEING {
+            return None;
+        }
+        let p: Vec<f64> = best.iter().map(|&k| images[k].0).collect();
+        let lo = p.iter().copied().fold(f64::INFINITY, f64::min);
+        let hi = p.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+        if hi - lo < ABEL_FIT_SPAN {
+            return None;
+        }
+        let n = p.len() as f64;
+        let mean = p.iter().sum::<f64>() / n;
+        let spread = p.iter().map(|v| (v - mean) * (v - mean)).sum::<f64>();
+        // the least-squares slope moves by at most this times the largest
+        // change of an image
+        let sensitivity = p.iter().map(|v| (v - mean).abs()).sum::<f64>() / spread;
+        let s: [f64; 4] = std::array::from_fn(|q| {
+            best.iter()
+                .map(|&k| (images[k].0 - mean) * images[k].1[q])
+                .sum::<f64>()
+                / spread
+        });
+        let a: [f64; 4] = std::array::from_fn(|q| {
+            best.iter().map(|&k| images[k].1[q]).sum::<f64>() / n - s[q] * mean
+        });
+        let (worst, at) = best
+            .iter()
+            .enumerate()
+            .map(|(i, &k)| (off(&images[k], &a, &s), i))
+            .max_by(|x, y| x.0.total_cmp(&y.0))?;
+        let b = worst * sensitivity;
+        if b <= rtol {
+            return Some((s, b));
+        }
+        best.remove(at);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Images at every phase of [`ABEL_PHASES`] on the line `a + s p`, with a
+    /// scatter of up to `noise` (a fixed pseudo-random pattern) and the images at `outliers`
+    /// moved off it by `1e-3 (k² + 1)` (on no common line).
+    fn images(a: [f64; 4], s: [f64; 4], noise: f64, outliers: &[usize]) -> Images {
+        ABEL_PHASES
+            .iter()
+            .enumerate()
+            .map(|(k, &p)| {
+                let bump = if outliers.contains(&k) {
+                    1e-3 * (k * k + 1) as f64
+                } else {
+                    0.0
+                };
+                let r = std::array::from_fn(|q| {
+                    // a fixed pseudo-random pattern in [-1, 1]
+                    let scatter = (12.9898 * k as f64 + 78.233 * q as f64).sin();
+                    a[q] + s[q] * p + scatter * noise + bump
+                });
+                (p, r)
+            })
+            .collect()
+    }
+
+    #[test]
+    fn the_fitted_line_is_the_slope_of_the_images_despite_outliers() {
+        let (a, s) = ([1e-9, -2e-9, 0.0, 3e-9], [3e-7, -1e-8, 2e-9, 0.0]);
+        // four of thirteen images off by 1e-3, the rest scattered by 1e-14
+        let run = images(a, s, 1e-14, &[0, 3, 7, 12]);
+        let (slope, bound) = fitted_line(&run, 5e-11).expect("nine images on a line");
+        let err = nan_max((0..4).map(|q| (slope[q] - s[q]).abs()));
+        assert!(bound <= 5e-11, "bound {bound:e}");
+        assert!(err <= bound, "slope off by {err:e}, bound {bound:e}");
+        // two runs: the mean slope, bounded by their disagreement as well
+        let other = images(a, s.map(|v| v + 1e-12), 0.0, &[]);
+        let (mean, bound) = fitted_rate(&[run, other], 5e-11).expect("both runs fit");
+        assert!(bound >= 1e-12, "the runs' disagreement counts: {bound:e}");
+        assert!(nan_max((0..4).map(|q| (mean[q] - s[q]).abs())) <= bound);
+    }
+
+    #[test]
+    fn images_off_a_line_give_no_fitted_velocity() {
+        let (a, s) = ([0.0; 4], [1e-8; 4]);
+        // seven of thirteen off: only six on the line
+        let run = images(a, s, 0.0, &[0, 2, 4, 6, 8, 10, 12]);
+        assert!(fitted_line(&run, 5e-11).is_none());
+        // images scattered by 1e-9 do not bound a slope to 5e-11
+        assert!(fitted_line(&images(a, s, 1e-9, &[]), 5e-11).is_none());
+        // six phases on a line, spanning under two periods
+        let short: Images = images(a, s, 0.0, &[])
+            .into_iter()
+            .filter(|(p, _)| *p <= 2.5)
+            .collect();
+        assert!(fitted_line(&short, 5e-11).is_none());
+    }
 }

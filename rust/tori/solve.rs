@@ -32,7 +32,7 @@ use crate::solution::dubrovin::{
     closed_form_fits, half_period_velocities, lattice_rates_dd, CLOSED_FORM,
 };
 use crate::solution::velocity::algebraic_rates;
-use crate::solution::verify::abel_rate_defect;
+use crate::solution::verify::{abel_rate, AbelRate};
 use crate::solution::VELOCITY_CHECK_RTOL;
 use crate::solution::{a_periods_of, level_set_curve, Solution};
 
@@ -131,7 +131,7 @@ pub fn flow_data(sol: &Solution, b2: &[f64; 4]) -> Result<FlowData> {
 }
 
 /// [`flow_data`] with a cancellation token, checked inside the integrations
-/// of the Abel-map check of the velocities ([`abel_rate_defect`]).
+/// of the Abel-map check of the velocities ([`abel_rate`]).
 pub fn flow_data_with(sol: &Solution, b2: &[f64; 4], cancel: &Cancel) -> Result<FlowData> {
     // Where the frequency map takes the level set's closed form unchecked
     // (branch points spread over at most CLOSED_FORM_SPREAD, and the half
@@ -160,7 +160,7 @@ fn solution_flow_data(
     // defect above the shape's bound (next to pinched curves, where the theta
     // quotients' derivatives are sums of nearly cancelling terms), U and U'
     // are vouched for only if the Abel images of integrated states move along
-    // them ([`abel_rate_defect`], at the end).
+    // them ([`abel_rate`], at the end).
     //
     // A solution that failed its self-check (kept for its certified l(t),
     // [`Solution::certify_every`]) has its constants C_L, G or divisor in
@@ -250,7 +250,7 @@ fn solution_flow_data(
     // quotients depend on u: next to a pinched curve they hardly see one
     // direction, and the Abel images decide (FIT_PINCHED_IM_TAU).
     let by_abel = by_abel || (closed.is_none() && largest_im_tau(&t) > FIT_PINCHED_IM_TAU);
-    let (u, u2, w) = match closed.as_ref() {
+    let (mut u, mut u2, mut w) = match closed.as_ref() {
         Some(lat) => (lat.u[0], lat.u[1], Some(lat.w[0])),
         None => (sol.rate(), u2_fit, None),
     };
@@ -265,12 +265,13 @@ fn solution_flow_data(
             return Err(refusal);
         }
         match abel_check(sol, (&c2, &c2_lo), &u, &u2, closed.is_some(), cancel) {
-            Ok(()) => {}
+            Ok(checked) => (u, u2, w) = (checked.u, checked.u2, checked.w.or(w)),
             Err(Error::Unverified { .. }) => return Err(refusal),
             Err(e) => return Err(e),
         }
     } else if by_abel {
-        abel_check(sol, (&c2, &c2_lo), &u, &u2, closed.is_some(), cancel)?;
+        let checked = abel_check(sol, (&c2, &c2_lo), &u, &u2, closed.is_some(), cancel)?;
+        (u, u2, w) = (checked.u, checked.u2, checked.w.or(w));
     }
     Ok(FlowData {
         tau: [[t[0], t[1]], [t[2], t[3]]],
@@ -281,13 +282,24 @@ fn solution_flow_data(
     })
 }
 
+/// The velocities checked by the Abel images of integrated states.
+struct Checked {
+    u: [C; 2],
+    u2: [C; 2],
+    /// Where `U` is the velocity fitted to the images: its lattice
+    /// coordinates ([`FlowData::w`]).
+    w: Option<[f64; 4]>,
+}
+
 /// `U` and `U'` (the flows with coefficients `sol.c4()` and `c2`) checked by
-/// the Abel images of integrated states ([`abel_rate_defect`]) to
+/// the Abel images of integrated states ([`abel_rate`]) to
 /// [`ABEL_RATE_RTOL`] and [`ABEL_SECOND_FLOW_RTOL`] (an unchecked `U'`
 /// left to the lattice basis), for a solution whose theta quotients'
 /// velocity check did not hold them to it, whose `U` is their fit next to a
 /// pinched curve, or that failed its self-check (`u_closed`: whether `U` is
-/// the closed form, for the message).
+/// the closed form, for the message). Where the images move along another
+/// velocity, on a line to within the same bound, that velocity replaces the
+/// given one.
 fn abel_check(
     sol: &Solution,
     (c2, c2_lo): (&[f64; 6], &[f64; 6]),
@@ -295,12 +307,31 @@ fn abel_check(
     u2: &[C; 2],
     u_closed: bool,
     cancel: &Cancel,
-) -> Result<()> {
-    let d1 = abel_rate_defect(sol, sol.c4(), sol.c4_lo(), u, cancel)?;
-    let d2 = if d1 <= ABEL_RATE_RTOL {
-        abel_rate_defect(sol, c2, c2_lo, u2, cancel)?
+) -> Result<Checked> {
+    let tau = sol.tau();
+    // `U = X + τY` of lattice coordinates `(X1, X2, Y1, Y2)`
+    let velocity = |w: &[f64; 4]| -> [C; 2] {
+        [
+            tau[0] * w[2] + tau[1] * w[3] + w[0],
+            tau[2] * w[2] + tau[3] * w[3] + w[1],
+        ]
+    };
+    // the given velocity where the images hold it to `rtol`, else the one
+    // fitted to them where that holds to `rtol`
+    let decide = |r: AbelRate, given: &[C; 2], rtol: f64| match r.fit {
+        _ if r.defect <= rtol => (r.defect, *given, None),
+        Some((w, bound)) if bound <= rtol => (bound, velocity(&w), Some(w)),
+        Some((_, bound)) => (r.defect.min(bound), *given, None),
+        None => (r.defect, *given, None),
+    };
+    let r1 = abel_rate(sol, sol.c4(), sol.c4_lo(), u, ABEL_RATE_RTOL, cancel)?;
+    let (d1, u, w) = decide(r1, u, ABEL_RATE_RTOL);
+    let (d2, u2) = if d1 <= ABEL_RATE_RTOL {
+        let r2 = abel_rate(sol, c2, c2_lo, u2, ABEL_SECOND_FLOW_RTOL, cancel)?;
+        let (d2, u2, _) = decide(r2, u2, ABEL_SECOND_FLOW_RTOL);
+        (d2, u2)
     } else {
-        f64::NAN
+        (f64::NAN, *u2)
     };
     // Where U' could not be checked (its flow beyond the integrations' budget,
     // or too few of its states that the Abel map takes), the lattice basis
@@ -310,7 +341,7 @@ fn abel_check(
     // within it is the same integer vectors; the frequencies are U's
     // coordinates in that basis.
     if d1 <= ABEL_RATE_RTOL && (d2 <= ABEL_SECOND_FLOW_RTOL || d2.is_nan()) {
-        return Ok(());
+        return Ok(Checked { u, u2, w });
     }
     // the failing flow's defect (NaN: the check could not be made)
     let (worst, which, bound) = if d1 <= ABEL_RATE_RTOL {
@@ -325,8 +356,8 @@ fn abel_check(
         )
     } else {
         format!(
-            "the Abel images of integrated states move along {which} only to {worst:e} \
-             (relative, > {bound:e})"
+            "the Abel images of integrated states move along {which}, or along a velocity \
+             fitted to them, only to {worst:e} (relative, > {bound:e})"
         )
     };
     let thetas = if let Some(why) = sol.certify_every() {

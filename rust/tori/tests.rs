@@ -1079,3 +1079,65 @@ fn the_lattice_basis_decides_where_the_second_flow_cannot_be_checked() {
     let d2 = abel_rate_defect(sol, &c2, &c_rounding(sol.a(), &b2, &c2), &u2, &cancel).unwrap();
     assert!(d2.is_nan(), "{d2:e}");
 }
+
+/// Draw 1724 of the same harsh draw (branch points spread over 1e14 and
+/// more; velocity defect 3.1e-9): the Abel images of integrated states do not
+/// move along the solution's `U` to the check's bound, but they lie on a line
+/// whose slope is the velocity, within it; the frequencies are its
+/// coordinates (against a quadruple-precision Abel fit: 6.5e-14,
+/// tests/test_every_state.py).
+#[test]
+fn the_frequencies_rest_on_the_velocity_the_abel_images_move_at() {
+    use crate::solution::motion::Motion;
+    use crate::solution::verify::abel_rate;
+    use crate::tori::solve::{state_frequencies, torus_of_state, ABEL_RATE_RTOL};
+    let a = [
+        -0.5418066723731292,
+        5.489311414050225,
+        7.892608735593191,
+        8.482776549852908,
+    ];
+    let b = [
+        -0.5061151963599513,
+        -0.16699530284397474,
+        -0.17447762438702374,
+        -0.40448708043917325,
+    ];
+    let l0 = [
+        6.665991411962938e-05,
+        -0.00017742300824603844,
+        -38703.052749430375,
+        0.0005861107858978626,
+        13989.820985456234,
+        -5.125851437021158e-06,
+    ];
+    let cancel = Cancel::never();
+    let m = Motion::new(&a, &b, &l0).unwrap();
+    let sol = m.genus2().expect("a genus-2 motion");
+    let r = abel_rate(
+        sol,
+        sol.c4(),
+        sol.c4_lo(),
+        &sol.rate(),
+        ABEL_RATE_RTOL,
+        &cancel,
+    )
+    .unwrap();
+    assert!(
+        r.defect > ABEL_RATE_RTOL,
+        "the given U holds: {:e}",
+        r.defect
+    );
+    let (w, bound) = r.fit.expect("a velocity fitted to the images");
+    assert!(bound <= ABEL_RATE_RTOL, "{bound:e}");
+    // the fitted velocity is another than the solution's, by more than the bound
+    let (x, y) = sol.curve().lattice_coordinates(&sol.rate());
+    let given = [x[0], x[1], y[0], y[1]];
+    let rate = given.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    let moved = (0..4).fold(0.0f64, |m, q| m.max((w[q] - given[q]).abs())) / rate;
+    assert!(moved > ABEL_RATE_RTOL, "{moved:e}");
+    let (t, _) = torus_of_state(&a, &b, &l0, &cancel).unwrap();
+    let e = state_frequencies(&a, &b, &l0);
+    assert_eq!(e.status, Status::Ok);
+    assert_eq!(t.nu.map(f64::to_bits), e.nu.map(f64::to_bits));
+}
