@@ -553,10 +553,14 @@ const ABEL_FIT_SPAN: f64 = 2.0;
 /// through those images is then held to the caller's bound).
 const ABEL_FIT_CONSENSUS: f64 = 1e-8;
 
-/// A velocity is fitted only where the given one's defect is at most this:
-/// its images are unwrapped modulo the lattice against it, which needs its
-/// drift over the last of [`ABEL_PHASES`] well below half a period.
-const ABEL_FIT_FROM_MAX: f64 = 1e-2;
+/// Largest relative correction a fitted velocity may make to the given one:
+/// the images are unwrapped modulo the lattice against the given velocity,
+/// which needs its drift over the last of [`ABEL_PHASES`] well below half a
+/// period. (The given velocity's defect can be far larger: an image of `l0`
+/// off by a constant shifts every image alike, which the line's offset takes
+/// up; on the harsh draw one solution had a defect of 2e-2 while its images
+/// lay on a line to 5e-16.)
+const ABEL_FIT_MAX_SLOPE: f64 = 1e-2;
 
 /// What the Abel images of integrated states say about a velocity `u`
 /// ([`abel_rate`]).
@@ -735,11 +739,13 @@ pub fn abel_rate(
         }
         runs.push(images);
     }
-    let fit = if worst_dd > rtol && worst_dd <= ABEL_FIT_FROM_MAX {
-        fitted_rate(&runs, rtol).map(|(slope, bound)| {
-            let w0 = [x[0], x[1], y[0], y[1]];
-            (std::array::from_fn(|q| w0[q] + slope[q] * rate), bound)
-        })
+    let fit = if worst_dd > rtol {
+        fitted_rate(&runs, rtol)
+            .filter(|(slope, _)| nan_max(slope.iter().map(|v| v.abs())) <= ABEL_FIT_MAX_SLOPE)
+            .map(|(slope, bound)| {
+                let w0 = [x[0], x[1], y[0], y[1]];
+                (std::array::from_fn(|q| w0[q] + slope[q] * rate), bound)
+            })
     } else {
         None
     };

@@ -86,24 +86,31 @@ def torus_rate(sol):
 def fitted_error(top, sol, l0, fp=LD):
     """max|U - U_fit| / (largest lattice rate), ``U`` of :func:`torus_rate`, and the
     samples used (None if too few); the trajectory by heyoka in ``fp`` (long double, or
-    ``heyoka.real128``). The images are taken relative to that of ``l0``."""
+    ``heyoka.real128``). The images are taken relative to that of ``l0``, and a sample
+    is set aside where its image is off the others' median by ``ABEL_MISS``."""
     u = torus_rate(sol)
     x, y = lattice(sol.tau, u)
     rate = max(np.max(np.abs(x)), np.max(np.abs(y)))
     t_user = np.linspace(0.0, PERIODS / rate / sol.time_scale, SAMPLES)
     ref = np.asarray(propagate(top.a, top.b, l0, t_user, fp), dtype=float)
     u0 = sol.abel(np.asarray(l0, dtype=float))
-    keep, miss = [], []
+    times, offsets = [], []
     for t, l in zip(t_user * sol.time_scale, ref):
         try:
             w = sol.abel(l)
         except (ValueError, manakov.ClosedFormError):
             continue
         dx, dy = lattice(sol.tau, w - u0 - u * t)
-        r = np.concatenate([dx - np.round(dx), dy - np.round(dy)])
-        if np.max(np.abs(r)) < ABEL_MISS:
-            keep.append(t)
-            miss.append(r)
+        times.append(t)
+        offsets.append(np.concatenate([dx - np.round(dx), dy - np.round(dy)]))
+    if not times:
+        return None, 0
+    # Images are set aside by their distance from the median offset, not from that of
+    # l0: an image of l0 off by a constant shifts the whole line, not its slope.
+    offsets = np.array(offsets)
+    centre = np.median(offsets, axis=0)
+    near = np.max(np.abs(offsets - centre), axis=1) < ABEL_MISS
+    keep, miss = list(np.array(times)[near]), list(offsets[near])
     if len(keep) < MIN_SAMPLES:
         return None, len(keep)
     tt = np.array(keep)
