@@ -1055,8 +1055,10 @@ def test_the_velocity_part_of_the_self_check_has_its_own_bound(case) -> None:
 #: Draws of the harsh random draw (tests/data/every_state_harsh.py, seed 20261125)
 #: whose theta quotients' velocity check exceeds 1e-10: (a, b, l0). Draw 48 (branch
 #: points spread over 1e30): the Abel images of integrated states vouch for U and U'
-#: (and U agrees with a long-double Abel fit to 1.1e-12); draw 1724: they move along
-#: U only to 1.7e-9, at every phase.
+#: (and U agrees with a long-double Abel fit to 1.1e-12); draw 5688 (velocity defect
+#: 3.1e-8): they move along U only to 3.1e-10, and lie on no line to the check's bound
+#: either (draw 1724, which took this place, has its frequencies from the line its images
+#: lie on: test_the_frequencies_rest_on_the_velocity_the_abel_images_move_at).
 ABEL_STATES = [
     (
         [-0.9256184990074312, 279.5208482998301, 279.7404819891023, 633.6897780257893],
@@ -1071,15 +1073,15 @@ ABEL_STATES = [
         ],
     ),
     (
-        [-0.5418066723731292, 5.489311414050225, 7.892608735593191, 8.482776549852908],
-        [-0.5061151963599513, -0.16699530284397474, -0.17447762438702374, -0.40448708043917325],
+        [-0.35785937930241984, 254.88236565325207, 254.9803473443627, 255.66968611875146],
+        [-0.493215943402906, -383.247557967334, -383.25002290168334, -383.1049452168393],
         [
-            6.665991411962938e-05,
-            -0.00017742300824603844,
-            -38703.052749430375,
-            0.0005861107858978626,
-            13989.820985456234,
-            -5.125851437021158e-06,
+            -693.3807049218774,
+            4.444570211926769,
+            0.00024826220637976393,
+            3.602082410445823e-06,
+            -265891.11124832206,
+            4.018520895008697e-05,
         ],
     ),
 ]
@@ -1104,6 +1106,8 @@ def test_the_abel_map_of_integrated_states_vouches_for_the_frequencies() -> None
 #: for the fit; on 3623 the closed form refused) and the frequency map answered ok, with U
 #: off by 1.2e-10 and 4.6e-10 of the largest lattice rate against the Abel images of a
 #: long-double and of a quadruple-precision trajectory (tests/data/frequency_abel_check.txt).
+#: On 3623 the frequencies now rest on the velocity the Abel images move at (2.0e-11
+#: from the quadruple-precision fit).
 WEAK_DIRECTION_STATES = [
     (
         [-0.4454024278348636, -0.42589631886380747, 249.18970958170598, 249.2216294628726],
@@ -1141,14 +1145,27 @@ def test_the_fit_of_u_is_not_trusted_along_a_direction_the_quotients_hardly_see(
     """The closed form of U stands where it satisfies the quotients' equations to the
     bound they vouch for; where U is their fit, the frequencies need the Abel images of
     integrated states, which refuse it on draw 3623 (by the defect the
-    quadruple-precision trajectory shows)."""
+    quadruple-precision trajectory shows): its frequencies rest on the velocity the
+    images move at instead, which agrees with that trajectory."""
     (a, b, l0), (a2, b2, l02) = WEAK_DIRECTION_STATES
     top, sol = frequencies_given(a, b, l0)
     assert sol.velocity_check <= SHAPE_CHECK_BOUND
-    sol2 = frequencies_refused(a2, b2, l02, "least-squares fit")
-    assert sol2.velocity_check <= SHAPE_CHECK_BOUND
     err = abel_fit_error(top, sol, l0)
     assert err is not None and err <= WEAK_DIRECTION_BOUND
+    top2, sol2 = frequencies_given(a2, b2, l02)
+    assert sol2.velocity_check <= SHAPE_CHECK_BOUND
+    # the frequencies' velocity is not the quotients' fit (sol.U, which l(t) uses)
+    data = str(Path(__file__).resolve().parent / "data")
+    if data not in sys.path:
+        sys.path.insert(0, data)
+    import frequency_abel_check
+
+    x, y = frequency_abel_check.lattice(sol2.tau, frequency_abel_check.torus_rate(sol2))
+    x_fit, y_fit = frequency_abel_check.lattice(sol2.tau, np.asarray(sol2.U))
+    moved = np.max(np.abs(np.r_[x - x_fit, y - y_fit])) / np.max(np.abs(np.r_[x, y]))
+    assert moved > ABEL_FIT_BOUND
+    err2 = abel_fit_error(top2, sol2, l02, quad=True)
+    assert err2 is not None and err2 <= ABEL_FIT_BOUND
 
 
 #: Draw 842 of the same harsh draw (branch points spread over 5e26; U is the theta
@@ -1180,14 +1197,17 @@ def test_the_second_flow_needs_only_to_fix_the_real_plane() -> None:
     assert err is not None and err <= WEAK_DIRECTION_BOUND
 
 
-#: Draws 2798 and 9958 of the same harsh draw (branch points spread over 1e31 and 6e21):
-#: their theta quotients fail the self-check (defects 3.2e-10 and 3.3e-8), and each
+#: Draws 2798 and 9027 of the same harsh draw (branch points spread over 1e31 and 2e24):
+#: their theta quotients fail the self-check (defects 3.2e-10 and 2.0e-8), and each
 #: solution is kept for its l(t), which an integration certifies at every call. The
 #: earlier code refused the frequencies of both. The frequencies use none of the
 #: quotients' constants (C_L, G, the divisor), only U, U' and the curve: on 2798 (U is
 #: the quotients' fit, the closed form refused) the Abel images of integrated states
 #: vouch for U and U', and U agrees with the slope of the Abel images of a long-double
-#: trajectory to 4.3e-15; on 9958 they move along the fit only to 1.7e-8.
+#: trajectory to 4.3e-15; on 9027 they move along the fit only to 1.8e-8, and lie on no
+#: line to the check's bound, over one to four periods or 32 times as long. (Draw 9958,
+#: which took this place, has its frequencies from the line its images lie on over the
+#: longer span: 3.0e-12 from a quadruple-precision Abel fit.)
 SELF_CHECK_FAILED_STATES = [
     (
         [0.8967390505337116, 1.7129587477520798, 900.2610221438466, 900.2623013785277],
@@ -1202,15 +1222,15 @@ SELF_CHECK_FAILED_STATES = [
         ],
     ),
     (
-        [0.722200434850111, 0.9031562348980198, 2.9414590454907303, 2.949478307698651],
-        [0.42810280649827503, -417.6450933588394, -420.5084050535709, -420.76208765806774],
+        [0.22309459771474005, 0.252693044074548, 40.25814783982496, 40.491385096600766],
+        [0.9103173402628504, -60.36880991309685, -60.367364683463165, -59.07186961393915],
         [
-            66531.18682451487,
-            1.5689977637924342e-05,
-            -0.07039798877543015,
-            5.471320703113149e-05,
-            -84519.15723259121,
-            -5.077669142056833e-06,
+            433115.8815255508,
+            -2.2483982769033403e-06,
+            -306830.5363404395,
+            7.273407248964303e-05,
+            -193.11082802366928,
+            -7.4291846114222384e-06,
         ],
     ),
 ]
@@ -1318,6 +1338,33 @@ def test_the_frequencies_rest_on_the_velocity_the_abel_images_move_at() -> None:
     assert err is not None and err <= ABEL_FIT_BOUND
 
 
+#: Draw 3872 of the same harsh draw (U the theta quotients' fit next to a pinched
+#: curve): its Abel images over one to four periods scatter by ~1e-9 of a period, so the
+#: line through them bounds the velocity only to ~4e-9. Once passed at 9.0e-11 with U off
+#: by 1.3e-10 (the check's bound was then tightened), then refused; the images over a
+#: span 32 times longer bound it to 5e-11, and it agrees with a quadruple-precision Abel
+#: fit to 5.5e-12.
+SCATTERED_IMAGES_STATE = (
+    [0.9330842905750012, 1.059188035749124, 1.0646032671356975, 39.80077885983949],
+    [-0.6214282179219519, -1.386991288185635, -1.2448473486421618, 293.2294230451944],
+    [
+        9299.936066991515,
+        343490.6551235591,
+        -2.0514709347756864e-05,
+        -0.0001527124340605947,
+        -0.009482720985584954,
+        0.0010721603527330346,
+    ],
+)
+
+
+def test_images_that_scatter_give_the_velocity_over_a_longer_span() -> None:
+    a, b, l0 = SCATTERED_IMAGES_STATE
+    top, sol = frequencies_given(a, b, l0)
+    err = abel_fit_error(top, sol, l0, quad=True)
+    assert err is not None and err <= ABEL_FIT_BOUND
+
+
 #: Draw 6914 of the same harsh draw: a lattice rate slow against the stiffness of the
 #: top, so that the check of U by the Abel images (four periods, at the default step and
 #: at half of it) takes 1.4e6 steps, beyond the 1e5 it was allowed; the frequencies were
@@ -1393,6 +1440,32 @@ SECOND_FLOW_STATE = (
 
 def test_the_abel_map_decides_where_the_second_flow_disagrees() -> None:
     frequencies_given(*SECOND_FLOW_STATE)
+
+
+#: Draw 7135 of the same harsh draw: the closed form of U refused, and the theta
+#: quotients' second flow at v0 satisfies (1) for no velocity (least-squares residual
+#: 2.1e-6): the frequencies were refused. The Abel images of integrated states check the
+#: quotients' fits of U and U' as they check a closed form (or give the velocities they
+#: move at); U agrees with a quadruple-precision Abel fit to 4.1e-12.
+NO_CLOSED_FORM_SECOND_FLOW_STATE = (
+    [-0.8249575783098118, -0.29046536893032926, -0.2785046906536144, 463.7001330616075],
+    [-0.39992295559885194, 104.9775856308158, -40.43869876728665, -40.44423523277784],
+    [
+        0.0745870808048656,
+        79835.76365099012,
+        -2.1752764131680133e-06,
+        -0.004371754898330126,
+        -1.1762633005303048e-06,
+        -6.720234565987814e-06,
+    ],
+)
+
+
+def test_the_abel_map_decides_where_the_second_flow_has_neither_fit_nor_closed_form() -> None:
+    a, b, l0 = NO_CLOSED_FORM_SECOND_FLOW_STATE
+    top, sol = frequencies_given(a, b, l0)
+    err = abel_fit_error(top, sol, l0, quad=True)
+    assert err is not None and err <= ABEL_FIT_BOUND
 
 
 #: States of the harsh draw (seed 5) whose branch points spread over 1e18 and

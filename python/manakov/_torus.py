@@ -179,8 +179,9 @@ def torus_of_state(a: Any, b: Any, l0: Any) -> tuple[Torus, np.ndarray]:
         (as integer vectors); the frequencies are the coordinates of ``U``.
         Where ``U'`` is the theta quotients' least-squares fit next to a
         pinched curve, the Abel images of integrated states vouch for it to
-        1e-8 (relative), for ``U`` to 5e-11; where its flow is beyond their
-        budget, the integrality of the lattice basis (to 1e-7) stands in.
+        1e-8 (relative), for ``U`` to 5e-11 (or give the velocity they move at,
+        to the same bounds); where its flow is beyond their budget, the
+        integrality of the lattice basis (to 1e-7) stands in.
 
     Raises
     ------

@@ -174,7 +174,8 @@ class Solution:
     which use none of the quotients' constants (only ``U``, ``U'`` and the
     curve), are those of :func:`manakov.frequency_map`: the level set's closed
     form where the map takes it unchecked, else given only where the Abel images
-    of integrated states vouch for ``U`` and ``U'`` (:attr:`torus`).
+    of integrated states vouch for ``U`` and ``U'``, or lie on a line whose slope
+    is the velocity (:attr:`torus`).
 
     **Frames.** The solution is built on normalized data: ``l0' = l0/s``,
     ``a' = (a − κ)/σ``, ``c' = (c − μ)/λ`` (:attr:`state_scale`,
@@ -560,11 +561,15 @@ class Solution:
             integrated states do not vouch for ``U`` to 5e-11 and ``U'`` to 1e-8
             either (at three of thirteen times one to four periods out, at two
             integration steps; where ``U'`` cannot be checked, the lattice basis
-            it fixes must be integral to 1e-7; docs/degenerate.md §10). The
+            it fixes must be integral to 1e-7; docs/degenerate.md §10), nor lie
+            on a line to those bounds (at seven of the thirteen times at least,
+            whose slope, the velocity the images move at, the frequencies then
+            rest on; :attr:`U`, which :meth:`l` uses, stays as it is). The
             message names the step.
         """
         # Even a solution that failed its self-check has the frequency map's torus
-        # (the level set's closed form, or U and U' the Abel images vouch for).
+        # (the level set's closed form, or U and U' the Abel images vouch for or
+        # move at).
         self._genus2("torus")
         if self._torus is None:
             lam, coords, nu, _ = self._motion.torus()

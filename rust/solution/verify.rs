@@ -553,6 +553,14 @@ const ABEL_FIT_SPAN: f64 = 2.0;
 /// through those images is then held to the caller's bound).
 const ABEL_FIT_CONSENSUS: f64 = 1e-8;
 
+/// Where a velocity fitted to the images is bounded only to between the
+/// caller's bound and this (relative), it is fitted again over phases
+/// [`ABEL_LONG_SPAN`] times as long ([`long_fit`]).
+const ABEL_LONG_FROM: f64 = 1e-7;
+
+/// The factor by which [`long_fit`] stretches [`ABEL_PHASES`].
+const ABEL_LONG_SPAN: f64 = 32.0;
+
 /// Largest relative correction a fitted velocity may make to the given one:
 /// the images are unwrapped modulo the lattice against the given velocity,
 /// which needs its drift over the last of [`ABEL_PHASES`] well below half a
@@ -655,25 +663,7 @@ pub fn abel_rate(
     let Ok(u0) = sol.abel(l0) else {
         return Ok(unchecked);
     };
-    let images_of = |y: &[f64]| -> Images {
-        let mut images = Vec::with_capacity(times.len());
-        for (k, l) in y.chunks_exact(6).enumerate() {
-            let l: [f64; 6] = l.try_into().expect("rows of 6");
-            let Ok(w) = sol.abel(&l) else {
-                continue;
-            };
-            let d = [
-                w[0] - u0[0] - u[0] * times[k],
-                w[1] - u0[1] - u[1] * times[k],
-            ];
-            let (dx, dy) = curve.lattice_coordinates(&d);
-            let r = [dx[0], dx[1], dy[0], dy[1]].map(|v| v - v.round());
-            if r.iter().all(|v| v.is_finite()) {
-                images.push((ABEL_PHASES[k], r));
-            }
-        }
-        images
-    };
+    let images_of = |y: &[f64]| images(sol, &u0, u, &times, &ABEL_PHASES, y);
     // each run's ABEL_AGREEING-th smallest defect (None: too few Abel images)
     let defect_of = |images: &Images| -> Option<f64> {
         let mut defects: Vec<f64> = images
@@ -739,20 +729,105 @@ pub fn abel_rate(
         }
         runs.push(images);
     }
-    let fit = if worst_dd > rtol {
-        fitted_rate(&runs, rtol)
+    if !(worst_dd > rtol) {
+        return Ok(AbelRate {
+            defect: worst_dd,
+            fit: None,
+        });
+    }
+    let w0 = [x[0], x[1], y[0], y[1]];
+    let fit_to = |bound: f64| {
+        fitted_rate(&runs, bound)
             .filter(|(slope, _)| nan_max(slope.iter().map(|v| v.abs())) <= ABEL_FIT_MAX_SLOPE)
-            .map(|(slope, bound)| {
-                let w0 = [x[0], x[1], y[0], y[1]];
+            .map(|(slope, bound)| -> ([f64; 4], f64) {
                 (std::array::from_fn(|q| w0[q] + slope[q] * rate), bound)
             })
-    } else {
-        None
     };
+    let mut fit = fit_to(rtol);
+    // Images that scatter about a line bound its slope only to their scatter
+    // over the phases' span: a span ABEL_LONG_SPAN times longer, unwrapped
+    // against the short fit, bounds it that many times more tightly.
+    if fit.is_none() {
+        if let Some((w, _)) = fit_to(ABEL_LONG_FROM) {
+            fit = long_fit(sol, &c, &w, dt, rtol, cancel)?;
+        }
+    }
     Ok(AbelRate {
         defect: worst_dd,
         fit,
     })
+}
+
+/// The images of the states `y` (rows of 6, at `times`, the phases
+/// `phases`) that the Abel map takes: their offsets from `u0 + u t` in
+/// lattice coordinates, reduced to the nearest lattice vector.
+fn images(
+    sol: &super::Solution,
+    u0: &[num_complex::Complex64],
+    u: &[num_complex::Complex64; 2],
+    times: &[f64],
+    phases: &[f64],
+    y: &[f64],
+) -> Images {
+    let curve = sol.curve();
+    let mut images = Vec::with_capacity(times.len());
+    for (k, l) in y.chunks_exact(6).enumerate() {
+        let l: [f64; 6] = l.try_into().expect("rows of 6");
+        let Ok(w) = sol.abel(&l) else {
+            continue;
+        };
+        let d = [
+            w[0] - u0[0] - u[0] * times[k],
+            w[1] - u0[1] - u[1] * times[k],
+        ];
+        let (dx, dy) = curve.lattice_coordinates(&d);
+        let r = [dx[0], dx[1], dy[0], dy[1]].map(|v| v - v.round());
+        if r.iter().all(|v| v.is_finite()) {
+            images.push((phases[k], r));
+        }
+    }
+    images
+}
+
+/// The velocity fitted to the images of double-double runs over
+/// [`ABEL_LONG_SPAN`] times the phases of [`ABEL_PHASES`], against the
+/// velocity `w` (lattice coordinates) fitted over the short ones; None where
+/// the runs exceed [`ABEL_CHECK_MAX_DD_STEPS`] or give no line within
+/// `rtol` (`c`: the coefficients in double-double; `dt`: the step).
+fn long_fit(
+    sol: &super::Solution,
+    c: &[Dd; 6],
+    w: &[f64; 4],
+    dt: f64,
+    rtol: f64,
+    cancel: &Cancel,
+) -> Result<Option<([f64; 4], f64)>> {
+    let t = sol.tau();
+    let u = [
+        t[0] * w[2] + t[1] * w[3] + w[0],
+        t[2] * w[2] + t[3] * w[3] + w[1],
+    ];
+    let rate = nan_max(w.iter().map(|v| v.abs()));
+    let phases = ABEL_PHASES.map(|f| f * ABEL_LONG_SPAN);
+    let times = phases.map(|f| f / rate);
+    if !(3.0 * gauss16_dd_steps(&times, dt, 1) <= ABEL_CHECK_MAX_DD_STEPS) {
+        return Ok(None);
+    }
+    let Ok(u0) = sol.abel(&sol.l0) else {
+        return Ok(None);
+    };
+    let mut runs: Vec<Images> = Vec::with_capacity(2);
+    for split in [1, 2] {
+        let y = match gauss16_dd_so4(c, &sol.l0, &times, dt, split, cancel) {
+            Ok(y) => y,
+            Err(Error::NoConvergence { .. }) => return Ok(None),
+            Err(e) => return Err(e),
+        };
+        runs.push(images(sol, &u0, &u, &times, &phases, &y));
+    }
+    // the slope per long phase, in the short fit's lattice units per period
+    Ok(fitted_rate(&runs, rtol)
+        .map(|(slope, bound)| (std::array::from_fn(|q| w[q] + slope[q] * rate), bound)))
 }
 
 /// The slope (lattice coordinates per period of phase, so the relative
