@@ -729,7 +729,8 @@ pub fn abel_rate(
         }
         runs.push(images);
     }
-    if !(worst_dd > rtol) {
+    // (worst_dd is finite: every run gave its defect)
+    if worst_dd <= rtol {
         return Ok(AbelRate {
             defect: worst_dd,
             fit: None,
@@ -810,7 +811,8 @@ fn long_fit(
     let rate = nan_max(w.iter().map(|v| v.abs()));
     let phases = ABEL_PHASES.map(|f| f * ABEL_LONG_SPAN);
     let times = phases.map(|f| f / rate);
-    if !(3.0 * gauss16_dd_steps(&times, dt, 1) <= ABEL_CHECK_MAX_DD_STEPS) {
+    let steps = 3.0 * gauss16_dd_steps(&times, dt, 1);
+    if steps.is_nan() || steps > ABEL_CHECK_MAX_DD_STEPS {
         return Ok(None);
     }
     let Ok(u0) = sol.abel(&sol.l0) else {
