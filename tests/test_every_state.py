@@ -1011,6 +1011,16 @@ def frequencies_given(a, b, l0, passed: bool = True):
     return top, sol
 
 
+def frequencies_vouched(a, b, l0, bound: float, passed: bool = True):
+    """:func:`frequencies_given`, with ``U`` (as the frequencies give it) within
+    ``bound`` of the slope of the Abel images of a quadruple-precision trajectory over
+    20 periods."""
+    top, sol = frequencies_given(a, b, l0, passed=passed)
+    err = abel_fit_error(top, sol, l0, quad=True)
+    assert err is not None and err <= bound
+    return sol
+
+
 def frequencies_refused(a, b, l0, match: str):
     """The solution (passed its self-check) of a state whose frequencies both
     ``sol.frequencies`` (ClosedFormError matching ``match``) and the map (status
@@ -1191,10 +1201,7 @@ def test_the_second_flow_needs_only_to_fix_the_real_plane() -> None:
     """Frequencies given (map and solution alike) with U within WEAK_DIRECTION_BOUND of
     the slope of the Abel images of a quadruple-precision trajectory (the long-double
     one takes too few); the earlier check, holding U' to 1e-10, refused them."""
-    a, b, l0 = SECOND_FLOW_FIT_STATE
-    top, sol = frequencies_given(a, b, l0)
-    err = abel_fit_error(top, sol, l0, quad=True)
-    assert err is not None and err <= WEAK_DIRECTION_BOUND
+    frequencies_vouched(*SECOND_FLOW_FIT_STATE, WEAK_DIRECTION_BOUND)
 
 
 #: Draws 2798 and 9027 of the same harsh draw (branch points spread over 1e31 and 2e24):
@@ -1304,10 +1311,7 @@ UNCHECKED_SECOND_FLOW_STATE = (
 
 
 def test_the_lattice_basis_decides_where_the_second_flow_cannot_be_checked() -> None:
-    a, b, l0 = UNCHECKED_SECOND_FLOW_STATE
-    top, sol = frequencies_given(a, b, l0)
-    err = abel_fit_error(top, sol, l0, quad=True)
-    assert err is not None and err <= ABEL_FIT_BOUND
+    frequencies_vouched(*UNCHECKED_SECOND_FLOW_STATE, ABEL_FIT_BOUND)
 
 
 #: Draw 1724 of the same harsh draw (branch points spread over 1e14 and more): its
@@ -1331,11 +1335,8 @@ FITTED_VELOCITY_STATE = (
 
 
 def test_the_frequencies_rest_on_the_velocity_the_abel_images_move_at() -> None:
-    a, b, l0 = FITTED_VELOCITY_STATE
-    top, sol = frequencies_given(a, b, l0)
+    sol = frequencies_vouched(*FITTED_VELOCITY_STATE, ABEL_FIT_BOUND)
     assert sol.velocity_check > SHAPE_CHECK_BOUND
-    err = abel_fit_error(top, sol, l0, quad=True)
-    assert err is not None and err <= ABEL_FIT_BOUND
 
 
 #: Draw 3872 of the same harsh draw (U the theta quotients' fit next to a pinched
@@ -1359,10 +1360,7 @@ SCATTERED_IMAGES_STATE = (
 
 
 def test_images_that_scatter_give_the_velocity_over_a_longer_span() -> None:
-    a, b, l0 = SCATTERED_IMAGES_STATE
-    top, sol = frequencies_given(a, b, l0)
-    err = abel_fit_error(top, sol, l0, quad=True)
-    assert err is not None and err <= ABEL_FIT_BOUND
+    frequencies_vouched(*SCATTERED_IMAGES_STATE, ABEL_FIT_BOUND)
 
 
 #: Draw 6914 of the same harsh draw: a lattice rate slow against the stiffness of the
@@ -1384,11 +1382,8 @@ SLOW_RATE_STATE = (
 
 
 def test_a_slow_lattice_rate_on_a_stiff_top_is_checked() -> None:
-    a, b, l0 = SLOW_RATE_STATE
-    top, sol = frequencies_given(a, b, l0)
+    sol = frequencies_vouched(*SLOW_RATE_STATE, WEAK_DIRECTION_BOUND)
     assert sol.velocity_check > SHAPE_CHECK_BOUND
-    err = abel_fit_error(top, sol, l0, quad=True)
-    assert err is not None and err <= WEAK_DIRECTION_BOUND
 
 
 #: Draw 7055 of the same harsh draw (branch points spread over 1e9): its solution passed
@@ -1412,11 +1407,8 @@ LEVEL_SET_STATE = (
 
 
 def test_the_solution_takes_the_maps_closed_form_where_the_map_does() -> None:
-    a, b, l0 = LEVEL_SET_STATE
-    top, sol = frequencies_given(a, b, l0)
+    sol = frequencies_vouched(*LEVEL_SET_STATE, WEAK_DIRECTION_BOUND)
     assert sol.velocity_check > SHAPE_CHECK_BOUND
-    err = abel_fit_error(top, sol, l0, quad=True)
-    assert err is not None and err <= WEAK_DIRECTION_BOUND
 
 
 #: Draw 2569 of the same harsh draw (branch points spread over 5e19): the theta
@@ -1462,10 +1454,7 @@ NO_CLOSED_FORM_SECOND_FLOW_STATE = (
 
 
 def test_the_abel_map_decides_where_the_second_flow_has_neither_fit_nor_closed_form() -> None:
-    a, b, l0 = NO_CLOSED_FORM_SECOND_FLOW_STATE
-    top, sol = frequencies_given(a, b, l0)
-    err = abel_fit_error(top, sol, l0, quad=True)
-    assert err is not None and err <= ABEL_FIT_BOUND
+    frequencies_vouched(*NO_CLOSED_FORM_SECOND_FLOW_STATE, ABEL_FIT_BOUND)
 
 
 #: States of the harsh draw (seed 5) whose branch points spread over 1e18 and
@@ -1623,9 +1612,7 @@ def test_a_closed_form_failing_its_self_check_gives_only_certified_l(k: int) -> 
         ):
             getattr(sol, what)
     if k in (0, 1):
-        top, sol = frequencies_given(a, b, l0, passed=False)
-        err = abel_fit_error(top, sol, l0, quad=True)
-        assert err is not None and err <= ABEL_FIT_BOUND
+        frequencies_vouched(a, b, l0, ABEL_FIT_BOUND, passed=False)
     t = np.linspace(0.0, float(t_end), 51)
     # the second state's long-double trajectory is itself off by 4e-3 |l0| (its
     # components span seven orders of magnitude); quadruple precision decides
