@@ -541,7 +541,7 @@ pub const ABEL_CHECK_MAX_DD_STEPS: f64 = 1e6;
 /// offset and a slope in four lattice coordinates) fitted, seven images give
 /// 28 numbers for it to explain, where a velocity given beforehand needs
 /// [`ABEL_AGREEING`].
-pub const ABEL_FIT_AGREEING: usize = 7;
+const ABEL_FIT_AGREEING: usize = 7;
 
 /// Least span, in periods of the fastest lattice coordinate, of the phases
 /// of the images a fitted velocity rests on: its error is the images' scatter
@@ -590,7 +590,7 @@ pub struct AbelRate {
 /// lattice vector.
 type Images = Vec<(f64, [f64; 4])>;
 
-/// [`abel_rate`]'s defect of `u` alone.
+/// [`abel_rate`]'s defect of `u` alone (no bound given, so no fit).
 pub fn abel_rate_defect(
     sol: &super::Solution,
     c4: &[f64; 6],
@@ -598,7 +598,7 @@ pub fn abel_rate_defect(
     u: &[num_complex::Complex64; 2],
     cancel: &Cancel,
 ) -> Result<f64> {
-    Ok(abel_rate(sol, c4, c4_lo, u, 0.0, cancel)?.defect)
+    Ok(abel_rate(sol, c4, c4_lo, u, f64::INFINITY, cancel)?.defect)
 }
 
 /// The velocity `u` of the flow (1) with coefficients `c4` (state order;
@@ -925,8 +925,9 @@ mod tests {
     use super::*;
 
     /// Images at every phase of [`ABEL_PHASES`] on the line `a + s p`, with a
-    /// scatter of up to `noise` (a fixed pseudo-random pattern) and the images at `outliers`
-    /// moved off it by `1e-3 (k² + 1)` (on no common line).
+    /// scatter of up to `noise` (a fixed pseudo-random pattern) and the
+    /// images at `outliers` moved off it by `1e-3 (k² + 1)` (on no common
+    /// line).
     fn images(a: [f64; 4], s: [f64; 4], noise: f64, outliers: &[usize]) -> Images {
         ABEL_PHASES
             .iter()
@@ -950,7 +951,7 @@ mod tests {
     #[test]
     fn the_fitted_line_is_the_slope_of_the_images_despite_outliers() {
         let (a, s) = ([1e-9, -2e-9, 0.0, 3e-9], [3e-7, -1e-8, 2e-9, 0.0]);
-        // four of thirteen images off by 1e-3, the rest scattered by 1e-14
+        // four of thirteen images off by 1e-3 and more, the rest scattered by 1e-14
         let run = images(a, s, 1e-14, &[0, 3, 7, 12]);
         let (slope, bound) = fitted_line(&run, 5e-11).expect("nine images on a line");
         let err = nan_max((0..4).map(|q| (slope[q] - s[q]).abs()));

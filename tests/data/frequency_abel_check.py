@@ -37,7 +37,7 @@ the span: the fit is repeated in quadruple precision over 100 periods (1001 samp
 and that figure counts.
 
 Run: ``python tests/data/frequency_abel_check.py [N]`` (N draws, default 10000;
-about three minutes). Output committed as ``tests/data/frequency_abel_check.txt``.
+about fifteen minutes on two cores). Output committed as ``tests/data/frequency_abel_check.txt``.
 """
 
 from __future__ import annotations
