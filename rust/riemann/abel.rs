@@ -660,6 +660,14 @@ impl HyperellipticCurve {
         (alpha, beta)
     }
 
+    /// `z = α + τ β` of real lattice coordinates `(α, β)` (the inverse of
+    /// [`Self::lattice_coordinates`]).
+    pub fn lattice_point(&self, alpha: &[f64], beta: &[f64]) -> Vec<C> {
+        (0..self.g)
+            .map(|i| (0..self.g).fold(C::new(alpha[i], 0.0), |z, j| z + self.tau[(i, j)] * beta[j]))
+            .collect()
+    }
+
     /// `z` reduced modulo `Z^g + τ Z^g` to `α + τβ` with `α, β ∈ [−1/2, 1/2]`.
     pub fn reduce(&self, z: &[C]) -> Vec<C> {
         let g = self.g;

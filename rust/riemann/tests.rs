@@ -465,3 +465,20 @@ fn curves_beyond_the_double_range_of_r_are_built_at_scale() {
     let d = (hs.tau() - h.tau()).norm() / h.tau().norm();
     assert!(d < 1e-13, "{d:e}");
 }
+
+#[test]
+fn lattice_point_inverts_lattice_coordinates() {
+    let mut rng = Rng(91);
+    for n in [5usize, 6] {
+        let e: Vec<C> = (0..n).map(|_| rng.c(2.0)).collect();
+        let h = HyperellipticCurve::new(&e).unwrap();
+        for _ in 0..20 {
+            let z = [rng.c(3.0), rng.c(3.0)];
+            let (alpha, beta) = h.lattice_coordinates(&z);
+            let back = h.lattice_point(&alpha, &beta);
+            for i in 0..2 {
+                assert!((back[i] - z[i]).norm() < 1e-13 * 3.0, "{z:?} -> {back:?}");
+            }
+        }
+    }
+}

@@ -750,7 +750,7 @@ pub fn abel_rate(
     // against the short fit, bounds it that many times more tightly.
     if fit.is_none() {
         if let Some((w, _)) = fit_to(ABEL_LONG_FROM) {
-            fit = long_fit(sol, &c, &w, dt, rtol, cancel)?;
+            fit = long_fit(sol, (&c, dt), &u0, &w, rtol, cancel)?;
         }
     }
     Ok(AbelRate {
@@ -794,20 +794,18 @@ fn images(
 /// [`ABEL_LONG_SPAN`] times the phases of [`ABEL_PHASES`], against the
 /// velocity `w` (lattice coordinates) fitted over the short ones; None where
 /// the runs exceed [`ABEL_CHECK_MAX_DD_STEPS`] or give no line within
-/// `rtol` (`c`: the coefficients in double-double; `dt`: the step).
+/// `rtol` (`c`: the coefficients in double-double, `dt` the step; `u0` the
+/// image of `l0`).
 fn long_fit(
     sol: &super::Solution,
-    c: &[Dd; 6],
+    (c, dt): (&[Dd; 6], f64),
+    u0: &[num_complex::Complex64],
     w: &[f64; 4],
-    dt: f64,
     rtol: f64,
     cancel: &Cancel,
 ) -> Result<Option<([f64; 4], f64)>> {
-    let t = sol.tau();
-    let u = [
-        t[0] * w[2] + t[1] * w[3] + w[0],
-        t[2] * w[2] + t[3] * w[3] + w[1],
-    ];
+    let u = sol.curve().lattice_point(&w[..2], &w[2..]);
+    let u = [u[0], u[1]];
     let rate = nan_max(w.iter().map(|v| v.abs()));
     let phases = ABEL_PHASES.map(|f| f * ABEL_LONG_SPAN);
     let times = phases.map(|f| f / rate);
@@ -815,9 +813,6 @@ fn long_fit(
     if steps.is_nan() || steps > ABEL_CHECK_MAX_DD_STEPS {
         return Ok(None);
     }
-    let Ok(u0) = sol.abel(&sol.l0) else {
-        return Ok(None);
-    };
     let mut runs: Vec<Images> = Vec::with_capacity(2);
     for split in [1, 2] {
         let y = match gauss16_dd_so4(c, &sol.l0, &times, dt, split, cancel) {
@@ -825,7 +820,7 @@ fn long_fit(
             Err(Error::NoConvergence { .. }) => return Ok(None),
             Err(e) => return Err(e),
         };
-        runs.push(images(sol, &u0, &u, &times, &phases, &y));
+        runs.push(images(sol, u0, &u, &times, &phases, &y));
     }
     // the slope per long phase, in the short fit's lattice units per period
     Ok(fitted_rate(&runs, rtol)

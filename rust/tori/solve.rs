@@ -309,13 +309,10 @@ fn abel_check(
     u_closed: bool,
     cancel: &Cancel,
 ) -> Result<Checked> {
-    let tau = sol.tau();
     // `U = X + τY` of lattice coordinates `(X1, X2, Y1, Y2)`
     let velocity = |w: &[f64; 4]| -> [C; 2] {
-        [
-            tau[0] * w[2] + tau[1] * w[3] + w[0],
-            tau[2] * w[2] + tau[3] * w[3] + w[1],
-        ]
+        let u = sol.curve().lattice_point(&w[..2], &w[2..]);
+        [u[0], u[1]]
     };
     // the given velocity where the images hold it to `rtol`, else the one
     // fitted to them where that holds to `rtol`
