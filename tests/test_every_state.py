@@ -1627,3 +1627,47 @@ def test_a_closed_form_failing_its_self_check_gives_only_certified_l(k: int) -> 
     assert np.array_equal(lt[0], l0)
     err = float(np.max(np.abs(np.asarray(lt, dtype=np.longdouble) - ref)))
     assert err / float(np.linalg.norm(l0)) <= HARSH_BOUND
+
+
+#: Draw 8316 of the same harsh draw: 2.2e-4 (relative) from the so(3) block (1, 3, 4)
+#: of a stiff top (``l34`` large, ``l12`` next), where the level set's route and the
+#: solution's torus refuse (a pinched curve). The frequencies interpolate in the squared
+#: distance between the block's Euler orbit and states 1e-3 ... 8e-3 from it
+#: (docs/degenerate.md §11). The slope of the Abel images of a quadruple-precision
+#: trajectory (heyoka, ``real128``) over 100 periods, matched to integer combinations of
+#: the frequencies, gives NEAR_BLOCK_REFERENCE (``tests/data/frequency_abel_check.py``
+#: makes the same comparison over the whole draw).
+NEAR_BLOCK_STATE = (
+    [-0.6110918554618494, 28.096121468103778, 28.295441156394567, 28.306037409524382],
+    [-0.4655328431848831, 43.06934905449684, 43.23986953528779, 43.23237578830688],
+    [
+        5.032681551105081,
+        -4.711240043085908e-06,
+        -0.00014190944736832905,
+        -0.000211271346175163,
+        -5.320603182556908e-06,
+        22415.64352492835,
+    ],
+)
+NEAR_BLOCK_REFERENCE = (7915.547952020019, 5432.563682473131)
+
+
+def test_next_to_a_block_the_frequencies_interpolate_from_the_euler_orbit() -> None:
+    a, b, l0 = (np.asarray(v) for v in NEAR_BLOCK_STATE)
+    top = manakov.ManakovTop(a, b)
+    sol = top.solve(l0)
+    with pytest.raises(manakov.ClosedFormError):
+        _ = sol.torus
+    nu = sol.frequencies
+    fm = manakov.frequency_map(top, l0[None, :])
+    assert manakov.tori.STATUS_NAMES[int(fm.status[0])] == "ok"
+    assert np.array_equal(fm.nu[0], nu)
+    ref = np.asarray(NEAR_BLOCK_REFERENCE)
+    assert np.max(np.abs(nu - ref) / ref) <= ABEL_FIT_BOUND
+    # the block's own Euler frequencies (nu_perp, nu_E) miss the reference: the
+    # interpolation's correction is needed
+    lb = l0.copy()
+    lb[[0, 3, 4]] = 0.0
+    euler = top.solve(lb)
+    assert euler.kind == "euler"
+    assert abs(euler.frequencies[1] - ref[1]) / ref[1] > ABEL_FIT_BOUND

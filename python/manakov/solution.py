@@ -594,6 +594,14 @@ class Solution:
         """``(ν1, ν2) ≥ 0`` in cycles per unit time.
 
         * ``"genus2"``: ``U T = ν1 λ1 + ν2 λ2`` on the reduced basis of :attr:`torus`.
+          Where the torus is refused for a state within 1e-2 (relative) of an
+          so(3) block whose Euler orbit is transversally elliptic: the
+          interpolation in the squared distance between that orbit's
+          ``(ν_⊥, ν_E)`` and the tori of four states farther out (1e-3 … 8e-3
+          from the block, or at least four times the state's distance), in the
+          reduced basis of the nearest of them, given only where its bound is at
+          most 1e-11 (docs/degenerate.md §11); :func:`manakov.frequency_map`
+          gives the same numbers. Otherwise the torus's ``ClosedFormError``.
         * ``"euler"``: the orbit is closed (a 1-torus); ``ν2 = ν_E = ω/(4K)``, its
           frequency, and ``ν1 = ν_⊥ ∈ [0, ν_E/2]``, the rotation number of the
           linearized motion off the invariant so(3) along the orbit (the angle
@@ -606,7 +614,16 @@ class Solution:
         * ``"rest"``, ``"spherical"``, ``"equilibrium"``: ``(0, 0)``.
         """
         if self._core is not None:
-            return self.torus.frequencies
+            try:
+                return self.torus.frequencies
+            except _core.ClosedFormError as refused:
+                if self._freq is None:
+                    try:
+                        nu = self._motion.near_block_frequencies()
+                    except _core.ClosedFormError:
+                        raise refused from None  # the torus's refusal names the cause
+                    self._freq = _frozen(np.array(nu))
+                return self._freq
         if self._freq is None:
             # An Euler motion integrates its transverse monodromy once (0.1-10 ms).
             self._freq = _frozen(np.array(self._motion.closed_form_frequencies()))

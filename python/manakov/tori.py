@@ -289,7 +289,12 @@ def frequency_map(
     neighbouring tori's frequencies up to ``ν1 → |ν_⊥ + k ν_E|``); an equilibrium
     of (1) or any state of a spherical top gets :data:`EQUILIBRIUM`, an Euler
     top's separatrix :data:`SEPARATRIX`; genus-2 states are computed on the
-    normalized data, their frequencies in the user's time.
+    normalized data, their frequencies in the user's time. Where the genus-2
+    route refuses a state within 1e-2 (relative) of an so(3) block whose Euler
+    orbit is transversally elliptic (a pinched curve), the frequencies are
+    interpolated in the squared distance between that orbit's ``(ν_⊥, ν_E)``
+    and the tori of four states farther out, and given (``ok``) only where the
+    interpolation's bound is at most 1e-11 (docs/degenerate.md §11).
 
     Parameters
     ----------

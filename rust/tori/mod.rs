@@ -31,6 +31,7 @@
 //! not depend on the number of threads or on how the batch is split.
 
 pub mod motion;
+pub mod near_block;
 pub mod solve;
 #[cfg(test)]
 mod tests;

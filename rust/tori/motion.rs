@@ -15,6 +15,7 @@
 
 use num_complex::Complex64 as C;
 
+use super::near_block::near_block_frequencies;
 use super::solve::{classify as classify_error, flow_data_with, level_set_entry_with};
 use super::{real_torus_with_rates, MapEntry, RealTorus, Status};
 use crate::error::{Error, Result};
@@ -33,6 +34,45 @@ pub fn state_frequencies_in(frame: &TopFrame, l0: &[f64; 6]) -> MapEntry {
 /// (up to ~0.1 s) monodromy of an Euler state; when it fires the entry is a
 /// failure and the caller's next check stops the map.
 pub fn state_frequencies_in_with(frame: &TopFrame, l0: &[f64; 6], cancel: &Cancel) -> MapEntry {
+    let entry = state_frequencies_plain(frame, l0, cancel);
+    if entry.status == Status::Ok || !near_block_may_answer(entry.status) {
+        return entry;
+    }
+    // Next to an so(3) block the level set's route refuses on pinched curves;
+    // the frequencies there are the interpolation between the block's Euler
+    // motion and states farther out (docs/degenerate.md §11).
+    match near_block_frequencies(frame, l0, cancel) {
+        Ok(nu) => MapEntry {
+            status: Status::Ok,
+            nu,
+        },
+        Err(_) => entry,
+    }
+}
+
+/// Whether a genus-2 state refused with this status may be answered by
+/// [`near_block_frequencies`]: a refusal of the level set's route, not a
+/// class of the state (equilibria, separatrices, singular Casimirs, non-finite
+/// or zero states keep their status).
+fn near_block_may_answer(status: Status) -> bool {
+    !matches!(
+        status,
+        Status::Ok
+            | Status::SingularCasimirs
+            | Status::ZeroState
+            | Status::NonFinite
+            | Status::Equilibrium
+            | Status::Separatrix
+    )
+}
+
+/// [`state_frequencies_in_with`] without the interpolation next to so(3)
+/// blocks: the classification's route alone (the interpolation's own nodes).
+pub(crate) fn state_frequencies_plain(
+    frame: &TopFrame,
+    l0: &[f64; 6],
+    cancel: &Cancel,
+) -> MapEntry {
     if l0.iter().any(|v| !v.is_finite()) {
         return MapEntry::failed(Status::NonFinite);
     }

@@ -1141,3 +1141,59 @@ fn the_frequencies_rest_on_the_velocity_the_abel_images_move_at() {
     assert_eq!(e.status, Status::Ok);
     assert_eq!(t.nu.map(f64::to_bits), e.nu.map(f64::to_bits));
 }
+
+/// Harsh draw 8316 (`tests/data/every_state_harsh.py`): 2.2e-4 (relative)
+/// from the so(3) block (1, 3, 4) of a stiff top (`l34` large, `l12` next), where the level set's route
+/// refuses; the interpolation next to the block answers, and the slope of the
+/// Abel images of a quadruple-precision trajectory over 100 periods
+/// (heyoka, `real128`) gives (7915.547952020019, 5432.563682473131), which the
+/// answer meets to 3.5e-13. The block's Euler value alone is 7.2e-10 off.
+#[test]
+fn next_to_a_block_the_frequencies_interpolate_from_the_euler_orbit() {
+    use crate::solution::normalize::TopFrame;
+    use crate::tori::motion::{state_frequencies_in, state_frequencies_plain};
+    use crate::tori::near_block::NEAR_BLOCK_RTOL;
+    let a = [
+        -0.6110918554618494,
+        28.096121468103778,
+        28.295441156394567,
+        28.306037409524382,
+    ];
+    let b = [
+        -0.4655328431848831,
+        43.06934905449684,
+        43.23986953528779,
+        43.23237578830688,
+    ];
+    let l0 = [
+        5.032681551105081,
+        -4.711240043085908e-06,
+        -0.00014190944736832905,
+        -0.000211271346175163,
+        -5.320603182556908e-06,
+        22415.64352492835,
+    ];
+    let frame = TopFrame::new(&a, &b).unwrap();
+    let cancel = Cancel::never();
+    assert_ne!(
+        state_frequencies_plain(&frame, &l0, &cancel).status,
+        Status::Ok,
+        "the level set's route answers: the interpolation is not tested"
+    );
+    let e = state_frequencies_in(&frame, &l0);
+    assert_eq!(e.status, Status::Ok);
+    let reference = [7915.547952020019, 5432.563682473131];
+    let err = (0..2)
+        .map(|i| (e.nu[i] - reference[i]).abs() / reference[i])
+        .fold(0.0f64, f64::max);
+    assert!(err <= 10.0 * NEAR_BLOCK_RTOL, "{:?}: {err:e}", e.nu);
+    // the block's own Euler frequencies miss by far more (the correction is real)
+    let mut lb = l0;
+    for q in [0, 3, 4] {
+        lb[q] = 0.0;
+    }
+    let euler = state_frequencies_plain(&frame, &lb, &cancel);
+    assert_eq!(euler.status, Status::Ok);
+    let miss = (euler.nu[1] - reference[1]).abs() / reference[1];
+    assert!(miss > 1e-10, "{miss:e}");
+}

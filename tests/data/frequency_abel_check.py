@@ -36,6 +36,12 @@ images, the images' own scatter may be what is left, which enters the slope divi
 the span: the fit is repeated in quadruple precision over 100 periods (1001 samples),
 and that figure counts.
 
+A fourth group: states whose torus is refused (a pinched curve next to an so(3) block)
+and whose frequencies are interpolated between the block's Euler orbit and states farther
+out (docs/degenerate.md §11). With no torus there is no ``U`` of the frequencies; instead
+each lattice coordinate of the images' slope must be a half-integer combination of the
+frequencies (``near_block_error``), with the same escalation to quadruple precision.
+
 Run: ``python tests/data/frequency_abel_check.py [N]`` (N draws, default 10000;
 about fifteen minutes on two cores). Output committed as ``tests/data/frequency_abel_check.txt``.
 """
@@ -128,6 +134,64 @@ def fitted_error(top, sol, l0, fp=LD, periods: float = PERIODS):
     return float(np.max(np.abs(coef[1])) / rate), len(keep)
 
 
+def near_block_error(top, sol, l0, fp=LD, periods: float = PERIODS):
+    """For a state whose torus is refused and whose frequencies are interpolated next
+    to an so(3) block: each lattice coordinate of the velocity (the slope of the Abel
+    images, per unit of the user's time) must be a combination ``(p ν1 + q ν2)/2`` with
+    integers ``|p|, |q| <= 8``; the largest miss relative to the largest coordinate,
+    and the samples used (None if too few, or no ``U`` to unwrap the images with). The
+    images are unwrapped along ``sol.U`` (off by up to ~1e-9 here, which the fitted
+    slope absorbs); the line is fitted robustly (images farther than
+    ``max(ABEL_MISS, 3 x median)`` from the last fit set aside, six rounds)."""
+    try:
+        u = np.asarray(sol.U)
+    except manakov.ClosedFormError:
+        return None, 0
+    nu = np.asarray(sol.frequencies)
+    x, y = lattice(sol.tau, u)
+    rate = max(np.max(np.abs(x)), np.max(np.abs(y)))
+    samples = int(SAMPLES_PER_PERIOD * periods) + 1
+    t_user = np.linspace(0.0, periods / rate / sol.time_scale, samples)
+    ref = np.asarray(propagate(top.a, top.b, l0, t_user, fp), dtype=float)
+    u0 = sol.abel(np.asarray(l0, dtype=float))
+    times, offsets = [], []
+    for t, l in zip(t_user * sol.time_scale, ref):
+        try:
+            w = sol.abel(l)
+        except (ValueError, manakov.ClosedFormError):
+            continue
+        dx, dy = lattice(sol.tau, w - u0 - u * t)
+        times.append(t)
+        offsets.append(np.concatenate([dx - np.round(dx), dy - np.round(dy)]))
+    if not times:
+        return None, 0
+    tt, off = np.array(times), np.array(offsets)
+    design = np.vstack([np.ones_like(tt), tt]).T
+    keep = np.ones(len(tt), bool)
+    for _ in range(6):
+        coef, *_ = np.linalg.lstsq(design[keep], off[keep], rcond=None)
+        miss = np.max(np.abs(off - design @ coef), axis=1)
+        keep = miss < max(ABEL_MISS, 3.0 * float(np.median(miss)))
+    if np.sum(keep) < MIN_FRACTION * (samples - 1):
+        return None, int(np.sum(keep))
+    coef, *_ = np.linalg.lstsq(design[keep], off[keep], rcond=None)
+    slope = (np.concatenate([x, y]) + coef[1]) * sol.time_scale
+    k = np.arange(-8, 9)
+    combos = (k[:, None] * nu[0] + k[None, :] * nu[1]).ravel() / 2.0
+    worst = max(float(np.min(np.abs(c - combos))) for c in slope)
+    return worst / float(np.max(np.abs(slope))), int(np.sum(keep))
+
+
+def torus_refused(sol) -> bool:
+    """Whether ``sol.torus`` refuses (the frequencies then come from the interpolation
+    next to an so(3) block)."""
+    try:
+        _ = sol.torus
+    except manakov.ClosedFormError:
+        return True
+    return False
+
+
 def main(n: int = 10_000) -> None:
     rng = np.random.default_rng(SEED)
     t0 = time.time()
@@ -135,7 +199,7 @@ def main(n: int = 10_000) -> None:
         f"machine: {platform.machine()} {os.cpu_count()} cpus; manakov {manakov.__version__}; "
         f"harsh draw, seed {SEED}, {n} states"
     )
-    errs, errs_spread, errs_failed, skipped, checked = [], [], [], 0, 0
+    errs, errs_spread, errs_failed, errs_near, skipped, checked = [], [], [], [], 0, 0
     for i in range(n):
         a, b, l0 = draw(rng)
         top = manakov.ManakovTop(a, b)
@@ -145,24 +209,29 @@ def main(n: int = 10_000) -> None:
         sol = top.solve(l0)
         if sol.kind != "genus2":
             continue
+        near = torus_refused(sol)
         failed = not sol.self_check_passed
-        if not failed and sol.velocity_check <= 1e-10 and spread(sol) <= 1e14:
+        if not near and not failed and sol.velocity_check <= 1e-10 and spread(sol) <= 1e14:
             continue
         checked += 1
         mark = " (self-check failed)" if failed else ""
-        e, used = fitted_error(top, sol, l0)
+        fit = fitted_error
+        if near:
+            mark += " (torus refused: interpolated next to a block)"
+            fit = near_block_error
+        e, used = fit(top, sol, l0)
         e_ld, quad = e, ""
         if e is None or e > 1e-10:
             # the long-double trajectory may be the one that is off (too far off for
             # its images to fit, or off by more than the bound): quadruple precision
-            eq, used_q = fitted_error(top, sol, l0, hy.real128)
+            eq, used_q = fit(top, sol, l0, hy.real128)
             if eq is None:
                 quad = f"; in quadruple precision only {used_q} Abel images"
             else:
                 quad = f"; in quadruple precision {eq:.1e} ({used_q} samples)"
                 e = eq
         if e is None or e > LONG_FROM:
-            el, used_l = fitted_error(top, sol, l0, hy.real128, LONG_PERIODS)
+            el, used_l = fit(top, sol, l0, hy.real128, LONG_PERIODS)
             if el is None:
                 quad += f"; over {LONG_PERIODS:.0f} periods only {used_l} Abel images"
             else:
@@ -176,7 +245,9 @@ def main(n: int = 10_000) -> None:
             )
             continue
         ld = "too few images" if e_ld is None else f"{e_ld:.1e} ({used} samples)"
-        if failed:
+        if near:
+            errs_near.append(e)
+        elif failed:
             errs_failed.append(e)
         else:
             (errs if sol.velocity_check > 1e-10 else errs_spread).append(e)
@@ -188,7 +259,7 @@ def main(n: int = 10_000) -> None:
         )
     print(
         f"\n{checked} states ok with a velocity check above 1e-10, branch points spread over "
-        "more than 1e14, or a failed self-check;"
+        "more than 1e14, a failed self-check, or a refused torus;"
     )
     took = time.time() - t0
     print(f"{skipped} with too few Abel images to fit ({took:.0f} s)")
@@ -204,8 +275,17 @@ def main(n: int = 10_000) -> None:
             "level set's closed form, or vouched for by the Abel images)",
             errs_failed,
         ),
+        (
+            "torus refused, frequencies interpolated next to an so(3) block (each lattice "
+            "rate of the Abel images' slope against the nearest combination (p nu1 + "
+            "q nu2)/2, relative to the largest)",
+            errs_near,
+        ),
     ):
         e = np.array(v)
+        if len(e) == 0:
+            print(f"  {what}: none")
+            continue
         print(
             f"  {what}: fitted {len(e)}, U error median {np.median(e):.1e}, "
             f"max {np.max(e):.1e}, above 1e-10: {int(np.sum(e > 1e-10))}"

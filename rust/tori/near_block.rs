@@ -1,0 +1,341 @@
+//! Frequencies of states next to an so(3) block where the genus-2 route
+//! refuses (docs/degenerate.md §11).
+//!
+//! A state `l = l_b + l_⊥`, with `l_b` in the invariant subspace of a block
+//! (three components sharing no fourth index) and `l_⊥` the other three, at
+//! relative distance `δ = |l_⊥|/|l|`. Its curve is pinched by `δ`: the
+//! reduction and the Abel map lose digits like `1/δ`, and below `δ ~ 1e-4` on
+//! stiff tops the level set's route refuses. The frequencies are smooth there:
+//!
+//! * the reflection of the axis outside the block flips the sign of `l_⊥` and
+//!   is a symmetry of (1) (conjugation by a diagonal `±1` matrix preserves
+//!   `l̇ = [l, Ω]`, `Ω_ij = c_ij l_ij`), so along `l_b + σ l_⊥/δ` the
+//!   frequencies are even in `σ`: analytic in `x = σ²`;
+//! * at `σ = 0` they are the Euler motion's `(ν_⊥, ν_E)`
+//!   ([`crate::solution::transverse`]), where the orbit is transversally
+//!   elliptic (`ν_⊥ > 0`; next to a hyperbolic orbit no tori shrink onto it,
+//!   and the frequencies are not analytic in `x`).
+//!
+//! So the map interpolates in `x`: through the Euler value at `x = 0` and the
+//! genus-2 frequencies at three nodes `σ = 1e-3, 2e-3, 4e-3` (where the
+//! level set's route answers), each node's reduced basis matched to
+//! `(ν_⊥, ν_E)` by a unimodular integer matrix; a fourth node `σ = 8e-3`
+//! checks the cubic. The bound of the answer is that check scaled by the
+//! remainder's factor `|w(x)/w(x_4)|` (`w(x) = x Π (x − x_k)`) plus the
+//! nodes' own bound times their Lagrange weights at `x = δ²`; it must stay
+//! below [`NEAR_BLOCK_RTOL`]. Next to the block (`x ≪ x_k`) the answer is the
+//! Euler value plus a correction of relative size `~δ²/σ_1²`.
+
+use super::motion::state_frequencies_plain;
+use super::{MapEntry, Status};
+use crate::error::{Error, Result};
+use crate::numeric::cancel::Cancel;
+use crate::so4::PAIRS4;
+use crate::solution::euler::Embedding;
+use crate::solution::normalize::TopFrame;
+
+/// Largest relative distance `|l_⊥|/|l|` from a block at which the
+/// interpolation is tried.
+pub const NEAR_BLOCK_MAX: f64 = 1e-2;
+
+/// Relative distances `σ` of the node states from the block: the first three
+/// carry the cubic, the last checks it. Scaled up by `δ/`[`NODE_MARGIN`]
+/// where that is larger than 1, so that the first node is at least four times
+/// as far out as the state (`x ≤ x_1/16`): the answer is an interpolation
+/// next to the cubic's `x = 0` end, never an extrapolation.
+pub const NODES: [f64; 4] = [1e-3, 2e-3, 4e-3, 8e-3];
+
+/// The distance below which [`NODES`] are taken as they are.
+const NODE_MARGIN: f64 = 2.5e-4;
+
+/// Largest bound (relative, max norm) of interpolated frequencies that the
+/// map gives: a tenth of the bound the genus-2 frequencies are vouched for to.
+pub const NEAR_BLOCK_RTOL: f64 = 1e-11;
+
+/// The bound of a node's frequencies: those of the genus-2 route
+/// ([`super::solve::FREQUENCY_VELOCITY_RTOL`]).
+const NODE_RTOL: f64 = super::solve::FREQUENCY_VELOCITY_RTOL;
+
+/// A node's reduced basis is matched to `(ν_⊥, ν_E)` carried to the node
+/// (the polynomial through the block and the nodes before it) when its
+/// frequencies are within this of an integer combination (relative, max
+/// norm): the shift from the block at the first node (`~x_1 = 1e-6` times the
+/// frequencies' sensitivity to `x`) is below it (on the harsh draw up to
+/// 5.5e-5), the later nodes' misses of the prediction far below. Two
+/// combinations with entries up to [`MAX_ENTRY`] come this close only where
+/// `ν_⊥/ν_E` is this close to a fraction with a denominator up to
+/// `2 MAX_ENTRY`; the match must be unique (no other within ten times its
+/// residual), so such a state is refused, not matched wrongly.
+const MATCH_RTOL: f64 = 1e-4;
+
+/// Largest entry of the unimodular matrices tried: the reduced bases of tori
+/// next to the orbit are integer combinations of `(ν_⊥, ν_E)` (docs/degenerate.md
+/// §5), on the harsh draw up to `(−1, 10)` (a reduced basis in the metric of
+/// `Im τ`, not in the frequencies).
+const MAX_ENTRY: i32 = 32;
+
+/// Above this misprediction of the fourth node (relative) the nodes do not lie
+/// on one smooth curve through the Euler value (a basis matched wrongly, a
+/// resonance, a hyperbolic neighbourhood): no answer, whatever the bound.
+const CHECK_MAX: f64 = 1e-6;
+
+/// Relative 2-norm distance of `l` from the block `blk` and the positions
+/// outside it; scaled first, so no square overflows or underflows.
+fn block_distance(l: &[f64; 6], blk: [usize; 3]) -> (f64, [usize; 3]) {
+    let out = (0..4).find(|i| !blk.contains(i)).unwrap_or(3);
+    let mut perp = [0usize; 3];
+    let mut n = 0;
+    for (q, &(i, j)) in PAIRS4.iter().enumerate() {
+        if i == out || j == out {
+            perp[n] = q;
+            n += 1;
+        }
+    }
+    let s = l.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    if s == 0.0 || !s.is_finite() {
+        return (f64::NAN, perp);
+    }
+    let all: f64 = l.iter().map(|v| (v / s) * (v / s)).sum();
+    let off: f64 = perp.iter().map(|&q| (l[q] / s) * (l[q] / s)).sum();
+    ((off / all).sqrt(), perp)
+}
+
+/// The integer combination `(p, q)` with `f ≈ p ν_⊥ + q ν_E` (`|p|, |q| ≤`
+/// [`MAX_ENTRY`]) and its residual relative to `scale`, if it is within
+/// [`MATCH_RTOL`] and no other comes within ten times its residual.
+fn match_row(f: f64, nu0: &[f64; 2], scale: f64) -> Option<[i32; 2]> {
+    let mut best: Option<([i32; 2], f64)> = None;
+    let mut second = f64::INFINITY;
+    for q in -MAX_ENTRY..=MAX_ENTRY {
+        // the nearest p and its neighbours: the runner-up may be either
+        let p0 = ((f - f64::from(q) * nu0[1]) / nu0[0]).round();
+        for p in [p0 - 1.0, p0, p0 + 1.0] {
+            if p.abs() > f64::from(MAX_ENTRY) {
+                continue;
+            }
+            let res = (f - p * nu0[0] - f64::from(q) * nu0[1]).abs() / scale;
+            match best {
+                Some((_, rb)) if res >= rb => second = second.min(res),
+                _ => {
+                    if let Some((_, rb)) = best {
+                        second = second.min(rb);
+                    }
+                    // |p| ≤ MAX_ENTRY: the cast is exact
+                    best = Some(([p as i32, q], res));
+                }
+            }
+        }
+    }
+    let (m, rb) = best?;
+    (rb <= MATCH_RTOL && second > 10.0 * rb).then_some(m)
+}
+
+/// The unimodular matrix `M` with `f ≈ M ν0`: each row by [`match_row`], and
+/// `det M = ±1` (the node's reduced basis is a basis of the same lattice).
+fn match_basis(f: &[f64; 2], nu0: &[f64; 2]) -> Option<[[i32; 2]; 2]> {
+    let scale = f[0].abs().max(f[1].abs());
+    let m = [match_row(f[0], nu0, scale)?, match_row(f[1], nu0, scale)?];
+    ((m[0][0] * m[1][1] - m[0][1] * m[1][0]).abs() == 1).then_some(m)
+}
+
+/// `M⁻¹ f` for a unimodular `M`.
+fn unmatch(m: &[[i32; 2]; 2], f: &[f64; 2]) -> [f64; 2] {
+    let det = f64::from(m[0][0] * m[1][1] - m[0][1] * m[1][0]);
+    let (a, b, c, d) = (
+        f64::from(m[0][0]),
+        f64::from(m[0][1]),
+        f64::from(m[1][0]),
+        f64::from(m[1][1]),
+    );
+    [(d * f[0] - b * f[1]) / det, (a * f[1] - c * f[0]) / det]
+}
+
+/// Lagrange weights of the nodes `xs` at `x`.
+fn lagrange(xs: &[f64; 4], x: f64) -> [f64; 4] {
+    std::array::from_fn(|k| {
+        (0..4)
+            .filter(|&j| j != k)
+            .map(|j| (x - xs[j]) / (xs[k] - xs[j]))
+            .product()
+    })
+}
+
+/// The polynomial through `pts` (abscissa, value) at `x`.
+fn predict(pts: &[(f64, [f64; 2])], x: f64) -> [f64; 2] {
+    std::array::from_fn(|i| {
+        (0..pts.len())
+            .map(|k| {
+                let w: f64 = (0..pts.len())
+                    .filter(|&j| j != k)
+                    .map(|j| (x - pts[j].0) / (pts[k].0 - pts[j].0))
+                    .product();
+                w * pts[k].1[i]
+            })
+            .sum()
+    })
+}
+
+/// The refusal of the interpolation (the caller keeps the genus-2 route's
+/// status; the message serves `Solution.frequencies`).
+fn refusal(reason: String) -> Error {
+    Error::Unverified {
+        what: "frequencies next to an so(3) block",
+        reason,
+    }
+}
+
+/// `(ν1, ν2)` (user's time) of the state `l0` of the top `frame` by the
+/// interpolation of the module doc, in the reduced basis of the nearest node;
+/// an error where the state is not next to a transversally elliptic block
+/// orbit or the interpolation's bound exceeds [`NEAR_BLOCK_RTOL`].
+pub fn near_block_frequencies(
+    frame: &TopFrame,
+    l0: &[f64; 6],
+    cancel: &Cancel,
+) -> Result<[f64; 2]> {
+    let (delta, blk, perp) = Embedding::BLOCKS
+        .iter()
+        .map(|&b| {
+            let (d, p) = block_distance(l0, b);
+            (d, b, p)
+        })
+        .fold((f64::INFINITY, [0; 3], [0; 3]), |m, e| {
+            if e.0 < m.0 {
+                e
+            } else {
+                m
+            }
+        });
+    if !(delta > 0.0 && delta <= NEAR_BLOCK_MAX) {
+        return Err(refusal(format!(
+            "the state is at relative distance {delta:e} from the nearest so(3) block (the \
+             interpolation needs 0 < distance <= {NEAR_BLOCK_MAX:e})"
+        )));
+    }
+    let mut lb = *l0;
+    for &q in &perp {
+        lb[q] = 0.0;
+    }
+    let euler = state_frequencies_plain(frame, &lb, cancel);
+    let nu0 = euler.nu;
+    if euler.status != Status::Ok || !(nu0[0] > 0.0 && nu0[1] > 0.0) {
+        return Err(refusal(format!(
+            "the Euler motion of the block ({}) is not transversally elliptic: frequencies \
+             {nu0:?} (status '{}')",
+            Embedding::Block(blk).name(),
+            euler.status.name()
+        )));
+    }
+    let nodes = NODES.map(|s| s * (delta / NODE_MARGIN).max(1.0));
+    let xs: [f64; 4] = nodes.map(|s| s * s);
+    let mut g = [[0.0; 2]; 4];
+    let mut first = [[0; 2]; 2];
+    for (k, &sigma) in nodes.iter().enumerate() {
+        cancel.check()?;
+        let mut node = lb;
+        for &q in &perp {
+            node[q] = l0[q] * (sigma / delta);
+        }
+        let MapEntry { status, nu } = state_frequencies_plain(frame, &node, cancel);
+        if status != Status::Ok {
+            return Err(refusal(format!(
+                "the node at distance {sigma:e} from the block has status '{}'",
+                status.name()
+            )));
+        }
+        // Matched against the polynomial through the block and the nodes
+        // before it, at this node: the shift from the block grows like x, the
+        // prediction's miss far less.
+        let known: Vec<(f64, [f64; 2])> = std::iter::once((0.0, nu0))
+            .chain((0..k).map(|j| (xs[j], g[j])))
+            .collect();
+        let pred = predict(&known, xs[k]);
+        let m = match_basis(&nu, &pred).ok_or_else(|| {
+            refusal(format!(
+                "the node at distance {sigma:e} has frequencies {nu:?}, no unique integer \
+                 combination of {pred:?} (the block's {nu0:?} carried to the node)"
+            ))
+        })?;
+        if k == 0 {
+            first = m;
+        }
+        g[k] = unmatch(&m, &nu);
+    }
+    // The cubic through (0, ν0) and the first three nodes, at the fourth node
+    // and at x = δ².
+    let pts = [0.0, xs[0], xs[1], xs[2]];
+    let vals = [nu0, g[0], g[1], g[2]];
+    let at = |x: f64| -> [f64; 2] {
+        let w = lagrange(&pts, x);
+        std::array::from_fn(|i| (0..4).map(|k| w[k] * vals[k][i]).sum())
+    };
+    let p4 = at(xs[3]);
+    let check = (0..2)
+        .map(|i| (p4[i] - g[3][i]).abs() / g[3][i].abs())
+        .fold(0.0f64, f64::max);
+    let x = delta * delta;
+    let w = |y: f64| y * (y - xs[0]) * (y - xs[1]) * (y - xs[2]);
+    let weights = lagrange(&pts, x);
+    let bound = check * (w(x) / w(xs[3])).abs()
+        + NODE_RTOL * weights[1..].iter().map(|v| v.abs()).sum::<f64>();
+    if !(check <= CHECK_MAX && bound <= NEAR_BLOCK_RTOL) {
+        return Err(refusal(format!(
+            "the nodes' frequencies miss the cubic through the block's by {check:e} at the \
+             last node, which bounds the interpolation at this state by {bound:e} (> \
+             {NEAR_BLOCK_RTOL:e}, or a miss above {CHECK_MAX:e})"
+        )));
+    }
+    let p = at(x);
+    let nu = [
+        f64::from(first[0][0]) * p[0] + f64::from(first[0][1]) * p[1],
+        f64::from(first[1][0]) * p[0] + f64::from(first[1][1]) * p[1],
+    ];
+    if !nu.iter().all(|v| v.is_finite() && *v >= 0.0) {
+        return Err(refusal(format!("interpolated frequencies {nu:?}")));
+    }
+    Ok(nu)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_basis_match_finds_the_unimodular_matrix_and_only_it() {
+        let r2 = std::f64::consts::SQRT_2;
+        let nu0 = [0.3, r2];
+        let f = [r2 * (1.0 + 1e-9), 0.3 + r2];
+        let m = match_basis(&f, &nu0).expect("a match");
+        assert_eq!(m, [[0, 1], [1, 1]]);
+        let g = unmatch(&m, &f);
+        assert!((g[0] - 0.3).abs() < 1e-8 && (g[1] - r2).abs() < 1e-8);
+        // between combinations: no match
+        assert!(match_basis(&[0.3 + 0.5 * r2, 5.0], &nu0).is_none());
+        // two combinations alike (ν_⊥/ν_E rational, 3/17): no match
+        assert!(match_basis(&[1.7, 2.0], &[0.3, 1.7]).is_none());
+        // a reduced basis far from (ν_⊥, ν_E) (harsh draw 8207: (−1, 10))
+        let nu0 = [17882464.901168905, 46947661.87792917];
+        let f = [451594124.4372472, 46947641.98835879];
+        assert_eq!(match_basis(&f, &nu0), Some([[-1, 10], [0, 1]]));
+        // not unimodular: no match
+        assert!(match_basis(&[0.6, r2], &[0.3, r2]).is_none());
+    }
+
+    #[test]
+    fn the_distance_from_a_block_is_scaled_and_names_the_components_outside() {
+        // block (0, 1, 2): l12, l13, l23 inside; l14, l24, l34 outside
+        let l = [1e200, 1e200, 3e193, 1e200, 4e193, 0.0];
+        let (d, perp) = block_distance(&l, [0, 1, 2]);
+        assert_eq!(perp, [2, 4, 5]);
+        assert!((d / (5e-7 / 3f64.sqrt()) - 1.0).abs() < 1e-12, "{d}");
+    }
+
+    #[test]
+    fn the_weights_reproduce_a_cubic() {
+        let xs = [0.0, 1.0, 4.0, 9.0];
+        let f = |x: f64| 2.0 - x + 0.5 * x * x - 0.1 * x * x * x;
+        let w = lagrange(&xs, 2.5);
+        let p: f64 = (0..4).map(|k| w[k] * f(xs[k])).sum();
+        assert!((p - f(2.5)).abs() < 1e-12);
+    }
+}
