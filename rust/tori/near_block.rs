@@ -150,29 +150,22 @@ fn unmatch(m: &[[i32; 2]; 2], f: &[f64; 2]) -> [f64; 2] {
     [(d * f[0] - b * f[1]) / det, (a * f[1] - c * f[0]) / det]
 }
 
-/// Lagrange weights of the nodes `xs` at `x`.
-fn lagrange(xs: &[f64; 4], x: f64) -> [f64; 4] {
-    std::array::from_fn(|k| {
-        (0..4)
-            .filter(|&j| j != k)
-            .map(|j| (x - xs[j]) / (xs[k] - xs[j]))
-            .product()
-    })
+/// Lagrange weights of the abscissae `xs` at `x`.
+fn lagrange(xs: &[f64], x: f64) -> Vec<f64> {
+    (0..xs.len())
+        .map(|k| {
+            (0..xs.len())
+                .filter(|&j| j != k)
+                .map(|j| (x - xs[j]) / (xs[k] - xs[j]))
+                .product()
+        })
+        .collect()
 }
 
-/// The polynomial through `pts` (abscissa, value) at `x`.
-fn predict(pts: &[(f64, [f64; 2])], x: f64) -> [f64; 2] {
-    std::array::from_fn(|i| {
-        (0..pts.len())
-            .map(|k| {
-                let w: f64 = (0..pts.len())
-                    .filter(|&j| j != k)
-                    .map(|j| (x - pts[j].0) / (pts[k].0 - pts[j].0))
-                    .product();
-                w * pts[k].1[i]
-            })
-            .sum()
-    })
+/// The polynomial through the values `vals` at the abscissae `xs`, at `x`.
+fn predict(xs: &[f64], vals: &[[f64; 2]], x: f64) -> [f64; 2] {
+    let w = lagrange(xs, x);
+    std::array::from_fn(|i| w.iter().zip(vals).map(|(w, v)| w * v[i]).sum())
 }
 
 /// The refusal of the interpolation (the caller keeps the genus-2 route's
@@ -246,10 +239,11 @@ pub fn near_block_frequencies(
         // Matched against the polynomial through the block and the nodes
         // before it, at this node: the shift from the block grows like x, the
         // prediction's miss far less.
-        let known: Vec<(f64, [f64; 2])> = std::iter::once((0.0, nu0))
-            .chain((0..k).map(|j| (xs[j], g[j])))
+        let pts: Vec<f64> = std::iter::once(0.0)
+            .chain(xs[..k].iter().copied())
             .collect();
-        let pred = predict(&known, xs[k]);
+        let vals: Vec<[f64; 2]> = std::iter::once(nu0).chain(g[..k].iter().copied()).collect();
+        let pred = predict(&pts, &vals, xs[k]);
         let m = match_basis(&nu, &pred).ok_or_else(|| {
             refusal(format!(
                 "the node at distance {sigma:e} has frequencies {nu:?}, no unique integer \
@@ -265,11 +259,7 @@ pub fn near_block_frequencies(
     // and at x = δ².
     let pts = [0.0, xs[0], xs[1], xs[2]];
     let vals = [nu0, g[0], g[1], g[2]];
-    let at = |x: f64| -> [f64; 2] {
-        let w = lagrange(&pts, x);
-        std::array::from_fn(|i| (0..4).map(|k| w[k] * vals[k][i]).sum())
-    };
-    let p4 = at(xs[3]);
+    let p4 = predict(&pts, &vals, xs[3]);
     let check = (0..2)
         .map(|i| (p4[i] - g[3][i]).abs() / g[3][i].abs())
         .fold(0.0f64, f64::max);
@@ -285,7 +275,7 @@ pub fn near_block_frequencies(
              {NEAR_BLOCK_RTOL:e}, or a miss above {CHECK_MAX:e})"
         )));
     }
-    let p = at(x);
+    let p = predict(&pts, &vals, x);
     let nu = [
         f64::from(first[0][0]) * p[0] + f64::from(first[0][1]) * p[1],
         f64::from(first[1][0]) * p[0] + f64::from(first[1][1]) * p[1],
@@ -334,8 +324,8 @@ mod tests {
     fn the_weights_reproduce_a_cubic() {
         let xs = [0.0, 1.0, 4.0, 9.0];
         let f = |x: f64| 2.0 - x + 0.5 * x * x - 0.1 * x * x * x;
-        let w = lagrange(&xs, 2.5);
-        let p: f64 = (0..4).map(|k| w[k] * f(xs[k])).sum();
-        assert!((p - f(2.5)).abs() < 1e-12);
+        let vals = xs.map(|x| [f(x), -f(x)]);
+        let p = predict(&xs, &vals, 2.5);
+        assert!((p[0] - f(2.5)).abs() < 1e-12 && (p[1] + f(2.5)).abs() < 1e-12);
     }
 }
