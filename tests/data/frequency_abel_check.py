@@ -97,12 +97,12 @@ def torus_rate(sol):
     return (nu[0] * lam[0] + nu[1] * lam[1]) / sol.time_scale
 
 
-def fitted_error(top, sol, l0, fp=LD, periods: float = PERIODS):
-    """max|U - U_fit| / (largest lattice rate), ``U`` of :func:`torus_rate`, and the
-    samples used (None if too few); the trajectory by heyoka in ``fp`` (long double, or
-    ``heyoka.real128``). The images are taken relative to that of ``l0``, and a sample
-    is set aside where its image is off the others' median by ``ABEL_MISS``."""
-    u = torus_rate(sol)
+def abel_offsets(top, sol, l0, u, fp, periods):
+    """The Abel images of a trajectory of ``l0`` by heyoka in ``fp`` over ``periods``
+    of the fastest lattice coordinate of ``u`` (``SAMPLES_PER_PERIOD`` samples each),
+    as offsets from ``u0 + u t`` in lattice coordinates reduced modulo 1: ``(x, y)``
+    of ``u``, the largest lattice rate, the number of samples, and the normalized
+    times and offsets of the images the Abel map gives."""
     x, y = lattice(sol.tau, u)
     rate = max(np.max(np.abs(x)), np.max(np.abs(y)))
     samples = int(SAMPLES_PER_PERIOD * periods) + 1
@@ -118,14 +118,23 @@ def fitted_error(top, sol, l0, fp=LD, periods: float = PERIODS):
         dx, dy = lattice(sol.tau, w - u0 - u * t)
         times.append(t)
         offsets.append(np.concatenate([dx - np.round(dx), dy - np.round(dy)]))
-    if not times:
+    return (x, y), rate, samples, np.array(times), np.array(offsets)
+
+
+def fitted_error(top, sol, l0, fp=LD, periods: float = PERIODS):
+    """max|U - U_fit| / (largest lattice rate), ``U`` of :func:`torus_rate`, and the
+    samples used (None if too few); the trajectory by heyoka in ``fp`` (long double, or
+    ``heyoka.real128``). The images are taken relative to that of ``l0``, and a sample
+    is set aside where its image is off the others' median by ``ABEL_MISS``."""
+    u = torus_rate(sol)
+    _, rate, samples, times, offsets = abel_offsets(top, sol, l0, u, fp, periods)
+    if len(times) == 0:
         return None, 0
     # Images are set aside by their distance from the median offset, not from that of
     # l0: an image of l0 off by a constant shifts the whole line, not its slope.
-    offsets = np.array(offsets)
     centre = np.median(offsets, axis=0)
     near = np.max(np.abs(offsets - centre), axis=1) < ABEL_MISS
-    keep, miss = list(np.array(times)[near]), list(offsets[near])
+    keep, miss = list(times[near]), list(offsets[near])
     if len(keep) < MIN_FRACTION * (samples - 1):
         return None, len(keep)
     tt = np.array(keep)
@@ -148,24 +157,9 @@ def near_block_error(top, sol, l0, fp=LD, periods: float = PERIODS):
     except manakov.ClosedFormError:
         return None, 0
     nu = np.asarray(sol.frequencies)
-    x, y = lattice(sol.tau, u)
-    rate = max(np.max(np.abs(x)), np.max(np.abs(y)))
-    samples = int(SAMPLES_PER_PERIOD * periods) + 1
-    t_user = np.linspace(0.0, periods / rate / sol.time_scale, samples)
-    ref = np.asarray(propagate(top.a, top.b, l0, t_user, fp), dtype=float)
-    u0 = sol.abel(np.asarray(l0, dtype=float))
-    times, offsets = [], []
-    for t, l in zip(t_user * sol.time_scale, ref):
-        try:
-            w = sol.abel(l)
-        except (ValueError, manakov.ClosedFormError):
-            continue
-        dx, dy = lattice(sol.tau, w - u0 - u * t)
-        times.append(t)
-        offsets.append(np.concatenate([dx - np.round(dx), dy - np.round(dy)]))
-    if not times:
+    (x, y), _, samples, tt, off = abel_offsets(top, sol, l0, u, fp, periods)
+    if len(tt) == 0:
         return None, 0
-    tt, off = np.array(times), np.array(offsets)
     design = np.vstack([np.ones_like(tt), tt]).T
     keep = np.ones(len(tt), bool)
     for _ in range(6):
