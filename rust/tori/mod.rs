@@ -26,6 +26,10 @@
 //! the homology basis; `‖λ1‖ ≤ ‖λ2‖`, `|⟨λ1, λ2⟩| ≤ ‖λ1‖²/2`; the signs of
 //! `λ1`, `λ2` are chosen so that `ν1 ≥ 0`, `ν2 ≥ 0`.
 //!
+//! Next to an so(3) block, where the pinched curve defeats the genus-2
+//! route, [`near_block`] interpolates the frequencies between the block's
+//! Euler orbit and the tori of states farther out.
+//!
 //! [`map_states`] runs a per-state function over a batch in parallel (rayon),
 //! in waves between which the caller's [`Cancel`] is checked; the results do
 //! not depend on the number of threads or on how the batch is split.
