@@ -39,7 +39,7 @@ use crate::solution::normalize::TopFrame;
 pub const NEAR_BLOCK_MAX: f64 = 1e-2;
 
 /// Relative distances `σ` of the node states from the block: the first three
-/// carry the cubic, the last checks it. Scaled up by `δ/`[`NODE_MARGIN`]
+/// carry the cubic, the last checks it. Scaled up by `δ/NODE_MARGIN` (2.5e-4)
 /// where that is larger than 1, so that the first node is at least four times
 /// as far out as the state (`x ≤ x_1/16`): the answer is an interpolation
 /// next to the cubic's `x = 0` end, never an extrapolation.
