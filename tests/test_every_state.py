@@ -1671,3 +1671,72 @@ def test_next_to_a_block_the_frequencies_interpolate_from_the_euler_orbit() -> N
     euler = top.solve(lb)
     assert euler.kind == "euler"
     assert abs(euler.frequencies[1] - ref[1]) / ref[1] > ABEL_FIT_BOUND
+
+
+#: Distances from the self-dual states of the sweep below; exactly 0 is the Euler top.
+SELF_DUAL_DISTANCES = [1e-1, 1e-2, 1e-3, 1e-4, 1e-5, 1e-6, 1e-8, 1e-10, 1e-12, 1e-14, 1e-16, 0.0]
+#: Where the genus-2 torus and the interpolation from the self-dual Euler orbit both
+#: answer (two independent routes), they agree to this (relative); measured at most
+#: 1.1e-14 on the four tops.
+SELF_DUAL_AGREEMENT = 1e-12
+
+
+def self_dual_line(top_name: str, sign: int, seed: int = 11):
+    """The top and a function from the distance to the state ``n = sign m + d |m| e``
+    (``e`` a random unit vector)."""
+    rng = np.random.default_rng(seed)
+    p = manakov.problem(top_name)
+    top = manakov.ManakovTop(p.a, p.b)
+    m, e = rng.normal(size=3), rng.normal(size=3)
+    e /= np.linalg.norm(e)
+
+    def state(d: float) -> np.ndarray:
+        n = sign * m + d * np.linalg.norm(m) * e
+        return np.array([m[2], -m[1], n[0], m[0], n[1], n[2]])
+
+    return top, state
+
+
+@pytest.mark.parametrize("sign", [1, -1])
+@pytest.mark.parametrize("top_name", ["generic", "physical", "wide", "near_degenerate"])
+def test_next_to_the_self_dual_states_the_frequency_map_has_no_hole(top_name, sign) -> None:
+    """Within ~1e-6 of a self-dual state ``h1² = 4 h0²`` to rounding: the level set's
+    route is not defined there, and the map reported that status. The frequencies are
+    the interpolation from the Euler orbit (docs/degenerate.md §11), continuous up to
+    it, and ``sol.frequencies`` gives the same numbers."""
+    top, state = self_dual_line(top_name, sign)
+    states = np.array([state(d) for d in SELF_DUAL_DISTANCES])
+    fm = manakov.frequency_map(top, states)
+    names = [manakov.tori.STATUS_NAMES[int(s)] for s in fm.status]
+    assert names == ["ok"] * len(SELF_DUAL_DISTANCES)
+    euler = fm.nu[-1]
+    for d, l0, nu in zip(SELF_DUAL_DISTANCES[:-1], states, fm.nu):
+        sol = top.solve(l0)
+        assert np.array_equal(sol.frequencies, nu)
+        if d <= 1e-8:
+            # linear in the distance, up to the change of basis (an integer
+            # combination of the Euler orbit's nu_perp, nu_E: docs/degenerate.md §5)
+            k = np.arange(-8, 9)
+            combos = (k[:, None] * euler[0] + k[None, :] * euler[1]).ravel()
+            miss = max(float(np.min(np.abs(v - combos))) / v for v in nu)
+            assert miss <= 1e3 * d
+
+
+def test_next_to_the_self_dual_states_the_interpolation_meets_the_torus() -> None:
+    """At 2e-5 from a self-dual state both routes answer: the genus-2 torus of the state
+    and the interpolation between the Euler orbit and the tori of states 8e-5 ... 6.4e-4
+    out."""
+    met = 0
+    for top_name in ["generic", "physical", "wide", "near_degenerate"]:
+        for sign in (1, -1):
+            top, state = self_dual_line(top_name, sign)
+            sol = top.solve(state(2e-5))
+            assert sol.kind == "genus2"
+            try:
+                nu = np.asarray(sol._motion.near_euler_frequencies())
+            except manakov.ClosedFormError:
+                continue
+            torus = sol.torus.frequencies
+            assert np.max(np.abs(nu - torus) / torus) <= SELF_DUAL_AGREEMENT
+            met += 1
+    assert met >= 6

@@ -600,8 +600,13 @@ class Solution:
           ``(ν_⊥, ν_E)`` and the tori of four states farther out (1e-3 … 8e-3
           from the block, or at least four times the state's distance), in the
           reduced basis of the nearest of them, given only where its bound is at
-          most 1e-11 (docs/degenerate.md §11); :func:`manakov.frequency_map`
+          most 5e-11 (docs/degenerate.md §11); :func:`manakov.frequency_map`
           gives the same numbers. Otherwise the torus's ``ClosedFormError``.
+        * ``"integrated"`` (``l(t)`` by a confirmed integration): within 1e-3 of
+          the self-dual states (``h1² = 4 h0²`` to rounding) or 1e-2 of an so(3)
+          block, the same interpolation (in the distance itself next to the
+          self-dual states, from nodes 1e-5 … 8e-5 out); otherwise
+          ``ClosedFormError``.
         * ``"euler"``: the orbit is closed (a 1-torus); ``ν2 = ν_E = ω/(4K)``, its
           frequency, and ``ν1 = ν_⊥ ∈ [0, ν_E/2]``, the rotation number of the
           linearized motion off the invariant so(3) along the orbit (the angle
@@ -613,20 +618,30 @@ class Solution:
         * ``"separatrix"``: ``(0, 0)``: no period (the limit of both).
         * ``"rest"``, ``"spherical"``, ``"equilibrium"``: ``(0, 0)``.
         """
+        if self._freq is not None:
+            return self._freq
         if self._core is not None:
             try:
                 return self.torus.frequencies
             except _core.ClosedFormError as refused:
-                if self._freq is None:
-                    try:
-                        nu = self._motion.near_block_frequencies()
-                    except _core.ClosedFormError:
-                        raise refused from None  # the torus's refusal names the cause
-                    self._freq = _frozen(np.array(nu))
-                return self._freq
-        if self._freq is None:
+                return self._near_euler(refused)
+        try:
             # An Euler motion integrates its transverse monodromy once (0.1-10 ms).
             self._freq = _frozen(np.array(self._motion.closed_form_frequencies()))
+        except _core.ClosedFormError as refused:
+            if self.kind != "integrated":
+                raise
+            return self._near_euler(refused)
+        return self._freq
+
+    def _near_euler(self, refused: Exception) -> np.ndarray:
+        """The frequencies interpolated next to an Euler subspace, kept; else the
+        original refusal, which names its cause."""
+        try:
+            nu = self._motion.near_euler_frequencies()
+        except _core.ClosedFormError:
+            raise refused from None
+        self._freq = _frozen(np.array(nu))
         return self._freq
 
     @property

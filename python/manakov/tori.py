@@ -291,10 +291,12 @@ def frequency_map(
     top's separatrix :data:`SEPARATRIX`; genus-2 states are computed on the
     normalized data, their frequencies in the user's time. Where the genus-2
     route refuses a state within 1e-2 (relative) of an so(3) block whose Euler
-    orbit is transversally elliptic (a pinched curve), the frequencies are
-    interpolated in the squared distance between that orbit's ``(ν_⊥, ν_E)``
-    and the tori of four states farther out, and given (``ok``) only where the
-    interpolation's bound is at most 1e-11 (docs/degenerate.md §11).
+    orbit is transversally elliptic (a pinched curve), or within 1e-3 of a
+    self-dual state (``h1² = 4 h0²`` to rounding), the frequencies are
+    interpolated between that orbit's ``(ν_⊥, ν_E)`` and the tori of four states
+    farther out (in the squared distance next to a block, in the distance next
+    to the self-dual states), and given (``ok``) only where the interpolation's
+    bound is at most 5e-11 (docs/degenerate.md §11).
 
     Parameters
     ----------

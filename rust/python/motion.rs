@@ -14,7 +14,7 @@ use crate::solution::jacobi::Jacobi;
 use crate::solution::motion::{Kind, Motion};
 use crate::solution::transverse::euler_frequencies_with;
 use crate::tori::motion::torus_of_motion;
-use crate::tori::near_block::near_block_frequencies;
+use crate::tori::near_euler::near_euler_frequencies;
 
 type C = Complex64;
 
@@ -112,14 +112,15 @@ impl MotionCore {
         })
     }
 
-    /// `(ν1, ν2)` (user's time) of a genus-2 state next to an so(3) block
-    /// whose torus is refused: the interpolation between the block's Euler
-    /// motion and states farther out (`crate::tori::near_block`), the numbers
+    /// `(ν1, ν2)` (user's time) of a state next to an so(3) block or the
+    /// self-dual states whose frequencies are otherwise refused: the
+    /// interpolation between the Euler motion of the nearest state of that
+    /// subspace and states farther out (`crate::tori::near_euler`), the numbers
     /// the frequency map gives. Raises where it does not apply or its bound
     /// fails.
-    fn near_block_frequencies(&self, py: Python<'_>) -> PyResult<[f64; 2]> {
+    fn near_euler_frequencies(&self, py: Python<'_>) -> PyResult<[f64; 2]> {
         let cancel = py_cancel();
-        Ok(py.detach(|| near_block_frequencies(self.motion.frame(), self.motion.l0(), &cancel))?)
+        Ok(py.detach(|| near_euler_frequencies(self.motion.frame(), self.motion.l0(), &cancel))?)
     }
 
     /// `(ν1, ν2)` of the closed forms (user's time): `(ν_⊥, ν_E)` of

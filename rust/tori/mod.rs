@@ -27,15 +27,16 @@
 //! `λ1`, `λ2` are chosen so that `ν1 ≥ 0`, `ν2 ≥ 0`.
 //!
 //! Next to an so(3) block, where the pinched curve defeats the genus-2
-//! route, [`near_block`] interpolates the frequencies between the block's
-//! Euler orbit and the tori of states farther out.
+//! route, and next to the self-dual states, where `F` (19) is not defined,
+//! [`near_euler`] interpolates the frequencies between the Euler orbit and
+//! the tori of states farther out.
 //!
 //! [`map_states`] runs a per-state function over a batch in parallel (rayon),
 //! in waves between which the caller's [`Cancel`] is checked; the results do
 //! not depend on the number of threads or on how the batch is split.
 
 pub mod motion;
-pub mod near_block;
+pub mod near_euler;
 pub mod solve;
 #[cfg(test)]
 mod tests;
@@ -576,7 +577,9 @@ macro_rules! status_table {
 status_table! {
     /// Frequencies computed.
     Ok = 0, "ok";
-    /// `h1² = 4 h0²`: `F(s)` of (19) is undefined (the level set is singular).
+    /// `h1² = 4 h0²`: `F(s)` of (19) is undefined (the level set is singular),
+    /// and the interpolation next to the self-dual states
+    /// ([`near_euler`]) does not hold either.
     SingularCasimirs = 1, "h1^2 = 4 h0^2";
     /// Two branch points `d_j` of (8) coincide (a repeated root of `F` (19) and
     /// a root of `F` at an `a_j` included): the genus drops, a separatrix or a

@@ -15,7 +15,7 @@
 
 use num_complex::Complex64 as C;
 
-use super::near_block::near_block_frequencies;
+use super::near_euler::near_euler_frequencies;
 use super::solve::{classify as classify_error, flow_data_with, level_set_entry_with};
 use super::{real_torus_with_rates, MapEntry, RealTorus, Status};
 use crate::error::{Error, Result};
@@ -35,13 +35,15 @@ pub fn state_frequencies_in(frame: &TopFrame, l0: &[f64; 6]) -> MapEntry {
 /// failure and the caller's next check stops the map.
 pub fn state_frequencies_in_with(frame: &TopFrame, l0: &[f64; 6], cancel: &Cancel) -> MapEntry {
     let entry = state_frequencies_plain(frame, l0, cancel);
-    if entry.status == Status::Ok || !near_block_may_answer(entry.status) {
+    if entry.status == Status::Ok || !near_euler_may_answer(entry.status) {
         return entry;
     }
-    // Next to an so(3) block the level set's route refuses on pinched curves;
-    // the frequencies there are the interpolation between the block's Euler
-    // motion and states farther out (docs/degenerate.md §11).
-    match near_block_frequencies(frame, l0, cancel) {
+    // Next to an so(3) block the level set's route refuses on pinched curves,
+    // next to the self-dual states where h1² = 4h0² to rounding; the
+    // frequencies there are the interpolation between the Euler motion of the
+    // nearest state of that subspace and states farther out
+    // (docs/degenerate.md §11).
+    match near_euler_frequencies(frame, l0, cancel) {
         Ok(nu) => MapEntry {
             status: Status::Ok,
             nu,
@@ -51,14 +53,14 @@ pub fn state_frequencies_in_with(frame: &TopFrame, l0: &[f64; 6], cancel: &Cance
 }
 
 /// Whether a genus-2 state refused with this status may be answered by
-/// [`near_block_frequencies`]: a refusal of the level set's route, not a
-/// class of the state (equilibria, separatrices, singular Casimirs, non-finite
-/// or zero states keep their status).
-fn near_block_may_answer(status: Status) -> bool {
+/// [`near_euler_frequencies`]: a refusal of the level set's route (singular
+/// Casimirs included: a state next to, not on, the self-dual states), not a
+/// class of the state (equilibria, separatrices, non-finite or zero states
+/// keep their status).
+fn near_euler_may_answer(status: Status) -> bool {
     !matches!(
         status,
         Status::Ok
-            | Status::SingularCasimirs
             | Status::ZeroState
             | Status::NonFinite
             | Status::Equilibrium
@@ -66,8 +68,8 @@ fn near_block_may_answer(status: Status) -> bool {
     )
 }
 
-/// [`state_frequencies_in_with`] without the interpolation next to so(3)
-/// blocks: the classification's route alone (the interpolation's own nodes).
+/// [`state_frequencies_in_with`] without the interpolation next to Euler
+/// subspaces: the classification's route alone (the interpolation's own nodes).
 pub(crate) fn state_frequencies_plain(
     frame: &TopFrame,
     l0: &[f64; 6],

@@ -1152,7 +1152,7 @@ fn the_frequencies_rest_on_the_velocity_the_abel_images_move_at() {
 fn next_to_a_block_the_frequencies_interpolate_from_the_euler_orbit() {
     use crate::solution::normalize::TopFrame;
     use crate::tori::motion::{state_frequencies_in, state_frequencies_plain};
-    use crate::tori::near_block::NEAR_BLOCK_RTOL;
+    use crate::tori::near_euler::NEAR_EULER_RTOL;
     let a = [
         -0.6110918554618494,
         28.096121468103778,
@@ -1186,7 +1186,7 @@ fn next_to_a_block_the_frequencies_interpolate_from_the_euler_orbit() {
     let err = (0..2)
         .map(|i| (e.nu[i] - reference[i]).abs() / reference[i])
         .fold(0.0f64, f64::max);
-    assert!(err <= 10.0 * NEAR_BLOCK_RTOL, "{:?}: {err:e}", e.nu);
+    assert!(err <= 2.0 * NEAR_EULER_RTOL, "{:?}: {err:e}", e.nu);
     // the block's own Euler frequencies miss by far more (the correction is real)
     let mut lb = l0;
     for q in [0, 3, 4] {

@@ -1,30 +1,35 @@
-//! Frequencies of states next to an so(3) block where the genus-2 route
-//! refuses (docs/degenerate.md §11).
+//! Frequencies of states next to an Euler subspace (an so(3) block or the
+//! self-dual states) where the genus-2 route refuses (docs/degenerate.md §11).
 //!
-//! A state `l = l_b + l_⊥`, with `l_b` in the invariant subspace of a block
-//! (three components sharing no fourth index) and `l_⊥` the other three, at
-//! relative distance `δ = |l_⊥|/|l|`. Its curve is pinched by `δ`: the
-//! reduction and the Abel map lose digits like `1/δ`, and below `δ ~ 1e-4` on
-//! stiff tops the level set's route refuses. The frequencies are smooth there:
+//! A state `l = l_E + l_⊥`, with `l_E` the nearest state of an invariant
+//! subspace where the motion is an Euler top ([`Embedding`]: a block, three
+//! components sharing no fourth index; or `m = ±n`) and `l_⊥` the rest, at
+//! relative distance `δ = |l_⊥|/|l|`. Its curve is pinched by `δ` (next to a
+//! block), or its Casimirs nearly coincide (`h1² − 4h0² ~ δ²` next to the
+//! self-dual states, where `F` (19) is not defined): the level set's route
+//! refuses. The frequencies are smooth there, along the line
+//! `l(σ) = l_E + σ l_⊥/δ`:
 //!
-//! * the reflection of the axis outside the block flips the sign of `l_⊥` and
-//!   is a symmetry of (1) (conjugation by a diagonal `±1` matrix preserves
-//!   `l̇ = [l, Ω]`, `Ω_ij = c_ij l_ij`), so along `l_b + σ l_⊥/δ` the
-//!   frequencies are even in `σ`: analytic in `x = σ²`;
 //! * at `σ = 0` they are the Euler motion's `(ν_⊥, ν_E)`
 //!   ([`crate::solution::transverse`]), where the orbit is transversally
-//!   elliptic (`ν_⊥ > 0`; next to a hyperbolic orbit no tori shrink onto it,
-//!   and the frequencies are not analytic in `x`).
+//!   elliptic (`ν_⊥ > 0`; next to a hyperbolic block orbit no tori shrink onto
+//!   it, and the frequencies are not analytic in `σ`);
+//! * next to a block, the reflection of the axis outside it flips the sign of
+//!   `l_⊥` and is a symmetry of (1) (conjugation by a diagonal `±1` matrix
+//!   preserves `l̇ = [l, Ω]`, `Ω_ij = c_ij l_ij`): the frequencies are even in
+//!   `σ`, analytic in `x = σ²`; next to the self-dual states no symmetry
+//!   flips `l_⊥` (the Casimir `|m|² − |n|²` is linear in `σ`), and `x = σ`.
 //!
-//! So the map interpolates in `x`: through the Euler value at `x = 0` and the
-//! genus-2 frequencies at three nodes `σ = 1e-3, 2e-3, 4e-3` (where the
-//! level set's route answers), each node's reduced basis matched to
-//! `(ν_⊥, ν_E)` by a unimodular integer matrix; a fourth node `σ = 8e-3`
-//! checks the cubic. The bound of the answer is that check scaled by the
+//! So the frequencies are interpolated in `x`: through the Euler value at
+//! `x = 0` and the genus-2 frequencies at three nodes `σ = 1e-3, 2e-3, 4e-3`
+//! (next to a block; `1e-5 … 4e-5` next to the self-dual states), where the
+//! level set's route answers, each node's reduced basis matched to
+//! `(ν_⊥, ν_E)` by a unimodular integer matrix; a fourth node (`σ = 8e-3`,
+//! `8e-5`) checks the cubic. The bound of the answer is that check scaled by the
 //! remainder's factor `|w(x)/w(x_4)|` (`w(x) = x Π (x − x_k)`) plus the
-//! nodes' own bound times their Lagrange weights at `x = δ²`; it must stay
-//! below [`NEAR_BLOCK_RTOL`]. Next to the block (`x ≪ x_k`) the answer is the
-//! Euler value plus a correction of relative size `~δ²/σ_1²`.
+//! nodes' own bound times their Lagrange weights at the state; it must stay
+//! below [`NEAR_EULER_RTOL`]. Next to the subspace (`x ≪ x_k`) the answer is
+//! the Euler value plus a correction of relative size `~x/x_1`.
 
 use super::motion::state_frequencies_plain;
 use super::{MapEntry, Status};
@@ -38,19 +43,35 @@ use crate::solution::normalize::TopFrame;
 /// interpolation is tried.
 pub const NEAR_BLOCK_MAX: f64 = 1e-2;
 
-/// Relative distances `σ` of the node states from the block: the first three
-/// carry the cubic, the last checks it. Scaled up by `δ/NODE_MARGIN` (2.5e-4)
-/// where that is larger than 1, so that the first node is at least four times
-/// as far out as the state (`x ≤ x_1/16`): the answer is an interpolation
-/// next to the cubic's `x = 0` end, never an extrapolation.
-pub const NODES: [f64; 4] = [1e-3, 2e-3, 4e-3, 8e-3];
+/// Relative distances `σ` of the node states from a block: the first three
+/// carry the cubic, the last checks it. Scaled up by `8δ/σ_1` where that is
+/// larger than 1, so that the first node is at least [`NODE_MARGIN`] times as
+/// far out as the state: the answer is an interpolation next to the cubic's
+/// `x = 0` end, never an extrapolation.
+pub const BLOCK_NODES: [f64; 4] = [1e-3, 2e-3, 4e-3, 8e-3];
 
-/// The distance below which [`NODES`] are taken as they are.
-const NODE_MARGIN: f64 = 2.5e-4;
+/// Largest relative distance from the self-dual states at which the
+/// interpolation is tried.
+pub const NEAR_SELF_DUAL_MAX: f64 = 1e-3;
+
+/// Relative distances of the node states from the self-dual states, scaled
+/// alike. Closer in than next to a block: the frequencies
+/// move linearly in `σ` here, and the first node's shift from the Euler value
+/// (`~σ_1` times their sensitivity) must stay below the basis match's
+/// tolerance; the level set's route answers from `σ ~ 1e-6` out
+/// (`h1² − 4h0² ~ σ²` above its rounding).
+pub const SELF_DUAL_NODES: [f64; 4] = [1e-5, 2e-5, 4e-5, 8e-5];
+
+/// The first node is at least this many times as far out as the state: the
+/// nodes' Lagrange weights at the state then sum to at most 0.42 (`x = σ`,
+/// next to the self-dual states; 0.03 for `x = σ²`), which keeps the nodes'
+/// own bound within [`NEAR_EULER_RTOL`].
+const NODE_MARGIN: f64 = 8.0;
 
 /// Largest bound (relative, max norm) of interpolated frequencies that the
-/// map gives: a tenth of the bound the genus-2 frequencies are vouched for to.
-pub const NEAR_BLOCK_RTOL: f64 = 1e-11;
+/// map gives: half the bound the genus-2 frequencies are vouched for to, as
+/// for the Abel-map check of `U` ([`super::solve::ABEL_RATE_RTOL`]).
+pub const NEAR_EULER_RTOL: f64 = 0.5 * NODE_RTOL;
 
 /// The bound of a node's frequencies: those of the genus-2 route
 /// ([`super::solve::FREQUENCY_VELOCITY_RTOL`]).
@@ -79,25 +100,51 @@ const MAX_ENTRY: i32 = 32;
 /// resonance, a hyperbolic neighbourhood): no answer, whatever the bound.
 const CHECK_MAX: f64 = 1e-6;
 
-/// Relative 2-norm distance of `l` from the block `blk` and the positions
-/// outside it; scaled first, so no square overflows or underflows.
-fn block_distance(l: &[f64; 6], blk: [usize; 3]) -> (f64, [usize; 3]) {
-    let out = (0..4).find(|i| !blk.contains(i)).unwrap_or(3);
-    let mut perp = [0usize; 3];
-    let mut n = 0;
-    for (q, &(i, j)) in PAIRS4.iter().enumerate() {
-        if i == out || j == out {
-            perp[n] = q;
-            n += 1;
+/// The nearest state `l_E` of the Euler subspace `emb` (the orthogonal
+/// projection: the block's components, or `m' = (m + σ n)/2` for `n = σ m`)
+/// and the relative 2-norm distance `|l − l_E|/|l|`, scaled first so that no
+/// square overflows or underflows.
+fn euler_projection(l: &[f64; 6], emb: Embedding) -> (f64, [f64; 6]) {
+    let le = match emb {
+        Embedding::Block(blk) => {
+            let out = (0..4).find(|i| !blk.contains(i)).unwrap_or(3);
+            let mut le = *l;
+            for (q, &(i, j)) in PAIRS4.iter().enumerate() {
+                if i == out || j == out {
+                    le[q] = 0.0;
+                }
+            }
+            le
         }
-    }
+        Embedding::SelfDual(sg) => {
+            let (m, n) = crate::kotter::m_n(l);
+            let s = f64::from(sg);
+            emb.state(&std::array::from_fn(|j| 0.5 * (m[j] + s * n[j])))
+        }
+    };
     let s = l.iter().fold(0.0f64, |m, v| m.max(v.abs()));
     if s == 0.0 || !s.is_finite() {
-        return (f64::NAN, perp);
+        return (f64::NAN, le);
     }
     let all: f64 = l.iter().map(|v| (v / s) * (v / s)).sum();
-    let off: f64 = perp.iter().map(|&q| (l[q] / s) * (l[q] / s)).sum();
-    ((off / all).sqrt(), perp)
+    let off: f64 = (0..6)
+        .map(|q| ((l[q] - le[q]) / s) * ((l[q] - le[q]) / s))
+        .sum();
+    ((off / all).sqrt(), le)
+}
+
+/// The Euler subspaces: the four blocks, then the self-dual and
+/// anti-self-dual states.
+fn embeddings() -> [Embedding; 6] {
+    let b = Embedding::BLOCKS;
+    [
+        Embedding::Block(b[0]),
+        Embedding::Block(b[1]),
+        Embedding::Block(b[2]),
+        Embedding::Block(b[3]),
+        Embedding::SelfDual(1),
+        Embedding::SelfDual(-1),
+    ]
 }
 
 /// The integer combination `(p, q)` with `f ≈ p ν_⊥ + q ν_E` (`|p|, |q| ≤`
@@ -172,7 +219,7 @@ fn predict(xs: &[f64], vals: &[[f64; 2]], x: f64) -> [f64; 2] {
 /// status; the message serves `Solution.frequencies`).
 fn refusal(reason: String) -> Error {
     Error::Unverified {
-        what: "frequencies next to an so(3) block",
+        what: "frequencies next to an so(3) block or a self-dual state",
         reason,
     }
 }
@@ -180,55 +227,58 @@ fn refusal(reason: String) -> Error {
 /// `(ν1, ν2)` (user's time) of the state `l0` of the top `frame` by the
 /// interpolation of the module doc, in the reduced basis of the nearest node;
 /// an error where the state is not next to a transversally elliptic block
-/// orbit or the interpolation's bound exceeds [`NEAR_BLOCK_RTOL`].
-pub fn near_block_frequencies(
+/// orbit or the interpolation's bound exceeds [`NEAR_EULER_RTOL`].
+pub fn near_euler_frequencies(
     frame: &TopFrame,
     l0: &[f64; 6],
     cancel: &Cancel,
 ) -> Result<[f64; 2]> {
-    let (delta, blk, perp) = Embedding::BLOCKS
+    let (delta, emb, le) = embeddings()
         .iter()
-        .map(|&b| {
-            let (d, p) = block_distance(l0, b);
-            (d, b, p)
+        .map(|&e| {
+            let (d, le) = euler_projection(l0, e);
+            (d, e, le)
         })
-        .fold((f64::INFINITY, [0; 3], [0; 3]), |m, e| {
+        .fold((f64::INFINITY, embeddings()[0], *l0), |m, e| {
             if e.0 < m.0 {
                 e
             } else {
                 m
             }
         });
-    if !(delta > 0.0 && delta <= NEAR_BLOCK_MAX) {
+    // Even in σ next to a block (the reflection), not next to the self-dual
+    // states (module doc).
+    let even = matches!(emb, Embedding::Block(_));
+    let (max, base) = if even {
+        (NEAR_BLOCK_MAX, BLOCK_NODES)
+    } else {
+        (NEAR_SELF_DUAL_MAX, SELF_DUAL_NODES)
+    };
+    if !(delta > 0.0 && delta <= max) {
         return Err(refusal(format!(
-            "the state is at relative distance {delta:e} from the nearest so(3) block (the \
-             interpolation needs 0 < distance <= {NEAR_BLOCK_MAX:e})"
+            "the state is at relative distance {delta:e} from the nearest {} state (the \
+             interpolation needs 0 < distance <= {max:e})",
+            emb.name()
         )));
     }
-    let mut lb = *l0;
-    for &q in &perp {
-        lb[q] = 0.0;
-    }
-    let euler = state_frequencies_plain(frame, &lb, cancel);
+    let abscissa = |sigma: f64| if even { sigma * sigma } else { sigma };
+    let euler = state_frequencies_plain(frame, &le, cancel);
     let nu0 = euler.nu;
     if euler.status != Status::Ok || !(nu0[0] > 0.0 && nu0[1] > 0.0) {
         return Err(refusal(format!(
-            "the Euler motion of the block ({}) is not transversally elliptic: frequencies \
-             {nu0:?} (status '{}')",
-            Embedding::Block(blk).name(),
+            "the Euler motion of the nearest {} state is not transversally elliptic: \
+             frequencies {nu0:?} (status '{}')",
+            emb.name(),
             euler.status.name()
         )));
     }
-    let nodes = NODES.map(|s| s * (delta / NODE_MARGIN).max(1.0));
-    let xs: [f64; 4] = nodes.map(|s| s * s);
+    let nodes = base.map(|s| s * (NODE_MARGIN * delta / base[0]).max(1.0));
+    let xs: [f64; 4] = nodes.map(abscissa);
     let mut g = [[0.0; 2]; 4];
     let mut first = [[0; 2]; 2];
     for (k, &sigma) in nodes.iter().enumerate() {
         cancel.check()?;
-        let mut node = lb;
-        for &q in &perp {
-            node[q] = l0[q] * (sigma / delta);
-        }
+        let node: [f64; 6] = std::array::from_fn(|q| le[q] + (l0[q] - le[q]) * (sigma / delta));
         let MapEntry { status, nu } = state_frequencies_plain(frame, &node, cancel);
         if status != Status::Ok {
             return Err(refusal(format!(
@@ -263,16 +313,16 @@ pub fn near_block_frequencies(
     let check = (0..2)
         .map(|i| (p4[i] - g[3][i]).abs() / g[3][i].abs())
         .fold(0.0f64, f64::max);
-    let x = delta * delta;
+    let x = abscissa(delta);
     let w = |y: f64| y * (y - xs[0]) * (y - xs[1]) * (y - xs[2]);
     let weights = lagrange(&pts, x);
     let bound = check * (w(x) / w(xs[3])).abs()
         + NODE_RTOL * weights[1..].iter().map(|v| v.abs()).sum::<f64>();
-    if !(check <= CHECK_MAX && bound <= NEAR_BLOCK_RTOL) {
+    if !(check <= CHECK_MAX && bound <= NEAR_EULER_RTOL) {
         return Err(refusal(format!(
             "the nodes' frequencies miss the cubic through the block's by {check:e} at the \
              last node, which bounds the interpolation at this state by {bound:e} (> \
-             {NEAR_BLOCK_RTOL:e}, or a miss above {CHECK_MAX:e})"
+             {NEAR_EULER_RTOL:e}, or a miss above {CHECK_MAX:e})"
         )));
     }
     let p = predict(&pts, &vals, x);
@@ -312,12 +362,22 @@ mod tests {
     }
 
     #[test]
-    fn the_distance_from_a_block_is_scaled_and_names_the_components_outside() {
+    fn the_projections_onto_the_euler_subspaces_are_scaled() {
         // block (0, 1, 2): l12, l13, l23 inside; l14, l24, l34 outside
         let l = [1e200, 1e200, 3e193, 1e200, 4e193, 0.0];
-        let (d, perp) = block_distance(&l, [0, 1, 2]);
-        assert_eq!(perp, [2, 4, 5]);
+        let (d, le) = euler_projection(&l, Embedding::Block([0, 1, 2]));
+        assert_eq!(le, [1e200, 1e200, 0.0, 1e200, 0.0, 0.0]);
         assert!((d / (5e-7 / 3f64.sqrt()) - 1.0).abs() < 1e-12, "{d}");
+        // m = (1, 2, 3), n = m + (0, 0, 2e-8): the self-dual state of m' = m + (0, 0, 1e-8)
+        let l = crate::kotter::l_from_m_n(&[1.0, 2.0, 3.0], &[1.0, 2.0, 3.0 + 2e-8]);
+        let (d, le) = euler_projection(&l, Embedding::SelfDual(1));
+        let (m, n) = crate::kotter::m_n(&le);
+        assert_eq!(m, n);
+        assert!((m[2] - (3.0 + 1e-8)).abs() < 1e-15);
+        assert!(
+            (d / (2f64.sqrt() * 1e-8 / 28f64.sqrt()) - 1.0).abs() < 1e-7,
+            "{d}"
+        );
     }
 
     #[test]
