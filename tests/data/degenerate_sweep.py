@@ -224,7 +224,7 @@ def main() -> None:
                 f"{manakov.tori.STATUS_NAMES[int(manakov.frequency_map(top, l0).status)]}"
             )
 
-    say("\n## 6. Self-dual Euler frequencies (nu_perp, nu_E) and the genus-2 map at distance eps")
+    say("\n## 6. Self-dual Euler frequencies (nu_perp, nu_E) and the frequency map at distance eps")
     say("top | sign | (nu_perp, nu_E) | eps: max(|nu2 - nu_E|, dist(nu1, ±nu_perp + Z nu_E))/nu_E")
     for name in ("generic", "physical", "wide"):
         p = manakov.problem(name)
@@ -238,7 +238,7 @@ def main() -> None:
             dq = rng.normal(size=3)
             dq /= np.linalg.norm(dq)
             cols = []
-            for eps in (1e-1, 1e-2, 1e-3, 1e-4):
+            for eps in (1e-1, 1e-2, 1e-3, 1e-4, 1e-6, 1e-8, 1e-12):
                 mm = m + eps * dq / 2
                 nn = sign * (m - eps * dq / 2)
                 l = np.array([mm[2], -mm[1], nn[0], mm[0], nn[1], nn[2]])
