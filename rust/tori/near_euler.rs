@@ -62,6 +62,9 @@ pub const NEAR_SELF_DUAL_MAX: f64 = 1e-3;
 /// (`h1² − 4h0² ~ σ²` above its rounding).
 pub const SELF_DUAL_NODES: [f64; 4] = [1e-5, 2e-5, 4e-5, 8e-5];
 
+/// The node sets tried, as factors of the standard nodes.
+const NODE_SCALES: [f64; 3] = [1.0, 0.25, 4.0];
+
 /// The first node is at least this many times as far out as the state: the
 /// nodes' Lagrange weights at the state then sum to at most 0.42 (`x = σ`,
 /// next to the self-dual states; 0.03 for `x = σ²`), which keeps the nodes'
@@ -272,7 +275,44 @@ pub fn near_euler_frequencies(
             euler.status.name()
         )));
     }
-    let nodes = base.map(|s| s * (NODE_MARGIN * delta / base[0]).max(1.0));
+    // The standard nodes first; where a node is refused or its basis does not
+    // match (the first node's shift from the Euler value too large), nodes
+    // four times closer in, then four times farther out.
+    let mut first_err = None;
+    let mut tried: Vec<f64> = Vec::new();
+    for scale in NODE_SCALES {
+        // never closer in than NODE_MARGIN times the state's distance
+        let factor = scale.max(NODE_MARGIN * delta / base[0]);
+        if tried.contains(&factor) {
+            continue;
+        }
+        tried.push(factor);
+        let nodes = base.map(|s| s * factor);
+        match interpolate(frame, l0, &le, delta, nu0, nodes, &abscissa, cancel) {
+            Ok(nu) => return Ok(nu),
+            Err(Error::Interrupted) => return Err(Error::Interrupted),
+            Err(e) => {
+                first_err.get_or_insert(e);
+            }
+        }
+    }
+    Err(first_err.unwrap_or_else(|| refusal("no set of nodes applies".into())))
+}
+
+/// The interpolation of the module doc through the Euler value `nu0` of the
+/// nearest state `le` of the subspace and the nodes at relative distances
+/// `nodes` along `le + σ (l0 − le)/δ`, at the state (`abscissa`: `σ ↦ x`).
+#[allow(clippy::too_many_arguments)]
+fn interpolate(
+    frame: &TopFrame,
+    l0: &[f64; 6],
+    le: &[f64; 6],
+    delta: f64,
+    nu0: [f64; 2],
+    nodes: [f64; 4],
+    abscissa: &dyn Fn(f64) -> f64,
+    cancel: &Cancel,
+) -> Result<[f64; 2]> {
     let xs: [f64; 4] = nodes.map(abscissa);
     let mut g = [[0.0; 2]; 4];
     let mut first = [[0; 2]; 2];
@@ -282,7 +322,7 @@ pub fn near_euler_frequencies(
         let MapEntry { status, nu } = state_frequencies_plain(frame, &node, cancel);
         if status != Status::Ok {
             return Err(refusal(format!(
-                "the node at distance {sigma:e} from the block has status '{}'",
+                "the node at distance {sigma:e} from the subspace has status '{}'",
                 status.name()
             )));
         }
@@ -297,7 +337,7 @@ pub fn near_euler_frequencies(
         let m = match_basis(&nu, &pred).ok_or_else(|| {
             refusal(format!(
                 "the node at distance {sigma:e} has frequencies {nu:?}, no unique integer \
-                 combination of {pred:?} (the block's {nu0:?} carried to the node)"
+                 combination of {pred:?} (the Euler value {nu0:?} carried to the node)"
             ))
         })?;
         if k == 0 {
@@ -320,7 +360,7 @@ pub fn near_euler_frequencies(
         + NODE_RTOL * weights[1..].iter().map(|v| v.abs()).sum::<f64>();
     if !(check <= CHECK_MAX && bound <= NEAR_EULER_RTOL) {
         return Err(refusal(format!(
-            "the nodes' frequencies miss the cubic through the block's by {check:e} at the \
+            "the nodes' frequencies miss the cubic through the Euler value by {check:e} at the \
              last node, which bounds the interpolation at this state by {bound:e} (> \
              {NEAR_EULER_RTOL:e}, or a miss above {CHECK_MAX:e})"
         )));
