@@ -595,18 +595,19 @@ class Solution:
 
         * ``"genus2"``: ``U T = ν1 λ1 + ν2 λ2`` on the reduced basis of :attr:`torus`.
           Where the torus is refused for a state within 1e-2 (relative) of an
-          so(3) block whose Euler orbit is transversally elliptic: the
-          interpolation in the squared distance between that orbit's
-          ``(ν_⊥, ν_E)`` and the tori of four states farther out (1e-3 … 8e-3
-          from the block, or at least four times the state's distance), in the
-          reduced basis of the nearest of them, given only where its bound is at
-          most 5e-11 (docs/degenerate.md §11); :func:`manakov.frequency_map`
-          gives the same numbers. Otherwise the torus's ``ClosedFormError``.
-        * ``"integrated"`` (``l(t)`` by a confirmed integration): within 1e-3 of
-          the self-dual states (``h1² = 4 h0²`` to rounding) or 1e-2 of an so(3)
-          block, the same interpolation (in the distance itself next to the
-          self-dual states, from nodes 1e-5 … 8e-5 out); otherwise
-          ``ClosedFormError``.
+          so(3) block whose Euler orbit is transversally elliptic, or within
+          1e-3 of a self-dual state: the interpolation (in the squared distance
+          next to a block, in the distance itself next to the self-dual states)
+          between that orbit's ``(ν_⊥, ν_E)`` and the tori of four states
+          farther out (1e-3 … 8e-3 from a block, 1e-5 … 8e-5 from the self-dual
+          states, or at least eight times the state's distance), in the reduced
+          basis of the nearest of them, given only where its bound is at most
+          5e-11 (docs/degenerate.md §11); :func:`manakov.frequency_map` gives
+          the same numbers. Otherwise the torus's ``ClosedFormError``.
+        * ``"integrated"`` (``l(t)`` by a confirmed integration): the same
+          interpolation where it applies (within ~1e-6 of the self-dual states,
+          where ``h1² = 4 h0²`` to rounding, the motion is of this kind);
+          otherwise ``ClosedFormError``.
         * ``"euler"``: the orbit is closed (a 1-torus); ``ν2 = ν_E = ω/(4K)``, its
           frequency, and ``ν1 = ν_⊥ ∈ [0, ν_E/2]``, the rotation number of the
           linearized motion off the invariant so(3) along the orbit (the angle
