@@ -737,13 +737,7 @@ pub fn abel_rate(
         });
     }
     let w0 = [x[0], x[1], y[0], y[1]];
-    let fit_to = |bound: f64| {
-        fitted_rate(&runs, bound)
-            .filter(|(slope, _)| nan_max(slope.iter().map(|v| v.abs())) <= ABEL_FIT_MAX_SLOPE)
-            .map(|(slope, bound)| -> ([f64; 4], f64) {
-                (std::array::from_fn(|q| w0[q] + slope[q] * rate), bound)
-            })
-    };
+    let fit_to = |bound: f64| corrected(&w0, rate, fitted_rate(&runs, bound));
     let mut fit = fit_to(rtol);
     // Images that scatter about a line bound its slope only to their scatter
     // over the phases' span: a span ABEL_LONG_SPAN times longer, unwrapped
@@ -823,8 +817,15 @@ fn long_fit(
         runs.push(images(sol, u0, &u, &times, &phases, &y));
     }
     // the slope per long phase, in the short fit's lattice units per period
-    Ok(fitted_rate(&runs, rtol)
-        .map(|(slope, bound)| (std::array::from_fn(|q| w[q] + slope[q] * rate), bound)))
+    Ok(corrected(w, rate, fitted_rate(&runs, rtol)))
+}
+
+/// The velocity (lattice coordinates) `w0` corrected by a fitted slope (per
+/// period of phase at the lattice rate `rate`) and its bound, where the
+/// correction is at most [`ABEL_FIT_MAX_SLOPE`].
+fn corrected(w0: &[f64; 4], rate: f64, fit: Option<([f64; 4], f64)>) -> Option<([f64; 4], f64)> {
+    fit.filter(|(slope, _)| nan_max(slope.iter().map(|v| v.abs())) <= ABEL_FIT_MAX_SLOPE)
+        .map(|(slope, bound)| (std::array::from_fn(|q| w0[q] + slope[q] * rate), bound))
 }
 
 /// The slope (lattice coordinates per period of phase, so the relative

@@ -35,7 +35,7 @@ pub fn state_frequencies_in(frame: &TopFrame, l0: &[f64; 6]) -> MapEntry {
 /// failure and the caller's next check stops the map.
 pub fn state_frequencies_in_with(frame: &TopFrame, l0: &[f64; 6], cancel: &Cancel) -> MapEntry {
     let entry = state_frequencies_plain(frame, l0, cancel);
-    if entry.status == Status::Ok || !near_euler_may_answer(entry.status) {
+    if !near_euler_may_answer(entry.status) {
         return entry;
     }
     // Next to an so(3) block the level set's route refuses on pinched curves,

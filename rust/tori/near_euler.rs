@@ -242,13 +242,9 @@ pub fn near_euler_frequencies(
             let (d, le) = euler_projection(l0, e);
             (d, e, le)
         })
-        .fold((f64::INFINITY, embeddings()[0], *l0), |m, e| {
-            if e.0 < m.0 {
-                e
-            } else {
-                m
-            }
-        });
+        // the first of equal distances; a NaN distance (non-finite l0) last
+        .min_by(|p, q| p.0.total_cmp(&q.0))
+        .unwrap_or((f64::NAN, embeddings()[0], *l0));
     // Even in σ next to a block (the reflection), not next to the self-dual
     // states (module doc).
     let even = matches!(emb, Embedding::Block(_));
