@@ -1683,6 +1683,52 @@ def test_next_to_a_block_the_frequencies_interpolate_from_the_euler_orbit() -> N
     assert abs(euler.frequencies[1] - ref[1]) / ref[1] > ABEL_FIT_BOUND
 
 
+#: Harsh draw 744 (tests/data/every_state_harsh.py, seed 20261125): 3.6e-8 from the
+#: block 124, whose Euler orbit is transversally hyperbolic; the off-block components
+#: are l13, l23, l34.
+NEAR_HYPERBOLIC_STATE = (
+    [0.7198613953580191, 0.7217156264155928, 821.6686749293884, 1762.6977729539296],
+    [0.7685421107289672, 0.7667558647660103, 0.7269525795908851, 0.7258336883756266],
+    [
+        246.71750689326697,
+        5.902675374587227e-05,
+        -829909.3496802971,
+        0.02963596787819141,
+        305.71044464976757,
+        0.0035517203059793386,
+    ],
+)
+#: The state's ``1/ν2`` against the genus-2 tori at 3e-5 and 1e-4 on its line, carried
+#: to it along ``ln(1/σ)`` at their own slope: the analytic terms (``~σ²``) tilt that
+#: slope, and 6.7 units of ``ln(1/σ)`` on leave 2.8e-8 (measured). The fit itself meets
+#: the torus at 3e-5 to 2.1e-14 (the Rust test of the same state).
+NEAR_HYPERBOLIC_SLOPE_RTOL = 1e-7
+
+
+def test_next_to_a_hyperbolic_block_the_long_period_grows_like_the_log() -> None:
+    a, b, l0 = (np.asarray(v) for v in NEAR_HYPERBOLIC_STATE)
+    top = manakov.ManakovTop(a, b)
+    fm = manakov.frequency_map(top, l0[None, :])
+    assert manakov.tori.STATUS_NAMES[int(fm.status[0])] == "ok"
+    nu = top.solve(l0).frequencies
+    assert np.array_equal(fm.frequencies[0], nu)
+    # Two genus-2 tori on the same line, closer to the block than the fit's nodes
+    # (an independent route): 1/ν2 is linear in ln(1/σ) there, and its line meets
+    # the state's.
+    off = np.zeros(6, bool)
+    off[[1, 3, 5]] = True
+    lb = np.where(off, 0.0, l0)
+    delta = np.linalg.norm(l0 - lb) / np.linalg.norm(l0)
+    inv = []
+    for sigma in (3e-5, 1e-4):
+        g = manakov.frequency_map(top, (lb + (l0 - lb) * (sigma / delta))[None, :])
+        assert manakov.tori.STATUS_NAMES[int(g.status[0])] == "ok"
+        inv.append(1.0 / g.frequencies[0][1])
+    slope = (inv[0] - inv[1]) / np.log(1e-4 / 3e-5)
+    predicted = inv[0] + slope * np.log(3e-5 / delta)
+    assert abs(1.0 / nu[1] - predicted) / predicted <= NEAR_HYPERBOLIC_SLOPE_RTOL
+
+
 #: Distances from the self-dual states of the sweep below; exactly 0 is the Euler top.
 SELF_DUAL_DISTANCES = [1e-1, 1e-2, 1e-3, 1e-4, 1e-5, 1e-6, 1e-8, 1e-10, 1e-12, 1e-14, 1e-16, 0.0]
 #: Where the genus-2 torus and the interpolation from the self-dual Euler orbit both

@@ -602,8 +602,12 @@ class Solution:
           farther out (1e-3 … 8e-3 from a block, 1e-5 … 8e-5 from the self-dual
           states, or at least eight times the state's distance), in the reduced
           basis of the nearest of them, given only where its bound is at most
-          5e-11 (docs/degenerate.md §11); :func:`manakov.frequency_map` gives
-          the same numbers. Otherwise the torus's ``ClosedFormError``.
+          5e-11 (docs/degenerate.md §11). Next to a block whose orbit is
+          transversally hyperbolic: ``1/ν2`` and ``(ν1 ∓ ν_E)/ν2`` fitted in
+          ``ln(1/σ)`` (``σ`` the distance; slope ``2/λ`` for ``1/ν2``, ``λ`` the
+          orbit's exponent) to the tori of seven states farther out, under the
+          same bound. :func:`manakov.frequency_map` gives the same numbers.
+          Otherwise the torus's ``ClosedFormError``.
         * ``"integrated"`` (``l(t)`` by a confirmed integration): the same
           interpolation where it applies (within ~1e-6 of the self-dual states,
           where ``h1² = 4 h0²`` to rounding, the motion is of this kind);

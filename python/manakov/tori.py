@@ -296,7 +296,11 @@ def frequency_map(
     interpolated between that orbit's ``(ν_⊥, ν_E)`` and the tori of four states
     farther out (in the squared distance next to a block, in the distance next
     to the self-dual states), and given (``ok``) only where the interpolation's
-    bound is at most 5e-11 (docs/degenerate.md §11).
+    bound is at most 5e-11 (docs/degenerate.md §11). Next to a block whose orbit
+    is transversally hyperbolic (growth ``e^{λ t}`` off it), ``1/ν2`` and
+    ``(ν1 ∓ ν_E)/ν2`` are linear in ``ln(1/σ)`` (``σ`` the distance), with the
+    slope ``2/λ`` for ``1/ν2``; they are fitted to the tori of seven states
+    farther out and given under the same bound.
 
     Parameters
     ----------

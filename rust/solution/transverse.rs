@@ -61,6 +61,13 @@ pub const MAX_STEPS: usize = 1 << 20;
 /// where the trace fixes `θ` only to the square root of its error (blocks).
 pub const MONODROMY_TOL: f64 = 1e-13;
 
+/// The convergence tolerance of the trace for a hyperbolic orbit's exponent
+/// ([`hyperbolic_exponent_with`]): the exponent's relative error is the
+/// trace's over `√(c² − 1) ln|μ|`, large next to `|c| = 1` (an orbit
+/// hyperbolic by 1e-2 loses four digits), so the trace is taken to its
+/// rounding where the steps allow.
+pub const EXPONENT_TOL: f64 = 1e-15;
+
 /// `|tr Φ − 1|/2` beyond `1 +` this at two step counts is taken as
 /// hyperbolic without further digits (the multipliers are real and apart).
 pub const HYPERBOLIC_MARGIN: f64 = 1e-6;
@@ -352,8 +359,39 @@ pub fn monodromy(m: &Motion) -> Result<Monodromy> {
 pub fn monodromy_with(m: &Motion, cancel: &Cancel) -> Result<Monodromy> {
     let orbit = Orbit::of(m)?;
     let mut n = orbit.first_steps()?;
-    let (cos, sin) = orbit.converged_invariant(&mut n, cancel)?;
+    let ((cos, sin), _) = orbit.converged_invariant(&mut n, false, cancel)?;
     Ok(classify(cos, sin, n))
+}
+
+/// The transverse Lyapunov exponent `λ = ln|μ| ν_E` (per unit of the user's
+/// time; `μ` the larger multiplier of `Φ(T)`) of a transversally hyperbolic
+/// block orbit, and a bound on its relative error: the trace converged to
+/// [`EXPONENT_TOL`] or its rounding (not stopped once clearly hyperbolic, as
+/// [`monodromy_with`] does), its last change carried through
+/// `d ln|μ| = d c/√(c² − 1)`, `c = (tr Φ − 1)/2`.
+///
+/// Errors: those of [`monodromy_with`], and an orbit that is not
+/// transversally hyperbolic.
+pub fn hyperbolic_exponent_with(m: &Motion, cancel: &Cancel) -> Result<(f64, f64)> {
+    let orbit = Orbit::of(m)?;
+    let mut n = orbit.first_steps()?;
+    let ((cos, sin), tol) = orbit.converged_invariant(&mut n, true, cancel)?;
+    let mono = classify(cos, sin, n);
+    if mono.kind != Transverse::Hyperbolic
+        || !(mono.angle_or_exponent > 0.0 && mono.angle_or_exponent.is_finite())
+    {
+        return Err(Error::InvalidArgument {
+            what: "state l0",
+            reason: "the Euler orbit is not transversally hyperbolic".into(),
+        });
+    }
+    let (_, top) = m.euler().ok_or(Error::InvalidArgument {
+        what: "state l0",
+        reason: "not an Euler top".into(),
+    })?;
+    let nu_e = top.frequency() * m.time_scale();
+    let rel = tol / (cos * cos - 1.0).sqrt() / mono.angle_or_exponent;
+    Ok((mono.angle_or_exponent * nu_e, rel))
 }
 
 /// A periodic Euler orbit of (1): what the Magnus steps along it need.
@@ -425,9 +463,17 @@ impl<'a> Orbit<'a> {
     }
 
     /// The invariant of `Φ(T)` ([`invariant`]) to [`MONODROMY_TOL`] (or the
-    /// rounding floor): step counts doubled from `*n` and Richardson
-    /// extrapolated, `*n` left at the last count used.
-    fn converged_invariant(&self, n: &mut usize, cancel: &Cancel) -> Result<(f64, f64)> {
+    /// rounding floor), and that tolerance in the units of the invariant's
+    /// first entry: step counts doubled from `*n` and Richardson extrapolated,
+    /// `*n` left at the last count used. A clearly hyperbolic block orbit
+    /// stops at once unless `full` (its exponent needs no digits to classify
+    /// the orbit).
+    fn converged_invariant(
+        &self,
+        n: &mut usize,
+        full: bool,
+        cancel: &Cancel,
+    ) -> Result<((f64, f64), f64)> {
         let emb = self.emb;
         let cap = (*n << MAX_DOUBLINGS).min(MAX_STEPS);
         // Values at n, 2n, 4n, … and their Richardson extrapolations
@@ -441,11 +487,12 @@ impl<'a> Orbit<'a> {
             *n = next_n;
             // Clearly hyperbolic at both counts: θ does not exist, ν_⊥ = 0; the
             // exponent needs no more digits.
-            if cur.1.is_nan()
+            if !full
+                && cur.1.is_nan()
                 && cur.0.abs() > 1.0 + HYPERBOLIC_MARGIN
                 && prev.0.abs() > 1.0 + HYPERBOLIC_MARGIN
             {
-                return Ok(cur);
+                return Ok((cur, f64::NAN));
             }
             let r = (
                 cur.0 + (cur.0 - prev.0) / 63.0,
@@ -462,8 +509,9 @@ impl<'a> Orbit<'a> {
                 // The data fix θ only to the rounding of the total transverse
                 // rotation (‖A‖ T radians) and of the n-fold product.
                 let floor = 8.0 * f64::EPSILON * (self.norm_a * self.period + (*n as f64).sqrt());
-                if change <= MONODROMY_TOL.max(floor) {
-                    return Ok(r);
+                let tol = if full { EXPONENT_TOL } else { MONODROMY_TOL };
+                if change <= tol.max(floor) {
+                    return Ok((r, change.max(floor) * scale));
                 }
                 if *n >= cap {
                     return Err(Error::NoConvergence {

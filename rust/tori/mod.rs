@@ -29,7 +29,9 @@
 //! Next to an so(3) block, where the pinched curve defeats the genus-2
 //! route, and next to the self-dual states, where `F` (19) is not defined,
 //! [`near_euler`] interpolates the frequencies between the Euler orbit and
-//! the tori of states farther out.
+//! the tori of states farther out; next to a transversally hyperbolic block
+//! orbit [`near_hyperbolic`] fits them in `ln(1/σ)` with the orbit's own
+//! exponent.
 //!
 //! [`map_states`] runs a per-state function over a batch in parallel (rayon),
 //! in waves between which the caller's [`Cancel`] is checked; the results do
@@ -37,6 +39,7 @@
 
 pub mod motion;
 pub mod near_euler;
+pub mod near_hyperbolic;
 pub mod solve;
 #[cfg(test)]
 mod tests;

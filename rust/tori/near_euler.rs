@@ -13,7 +13,8 @@
 //! * at `σ = 0` they are the Euler motion's `(ν_⊥, ν_E)`
 //!   ([`crate::solution::transverse`]), where the orbit is transversally
 //!   elliptic (`ν_⊥ > 0`; next to a hyperbolic block orbit no tori shrink onto
-//!   it, and the frequencies are not analytic in `σ`);
+//!   it, and the frequencies are not analytic in `σ`: that case is
+//!   [`super::near_hyperbolic`]'s);
 //! * next to a block, the reflection of the axis outside it flips the sign of
 //!   `l_⊥` and is a symmetry of (1) (conjugation by a diagonal `±1` matrix
 //!   preserves `l̇ = [l, Ω]`, `Ω_ij = c_ij l_ij`): the frequencies are even in
@@ -32,6 +33,7 @@
 //! the Euler value plus a correction of relative size `~x/x_1`.
 
 use super::motion::state_frequencies_plain;
+use super::near_hyperbolic::near_hyperbolic_frequencies;
 use super::{MapEntry, Status};
 use crate::error::{Error, Result};
 use crate::numeric::cancel::Cancel;
@@ -69,7 +71,7 @@ const NODE_SCALES: [f64; 3] = [1.0, 0.25, 4.0];
 /// nodes' Lagrange weights at the state then sum to at most 0.42 (`x = σ`,
 /// next to the self-dual states; 0.03 for `x = σ²`), which keeps the nodes'
 /// own bound within [`NEAR_EULER_RTOL`].
-const NODE_MARGIN: f64 = 8.0;
+pub(super) const NODE_MARGIN: f64 = 8.0;
 
 /// Largest bound (relative, max norm) of interpolated frequencies that the
 /// map gives: half the bound the genus-2 frequencies are vouched for to, as
@@ -228,9 +230,10 @@ fn refusal(reason: String) -> Error {
 }
 
 /// `(ν1, ν2)` (user's time) of the state `l0` of the top `frame` by the
-/// interpolation of the module doc, in the reduced basis of the nearest node;
-/// an error where the state is not next to a transversally elliptic block
-/// orbit or the interpolation's bound exceeds [`NEAR_EULER_RTOL`].
+/// interpolation of the module doc, in the reduced basis of the nearest node
+/// (next to a transversally hyperbolic block orbit: the fits of
+/// [`super::near_hyperbolic`]); an error where neither applies or the bound
+/// exceeds [`NEAR_EULER_RTOL`].
 pub fn near_euler_frequencies(
     frame: &TopFrame,
     l0: &[f64; 6],
@@ -263,6 +266,10 @@ pub fn near_euler_frequencies(
     let abscissa = |sigma: f64| if even { sigma * sigma } else { sigma };
     let euler = state_frequencies_plain(frame, &le, cancel);
     let nu0 = euler.nu;
+    if even && euler.status == Status::Ok && nu0[0] == 0.0 && nu0[1] > 0.0 {
+        // transversally hyperbolic (ν_⊥ = 0 is reported only for those)
+        return near_hyperbolic_frequencies(frame, l0, &le, delta, nu0[1], cancel);
+    }
     if euler.status != Status::Ok || !(nu0[0] > 0.0 && nu0[1] > 0.0) {
         return Err(refusal(format!(
             "the Euler motion of the nearest {} state is not transversally elliptic: \

@@ -1197,3 +1197,108 @@ fn next_to_a_block_the_frequencies_interpolate_from_the_euler_orbit() {
     let miss = (euler.nu[1] - reference[1]).abs() / reference[1];
     assert!(miss > 1e-10, "{miss:e}");
 }
+
+/// Harsh draw 744 (tests/data/every_state_harsh.py, seed 20261125): 3.6e-8
+/// (relative) from the block 124, whose Euler orbit is transversally
+/// hyperbolic (multiplier `e^0.255` per period). The level set's route
+/// refuses it; the fit of docs/degenerate.md §11 (next to a hyperbolic block
+/// orbit) answers. An integration
+/// cannot check it (a trajectory in double moves between tori whose `ν2`
+/// differ by `~ε/δ²`), so the fit is checked where the genus-2 torus answers
+/// on its own, on the same line at `σ = 3e-5` (ten times closer in than the
+/// first node; measured 2.1e-14), and the state's own `ν2` against that
+/// torus's through the orbit's exponent (measured 5.7e-10, the analytic terms
+/// at `x = 9e-10`).
+#[test]
+fn next_to_a_hyperbolic_block_the_frequencies_follow_the_orbits_exponent() {
+    use crate::solution::motion::Motion;
+    use crate::solution::normalize::TopFrame;
+    use crate::solution::transverse::hyperbolic_exponent_with;
+    use crate::tori::motion::{state_frequencies_in, state_frequencies_plain};
+    use crate::tori::near_euler::{near_euler_frequencies, NEAR_EULER_RTOL};
+    let a = [
+        0.7198613953580191,
+        0.7217156264155928,
+        821.6686749293884,
+        1762.6977729539296,
+    ];
+    let b = [
+        0.7685421107289672,
+        0.7667558647660103,
+        0.7269525795908851,
+        0.7258336883756266,
+    ];
+    let l0 = [
+        246.71750689326697,
+        5.902675374587227e-05,
+        -829909.3496802971,
+        0.02963596787819141,
+        305.71044464976757,
+        0.0035517203059793386,
+    ];
+    let frame = TopFrame::new(&a, &b).unwrap();
+    let cancel = Cancel::never();
+    assert_ne!(
+        state_frequencies_plain(&frame, &l0, &cancel).status,
+        Status::Ok,
+        "the level set's route answers: the fit is not tested"
+    );
+    let deep = state_frequencies_in(&frame, &l0);
+    assert_eq!(deep.status, Status::Ok);
+    // the block 124: l13, l23, l34 are the components off it
+    let mut le = l0;
+    for q in [1, 3, 5] {
+        le[q] = 0.0;
+    }
+    let norm = |v: &[f64; 6]| v.iter().map(|x| x * x).sum::<f64>().sqrt();
+    let off: [f64; 6] = std::array::from_fn(|q| l0[q] - le[q]);
+    let delta = norm(&off) / norm(&l0);
+    let sigma = 3e-5;
+    let lh: [f64; 6] = std::array::from_fn(|q| le[q] + off[q] * (sigma / delta));
+    let torus = state_frequencies_plain(&frame, &lh, &cancel);
+    assert_eq!(torus.status, Status::Ok, "the genus-2 torus at 3e-5");
+    let fit = near_euler_frequencies(&frame, &lh, &cancel).unwrap();
+    // the same module: a unimodular integer matrix takes one pair to the other
+    let mut miss = f64::INFINITY;
+    for p in -8i32..=8 {
+        for q in -8i32..=8 {
+            for r in -8i32..=8 {
+                for s in -8i32..=8 {
+                    if (p * s - q * r).abs() != 1 {
+                        continue;
+                    }
+                    let h = [
+                        f64::from(p) * fit[0] + f64::from(q) * fit[1],
+                        f64::from(r) * fit[0] + f64::from(s) * fit[1],
+                    ];
+                    let m = (0..2)
+                        .map(|i| (h[i].abs() - torus.nu[i]).abs() / torus.nu[i])
+                        .fold(0.0f64, f64::max);
+                    miss = miss.min(m);
+                }
+            }
+        }
+    }
+    assert!(
+        miss <= NEAR_EULER_RTOL,
+        "fit {fit:?}, torus {:?}: {miss:e}",
+        torus.nu
+    );
+    // The state's ν2 (the second entry in both) against the torus's through
+    // the orbit's own exponent: 1/ν2 moves by (2/λ) ln(σ/δ), up to the
+    // analytic terms of size ~σ² (relative 1e-8 at most here).
+    let m = Motion::in_frame(frame.clone(), &le).unwrap();
+    let (lambda, lambda_rel) = hyperbolic_exponent_with(&m, &cancel).unwrap();
+    // the 6 × 6 variational equations of (1) by scipy's DOP853
+    // (tests/data/hyperbolic_block_check.py, exponent_reference)
+    let reference = 20.16346107037;
+    let e = (lambda - reference).abs() / reference;
+    assert!(e <= lambda_rel + 1e-12, "λ = {lambda}: {e:e} (bound {lambda_rel:e})");
+    let predicted = 1.0 / (1.0 / torus.nu[1] + 2.0 / lambda * (sigma / delta).ln());
+    let err = (deep.nu[1] - predicted).abs() / predicted;
+    assert!(
+        err <= 1e-8,
+        "{:?} against ν2 = {predicted}: {err:e}",
+        deep.nu
+    );
+}
