@@ -1293,7 +1293,10 @@ fn next_to_a_hyperbolic_block_the_frequencies_follow_the_orbits_exponent() {
     // (tests/data/hyperbolic_block_check.py, exponent_reference)
     let reference = 20.16346107037;
     let e = (lambda - reference).abs() / reference;
-    assert!(e <= lambda_rel + 1e-12, "λ = {lambda}: {e:e} (bound {lambda_rel:e})");
+    assert!(
+        e <= lambda_rel + 1e-12,
+        "λ = {lambda}: {e:e} (bound {lambda_rel:e})"
+    );
     let predicted = 1.0 / (1.0 / torus.nu[1] + 2.0 / lambda * (sigma / delta).ln());
     let err = (deep.nu[1] - predicted).abs() / predicted;
     assert!(
