@@ -22,8 +22,9 @@
 //! `2/λ` is the orbit's own ([`hyperbolic_exponent_with`]); the rest is
 //! fitted to the genus-2 frequencies of seven node states `σ = 1e-3 … 8e-3`
 //! out (the basis `(1, x, x², x ln(1/σ), x² ln(1/σ))`), and the fits are
-//! evaluated at the state's `σ = δ`. Measured on the harsh draw, both forms
-//! hold at states 3e-5 … 3e-4 out to 1e-13 (docs/degenerate.md §11).
+//! evaluated at the state's `σ = δ`. On the harsh draw the fits evaluated at
+//! `σ = 3e-5` and `1e-4`, where the genus-2 torus answers on its own, meet it
+//! to 2.7e-13 (median) and 4.1e-11 (max) (docs/degenerate.md §11).
 //!
 //! The answer is given only where a second node set (`0.7` times the first,
 //! distinct states) gives the same frequencies, and the fits' residuals and
@@ -65,6 +66,19 @@ const MAX_COMB: i32 = 4;
 /// The fits themselves are checked by their residuals and the second set.
 const SIGN_RTOL: f64 = 0.1;
 
+/// The line `le + σ (l0 − le)/δ` through the state and what every fit on it
+/// shares: the block state's Euler frequency `ν_E` and the orbit's slope
+/// `2/λ`.
+struct Line<'a> {
+    frame: &'a TopFrame,
+    l0: &'a [f64; 6],
+    le: &'a [f64; 6],
+    delta: f64,
+    nu_e: f64,
+    slope: f64,
+    cancel: &'a Cancel,
+}
+
 /// The refusal of the fit (the caller keeps the genus-2 route's status).
 fn refusal(reason: String) -> Error {
     Error::Unverified {
@@ -99,18 +113,27 @@ pub(super) fn near_hyperbolic_frequencies(
     }
     // The standard nodes first; where they do not answer, nodes four, sixteen
     // and sixty-four times closer in (the analytic terms 16, 256, 4096 times
-    // smaller; the level set's route answers from ~1e-5 out on most lines),
+    // smaller, where the level set's route still answers),
     // never closer than NODE_MARGIN times the state's distance.
     // Never farther out than the standard nodes either: with nodes scaled out
     // (a state beyond HYPERBOLIC_NODES[0]/NODE_MARGIN = 1.25e-4) the two sets
     // agreed while the answer at 3e-4 missed the genus-2 torus there by up to
     // 1.1e-10 on the harsh draw (tests/data/hyperbolic_block_check.txt).
+    let line = Line {
+        frame,
+        l0,
+        le,
+        delta,
+        nu_e,
+        slope,
+        cancel,
+    };
     let mut first_err = None;
     for scale in NODE_SCALES {
         if NODE_MARGIN * delta > scale * HYPERBOLIC_NODES[0] {
             continue;
         }
-        match two_sets(frame, l0, le, delta, nu_e, slope, lambda_rel, scale, cancel) {
+        match two_sets(&line, lambda_rel, scale) {
             Ok(nu) => return Ok(nu),
             Err(Error::Interrupted) => return Err(Error::Interrupted),
             Err(e) => {
@@ -132,22 +155,11 @@ const NODE_SCALES: [f64; 4] = [1.0, 0.25, 0.0625, 0.015625];
 
 /// The answer of the node sets `first` and [`SECOND_SET`] times `first`
 /// (factors of [`HYPERBOLIC_NODES`]), if their bound allows.
-#[allow(clippy::too_many_arguments)]
-fn two_sets(
-    frame: &TopFrame,
-    l0: &[f64; 6],
-    le: &[f64; 6],
-    delta: f64,
-    nu_e: f64,
-    slope: f64,
-    lambda_rel: f64,
-    first: f64,
-    cancel: &Cancel,
-) -> Result<[f64; 2]> {
+fn two_sets(line: &Line, lambda_rel: f64, first: f64) -> Result<[f64; 2]> {
     let mut answers = Vec::with_capacity(2);
     for factor in [first, SECOND_SET * first] {
         let nodes = HYPERBOLIC_NODES.map(|s| s * factor);
-        answers.push(fit_at(frame, l0, le, delta, nu_e, slope, nodes, cancel)?);
+        answers.push(fit_at(line, nodes)?);
     }
     let (nu, resid, reach) = answers[0];
     let (other, resid2, _) = answers[1];
@@ -168,20 +180,19 @@ fn two_sets(
 }
 
 /// The fits of the module doc through the nodes at relative distances
-/// `nodes` along `le + σ (l0 − le)/δ`, at `σ = δ`: `(ν1, ν2)`, the
-/// largest residual (relative), and the factor by which a relative error
-/// of the slope `2/λ` reaches them (relative).
-#[allow(clippy::too_many_arguments)]
-fn fit_at(
-    frame: &TopFrame,
-    l0: &[f64; 6],
-    le: &[f64; 6],
-    delta: f64,
-    nu_e: f64,
-    slope: f64,
-    nodes: [f64; 7],
-    cancel: &Cancel,
-) -> Result<([f64; 2], f64, f64)> {
+/// `nodes` along the line, at `σ = δ`: `(ν1, ν2)`, the largest residual
+/// (relative), and the factor by which a relative error of the slope `2/λ`
+/// reaches them (relative).
+fn fit_at(line: &Line, nodes: [f64; 7]) -> Result<([f64; 2], f64, f64)> {
+    let Line {
+        frame,
+        l0,
+        le,
+        delta,
+        nu_e,
+        slope,
+        cancel,
+    } = *line;
     let mut f = [[0.0; 2]; 7];
     for (k, &sigma) in nodes.iter().enumerate() {
         cancel.check()?;
