@@ -357,10 +357,26 @@ pub fn monodromy(m: &Motion) -> Result<Monodromy> {
 /// [`monodromy`], checking `cancel` every few thousand steps (a map of many
 /// Euler states must stop on Ctrl-C; one state can take up to ~0.1 s).
 pub fn monodromy_with(m: &Motion, cancel: &Cancel) -> Result<Monodromy> {
+    Ok(monodromy_full(m, false, cancel)?.0)
+}
+
+/// The monodromy, the converged invariant `c = cos` and its tolerance
+/// ([`Orbit::converged_invariant`]; `full`: not stopped once clearly
+/// hyperbolic).
+fn monodromy_full(m: &Motion, full: bool, cancel: &Cancel) -> Result<(Monodromy, f64, f64)> {
     let orbit = Orbit::of(m)?;
     let mut n = orbit.first_steps()?;
-    let ((cos, sin), _) = orbit.converged_invariant(&mut n, false, cancel)?;
-    Ok(classify(cos, sin, n))
+    let ((cos, sin), tol) = orbit.converged_invariant(&mut n, full, cancel)?;
+    Ok((classify(cos, sin, n), cos, tol))
+}
+
+/// `ν_E` of an Euler motion in the user's time.
+fn user_euler_frequency(m: &Motion) -> Result<f64> {
+    let (_, top) = m.euler().ok_or(Error::InvalidArgument {
+        what: "state l0",
+        reason: "not an Euler top".into(),
+    })?;
+    Ok(top.frequency() * m.time_scale())
 }
 
 /// The transverse Lyapunov exponent `λ = ln|μ| ν_E` (per unit of the user's
@@ -373,25 +389,18 @@ pub fn monodromy_with(m: &Motion, cancel: &Cancel) -> Result<Monodromy> {
 /// Errors: those of [`monodromy_with`], and an orbit that is not
 /// transversally hyperbolic.
 pub fn hyperbolic_exponent_with(m: &Motion, cancel: &Cancel) -> Result<(f64, f64)> {
-    let orbit = Orbit::of(m)?;
-    let mut n = orbit.first_steps()?;
-    let ((cos, sin), tol) = orbit.converged_invariant(&mut n, true, cancel)?;
-    let mono = classify(cos, sin, n);
-    if mono.kind != Transverse::Hyperbolic
-        || !(mono.angle_or_exponent > 0.0 && mono.angle_or_exponent.is_finite())
-    {
+    let (mono, cos, tol) = monodromy_full(m, true, cancel)?;
+    let lambda = mono.angle_or_exponent * user_euler_frequency(m)?;
+    if mono.kind != Transverse::Hyperbolic || !(lambda > 0.0 && lambda.is_finite()) {
         return Err(Error::InvalidArgument {
             what: "state l0",
-            reason: "the Euler orbit is not transversally hyperbolic".into(),
+            reason: "the Euler orbit is not transversally hyperbolic (or its exponent is not \
+                     finite)"
+                .into(),
         });
     }
-    let (_, top) = m.euler().ok_or(Error::InvalidArgument {
-        what: "state l0",
-        reason: "not an Euler top".into(),
-    })?;
-    let nu_e = top.frequency() * m.time_scale();
     let rel = tol / (cos * cos - 1.0).sqrt() / mono.angle_or_exponent;
-    Ok((mono.angle_or_exponent * nu_e, rel))
+    Ok((lambda, rel))
 }
 
 /// A periodic Euler orbit of (1): what the Magnus steps along it need.
@@ -563,11 +572,7 @@ pub fn euler_frequencies(m: &Motion) -> Result<[f64; 2]> {
 /// [`euler_frequencies`] with a cancellation token ([`monodromy_with`]).
 pub fn euler_frequencies_with(m: &Motion, cancel: &Cancel) -> Result<[f64; 2]> {
     let mono = monodromy_with(m, cancel)?;
-    let (_, top) = m.euler().ok_or(Error::InvalidArgument {
-        what: "state l0",
-        reason: "not an Euler top".into(),
-    })?;
-    let nu_e = top.frequency() * m.time_scale();
+    let nu_e = user_euler_frequency(m)?;
     let nu_perp = match mono.kind {
         Transverse::Elliptic => mono.angle_or_exponent / (2.0 * std::f64::consts::PI) * nu_e,
         Transverse::Hyperbolic => 0.0,

@@ -156,30 +156,62 @@ fn embeddings() -> [Embedding; 6] {
 /// [`MAX_ENTRY`]) and its residual relative to `scale`, if it is within
 /// [`MATCH_RTOL`] and no other comes within ten times its residual.
 fn match_row(f: f64, nu0: &[f64; 2], scale: f64) -> Option<[i32; 2]> {
-    let mut best: Option<([i32; 2], f64)> = None;
-    let mut second = f64::INFINITY;
-    for q in -MAX_ENTRY..=MAX_ENTRY {
+    let candidates = (-MAX_ENTRY..=MAX_ENTRY).flat_map(|q| {
         // the nearest p and its neighbours: the runner-up may be either
         let p0 = ((f - f64::from(q) * nu0[1]) / nu0[0]).round();
-        for p in [p0 - 1.0, p0, p0 + 1.0] {
-            if p.abs() > f64::from(MAX_ENTRY) {
-                continue;
-            }
-            let res = (f - p * nu0[0] - f64::from(q) * nu0[1]).abs() / scale;
-            match best {
-                Some((_, rb)) if res >= rb => second = second.min(res),
-                _ => {
-                    if let Some((_, rb)) = best {
-                        second = second.min(rb);
-                    }
-                    // |p| ≤ MAX_ENTRY: the cast is exact
-                    best = Some(([p as i32, q], res));
+        [p0 - 1.0, p0, p0 + 1.0]
+            .into_iter()
+            .filter(|p| p.abs() <= f64::from(MAX_ENTRY))
+            // |p| ≤ MAX_ENTRY: the cast is exact
+            .map(move |p| {
+                (
+                    [p as i32, q],
+                    (f - p * nu0[0] - f64::from(q) * nu0[1]).abs() / scale,
+                )
+            })
+    });
+    let (m, rb, second) = unique_best(candidates)?;
+    (rb <= MATCH_RTOL && second > 10.0 * rb).then_some(m)
+}
+
+/// The candidate with the smallest miss, that miss, and the runner-up's
+/// (infinite if there is none); `None` for no candidates. Both the basis
+/// match here and the long cycle's identification next to a hyperbolic orbit
+/// ask for a best that no other comes near.
+pub(super) fn unique_best<T>(candidates: impl Iterator<Item = (T, f64)>) -> Option<(T, f64, f64)> {
+    let mut best: Option<(T, f64)> = None;
+    let mut second = f64::INFINITY;
+    for (c, miss) in candidates {
+        match &best {
+            Some((_, b)) if miss >= *b => second = second.min(miss),
+            _ => {
+                if let Some((_, b)) = &best {
+                    second = second.min(*b);
                 }
+                best = Some((c, miss));
             }
         }
     }
-    let (m, rb) = best?;
-    (rb <= MATCH_RTOL && second > 10.0 * rb).then_some(m)
+    best.map(|(c, b)| (c, b, second))
+}
+
+/// The first answer of `attempts` (tried in order, lazily), the
+/// cancellation at once, else the first refusal; `None` if nothing was
+/// tried. The node sets of both interpolations are tried this way.
+pub(super) fn first_answer(
+    attempts: impl IntoIterator<Item = Result<[f64; 2]>>,
+) -> Option<Result<[f64; 2]>> {
+    let mut first_err = None;
+    for attempt in attempts {
+        match attempt {
+            Ok(nu) => return Some(Ok(nu)),
+            Err(Error::Interrupted) => return Some(Err(Error::Interrupted)),
+            Err(e) => {
+                first_err.get_or_insert(e);
+            }
+        }
+    }
+    first_err.map(Err)
 }
 
 /// The unimodular matrix `M` with `f ≈ M ν0`: each row by [`match_row`], and
@@ -281,25 +313,20 @@ pub fn near_euler_frequencies(
     // The standard nodes first; where a node is refused or its basis does not
     // match (the first node's shift from the Euler value too large), nodes
     // four times closer in, then four times farther out.
-    let mut first_err = None;
     let mut tried: Vec<f64> = Vec::new();
-    for scale in NODE_SCALES {
+    let attempts = NODE_SCALES.into_iter().filter_map(|scale| {
         // never closer in than NODE_MARGIN times the state's distance
         let factor = scale.max(NODE_MARGIN * delta / base[0]);
         if tried.contains(&factor) {
-            continue;
+            return None;
         }
         tried.push(factor);
         let nodes = base.map(|s| s * factor);
-        match interpolate(frame, l0, &le, delta, nu0, nodes, &abscissa, cancel) {
-            Ok(nu) => return Ok(nu),
-            Err(Error::Interrupted) => return Err(Error::Interrupted),
-            Err(e) => {
-                first_err.get_or_insert(e);
-            }
-        }
-    }
-    Err(first_err.unwrap_or_else(|| refusal("no set of nodes applies".into())))
+        Some(interpolate(
+            frame, l0, &le, delta, nu0, nodes, &abscissa, cancel,
+        ))
+    });
+    first_answer(attempts).unwrap_or_else(|| Err(refusal("no set of nodes applies".into())))
 }
 
 /// The interpolation of the module doc through the Euler value `nu0` of the

@@ -31,7 +31,7 @@
 //! the exponent's error leave a bound of at most [`NEAR_EULER_RTOL`].
 
 use super::motion::state_frequencies_plain;
-use super::near_euler::{NEAR_EULER_RTOL, NODE_MARGIN};
+use super::near_euler::{first_answer, unique_best, NEAR_EULER_RTOL, NODE_MARGIN};
 use super::Status;
 use crate::error::{Error, Result};
 use crate::numeric::cancel::Cancel;
@@ -105,12 +105,8 @@ pub(super) fn near_hyperbolic_frequencies(
             Error::Interrupted => Error::Interrupted,
             e => refusal(format!("the block orbit's transverse exponent: {e}")),
         })?;
+    // finite and positive (hyperbolic_exponent_with)
     let slope = 2.0 / lambda;
-    if !(slope > 0.0 && slope.is_finite()) {
-        return Err(refusal(format!(
-            "the block orbit's transverse exponent {lambda:e}"
-        )));
-    }
     // The standard nodes first; where they do not answer, nodes four, sixteen
     // and sixty-four times closer in (the analytic terms 16, 256, 4096 times
     // smaller, where the level set's route still answers),
@@ -128,26 +124,17 @@ pub(super) fn near_hyperbolic_frequencies(
         slope,
         cancel,
     };
-    let mut first_err = None;
-    for scale in NODE_SCALES {
-        if NODE_MARGIN * delta > scale * HYPERBOLIC_NODES[0] {
-            continue;
-        }
-        match two_sets(&line, lambda_rel, scale) {
-            Ok(nu) => return Ok(nu),
-            Err(Error::Interrupted) => return Err(Error::Interrupted),
-            Err(e) => {
-                first_err.get_or_insert(e);
-            }
-        }
-    }
-    Err(first_err.unwrap_or_else(|| {
-        refusal(format!(
+    let attempts = NODE_SCALES
+        .into_iter()
+        .filter(|scale| NODE_MARGIN * delta <= scale * HYPERBOLIC_NODES[0])
+        .map(|scale| two_sets(&line, lambda_rel, scale));
+    first_answer(attempts).unwrap_or_else(|| {
+        Err(refusal(format!(
             "the state is at relative distance {delta:e} from the block; the fits need at \
              most {:e} ({NODE_MARGIN} times closer in than the first node)",
             HYPERBOLIC_NODES[0] / NODE_MARGIN
-        ))
-    }))
+        )))
+    })
 }
 
 /// The node sets tried, as factors of [`HYPERBOLIC_NODES`].
@@ -280,33 +267,21 @@ fn fit_at(line: &Line, nodes: [f64; 7]) -> Result<([f64; 2], f64, f64)> {
 /// first two nodes, with `1/ν2` moving between them at the slope `slope` in
 /// `ln(1/σ)` to [`SLOPE_ID_RTOL`], and no other within ten times as close.
 fn long_cycle(f: &[[f64; 2]; 7], ln: &[f64; 7], slope: f64) -> Result<[i32; 2]> {
-    let mut best: Option<([i32; 2], f64)> = None;
-    let mut second = f64::INFINITY;
-    for r in -MAX_COMB..=MAX_COMB {
-        for s in -MAX_COMB..=MAX_COMB {
-            if gcd(r, s) != 1 {
-                continue;
-            }
+    let range = || -MAX_COMB..=MAX_COMB;
+    let candidates = range()
+        .flat_map(|r| range().map(move |s| [r, s]))
+        .filter(|&[r, s]| gcd(r, s) == 1)
+        .filter_map(|[r, s]| {
             let v = |k: usize| f64::from(r) * f[k][0] + f64::from(s) * f[k][1];
             let (v0, v1) = (v(0), v(1));
-            if !(v0 > 0.0 && v1 > 0.0) {
-                continue;
-            }
-            let miss = ((1.0 / v1 - 1.0 / v0) / (ln[1] - ln[0]) / slope - 1.0).abs();
-            match best {
-                Some((_, b)) if miss >= b => second = second.min(miss),
-                _ => {
-                    if let Some((_, b)) = best {
-                        second = second.min(b);
-                    }
-                    best = Some(([r, s], miss));
-                }
-            }
-        }
-    }
-    match best {
-        Some((m, b)) if b <= SLOPE_ID_RTOL && second > 10.0 * b => Ok(m),
-        Some((_, b)) => Err(refusal(format!(
+            (v0 > 0.0 && v1 > 0.0).then(|| {
+                let miss = ((1.0 / v1 - 1.0 / v0) / (ln[1] - ln[0]) / slope - 1.0).abs();
+                ([r, s], miss)
+            })
+        });
+    match unique_best(candidates) {
+        Some((m, b, second)) if b <= SLOPE_ID_RTOL && second > 10.0 * b => Ok(m),
+        Some((_, b, second)) => Err(refusal(format!(
             "no unique integer combination of the nodes' frequencies moves with the orbit's \
              slope 2/λ = {slope:e} (closest: {b:e} relative, next: {second:e})"
         ))),
