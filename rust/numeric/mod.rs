@@ -23,5 +23,6 @@ pub mod cancel;
 pub mod compensated;
 pub mod complex;
 pub mod dd;
+pub(crate) mod dd_fn;
 pub(crate) mod first_order;
 pub mod tol;

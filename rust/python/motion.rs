@@ -63,6 +63,34 @@ impl MotionCore {
         l_of_times(py, t, |t, out, cancel| self.motion.l_batch(t, out, cancel))
     }
 
+    /// `l(t_k)` with the polished constants, evaluated in double-double.
+    fn l_precise<'py>(
+        &self,
+        py: Python<'py>,
+        t: PyReadonlyArray1<'_, f64>,
+    ) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        l_of_times(py, t, |t, out, cancel| {
+            self.motion.l_precise_batch(t, out, cancel)
+        })
+    }
+
+    /// `(residual, correction)` of the polish of a genus-2 motion's constants.
+    fn precise_polish(&self, py: Python<'_>) -> PyResult<(f64, f64)> {
+        let Some(sol) = self.motion.genus2() else {
+            return Err(Error::Unverified {
+                what: "precise l(t)",
+                reason: format!(
+                    "a motion of kind '{}' has no polished constants",
+                    self.motion.kind().name()
+                ),
+            }
+            .into());
+        };
+        let cancel = py_cancel();
+        let p = py.detach(|| sol.precise(&cancel).map(|p| (p.residual(), p.correction())))?;
+        Ok(p)
+    }
+
     /// `s` of `l0' = l0/s`.
     #[getter]
     fn state_scale(&self) -> f64 {

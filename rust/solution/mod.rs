@@ -57,6 +57,7 @@ mod lattice;
 mod level_set;
 pub mod motion;
 pub mod normalize;
+pub mod precise;
 mod setup;
 pub mod transverse;
 pub mod velocity;
@@ -194,6 +195,9 @@ pub struct Solution {
     /// closed form ([`Solution::stand_ins`]), and the last one's reason.
     stand_ins: std::sync::atomic::AtomicU64,
     stand_in_reason: std::sync::Mutex<String>,
+    /// The constants polished in DD ([`precise::Precise`]), on first use
+    /// (boxed: the fast path moves the solution and never reads them).
+    precise: std::sync::OnceLock<Result<Box<precise::Precise>>>,
 }
 
 fn singular(kind: SingularKind, reason: String) -> Error {
@@ -381,6 +385,7 @@ impl Solution {
             certified: std::sync::Mutex::new([0.0; 2]),
             stand_ins: std::sync::atomic::AtomicU64::new(0),
             stand_in_reason: std::sync::Mutex::new(String::new()),
+            precise: std::sync::OnceLock::new(),
             certify_every,
         })
     }

@@ -446,6 +446,49 @@ impl Motion {
         }
     }
 
+    /// `l(t_k)` of the Theorem with its constants polished and evaluated in
+    /// double-double ([`super::precise`]), in the user's frame: a genus-2
+    /// motion's; a constant one's is `l0` itself.
+    ///
+    /// Errors: those of [`Solution::precise`]; [`Error::Unverified`] for the
+    /// kinds with no precise evaluation (Euler and integrated motions).
+    pub fn l_precise_batch(&self, t: &[f64], out: &mut [f64], cancel: &Cancel) -> Result<()> {
+        if out.len() != 6 * t.len() {
+            return Err(Error::Shape {
+                what: "out",
+                expected: format!("({}, 6)", t.len()),
+                got: format!("{} entries", out.len()),
+            });
+        }
+        crate::error::check_finite("t", t)?;
+        match &self.body {
+            Body::Constant => {
+                for o in out.chunks_exact_mut(6) {
+                    o.copy_from_slice(&self.l0);
+                }
+                Ok(())
+            }
+            Body::Genus2(sol) => {
+                // the scales are powers of two: exact
+                let ts: Vec<f64> = t.iter().map(|&x| self.time_scale * x).collect();
+                crate::error::check_finite("t x time scale", &ts)?;
+                sol.l_precise_batch(&ts, out, cancel)?;
+                if self.scale != 1.0 {
+                    out.iter_mut().for_each(|v| *v *= self.scale);
+                }
+                Ok(())
+            }
+            _ => Err(Error::Unverified {
+                what: "precise l(t)",
+                reason: format!(
+                    "a motion of kind '{}' has no precise evaluation (the genus-2 and \
+                     constant kinds have)",
+                    self.kind().name()
+                ),
+            }),
+        }
+    }
+
     /// `l(t_k)` into `out` (row-major `(N, 6)`), in the user's frame; rayon
     /// for large batches, `cancel` checked between chunks.
     ///

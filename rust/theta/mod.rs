@@ -46,6 +46,7 @@
 mod batch;
 mod bound;
 mod chars;
+pub(crate) mod dd;
 mod eval;
 mod linalg;
 mod many;
