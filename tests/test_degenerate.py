@@ -15,12 +15,11 @@ heyoka's Taylor integrator in long double (``tests/data/longdouble_ref.py``, the
 from __future__ import annotations
 
 import math
-import sys
-from pathlib import Path
 
 import mpmath
 import numpy as np
 import pytest
+from _refs import longdouble_ref
 
 import manakov
 from manakov import _core, tori
@@ -61,23 +60,13 @@ def _gauss16(top: manakov.ManakovTop, l0: np.ndarray, t: np.ndarray) -> np.ndarr
     return top.integrate(l0, float(t[-1]), t_eval=t, dt=1e-3).l
 
 
-def _longdouble_ref():
-    pytest.importorskip("heyoka")
-    data = str(Path(__file__).resolve().parent / "data")
-    if data not in sys.path:
-        sys.path.insert(0, data)
-    import longdouble_ref
-
-    return longdouble_ref
-
-
 def _errors(top: manakov.ManakovTop, l0: np.ndarray, t: np.ndarray) -> tuple[float, float, str]:
     """``(error of solve, yardstick)`` against the long-double reference of the exact
     top (``c_ij`` of (2) from ``a, b`` in long double), relative to ``|l0|``, and the
     solution's kind. The yardstick is the larger of gauss16's error and the
     distance to the long-double flow of the doubles' ``c_ij`` (the rounding of the
     data, see :data:`GAUSS_FACTOR`)."""
-    ld = _longdouble_ref()
+    ld = longdouble_ref()
     sol = top.solve(l0)
     ref = np.asarray(ld.reference(top.a, top.b, l0, t), dtype=float)
     ref_doubles = np.asarray(ld.reference(top.a, top.b, l0, t, c=c_pairs(top)), dtype=float)

@@ -12,6 +12,7 @@ import sys
 import warnings
 from pathlib import Path
 
+import _refs
 import numpy as np
 import pytest
 
@@ -166,11 +167,7 @@ def test_a_drifting_phase_is_certified_or_integrated_never_wrong(case) -> None:
     the second's window the closed form is off, and the confirmed integration
     stands in for it, with an IntegratedValuesWarning (the earlier code refused
     those times)."""
-    pytest.importorskip("heyoka")
-    data = str(Path(__file__).resolve().parent / "data")
-    if data not in sys.path:
-        sys.path.insert(0, data)
-    import longdouble_ref
+    longdouble_ref = _refs.longdouble_ref()
 
     a, b, l0, t_end = (np.array(v) for v in case)
     top = manakov.ManakovTop(a, b)
@@ -256,10 +253,7 @@ def test_the_closed_form_is_certified_where_double_integrations_are_off(case) ->
     hy = pytest.importorskip("heyoka")
     if not hasattr(hy, "real128"):
         pytest.skip("this heyoka has no quadruple precision")
-    data = str(Path(__file__).resolve().parent / "data")
-    if data not in sys.path:
-        sys.path.insert(0, data)
-    import longdouble_ref
+    longdouble_ref = _refs.longdouble_ref()
 
     a, b, l0, t_end = (np.array(v) for v in case)
     top = manakov.ManakovTop(a, b)
@@ -979,11 +973,7 @@ def test_roots_of_f_clustered_at_a_branch_point_are_solved(case) -> None:
     draw's window; the earlier code refused each ("F(s) (19) has a repeated
     root", "roots of F(s) (19) did not converge", the self-check, or the drift
     check)."""
-    pytest.importorskip("heyoka")
-    data = str(Path(__file__).resolve().parent / "data")
-    if data not in sys.path:
-        sys.path.insert(0, data)
-    import longdouble_ref
+    longdouble_ref = _refs.longdouble_ref()
 
     a, b, l0, t_end = case
     a, b, l0 = np.array(a), np.array(b), np.array(l0)
@@ -1605,11 +1595,7 @@ def test_a_closed_form_failing_its_self_check_gives_only_certified_l(k: int) -> 
     within 9.8e-17 and 3.4e-12 of the slope of the Abel images of a
     quadruple-precision trajectory); on the last two both refuse them (the
     quotients' second flow fits no velocity; H0 fails its structure check)."""
-    pytest.importorskip("heyoka")
-    data = str(Path(__file__).resolve().parent / "data")
-    if data not in sys.path:
-        sys.path.insert(0, data)
-    import longdouble_ref
+    longdouble_ref = _refs.longdouble_ref()
 
     a, b, l0, t_end = (np.array(v) for v in UNCHECKED_STATES[k])
     sol = manakov.ManakovTop(a, b).solve(l0)

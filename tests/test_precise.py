@@ -10,11 +10,15 @@ double evaluation is off by a few units of rounding from ``t = 0`` on
 
 from __future__ import annotations
 
+import signal
+import subprocess
 import sys
-from pathlib import Path
+import textwrap
+import time
 
 import numpy as np
 import pytest
+from _refs import longdouble_ref
 
 import manakov
 
@@ -24,16 +28,6 @@ import manakov
 PRECISE_LD_RTOL = 1e-16
 
 
-def _longdouble_ref():
-    pytest.importorskip("heyoka")
-    data = str(Path(__file__).resolve().parent / "data")
-    if data not in sys.path:
-        sys.path.insert(0, data)
-    import longdouble_ref
-
-    return longdouble_ref
-
-
 @pytest.mark.parametrize("name", ["physical", "wide"])
 def test_precise_theorem_is_at_least_as_accurate_as_gauss16(name):
     """On the slow shared tops, where gauss16 at a quarter of its default step stays
@@ -41,7 +35,7 @@ def test_precise_theorem_is_at_least_as_accurate_as_gauss16(name):
     Theorem does not (1e-15 ... 3e-15 |l0| from t = 0 on), the precise evaluation is
     within half an ulp of |l0| of the long-double reference and below gauss16's
     error."""
-    ld = _longdouble_ref()
+    ld = longdouble_ref()
     p = manakov.problem(name)
     top = manakov.ManakovTop(p.a, p.b)
     l0 = np.asarray(p.l0, float)
@@ -108,3 +102,52 @@ def test_precise_l_of_the_other_kinds():
     assert sol.kind == "euler"
     with pytest.raises(manakov.ClosedFormError, match="no precise evaluation"):
         sol.l(1.0, precise=True)
+
+
+#: Ctrl-C must stop a call within this long (the project's promise).
+STOP_WITHIN_S = 0.5
+
+# 2e5 precise times: far more than a second on any machine (~0.5 ms a time per core).
+INTERRUPT_CHILD = textwrap.dedent(
+    """
+    import sys, time
+    import numpy as np
+    import manakov
+    p = manakov.problem("wide")
+    sol = manakov.ManakovTop(p.a, p.b).solve(p.l0)
+    t = np.linspace(0.0, 100.0, 200000)
+    print("ready", flush=True)
+    t0 = time.perf_counter()
+    try:
+        sol.l(t, precise=True)
+    except KeyboardInterrupt:
+        print("interrupted", time.perf_counter() - t0, flush=True)
+        sys.exit(130)
+    print("finished", time.perf_counter() - t0, flush=True)
+    """
+)
+
+
+@pytest.mark.skipif(sys.platform == "win32", reason="POSIX signals")
+@pytest.mark.parametrize("after", [0.02, 1.0])
+def test_sigint_stops_the_polish_and_a_long_precise_batch(after):
+    """Ctrl-C during the polish (after 20 ms: it takes ~0.1 s) and during the
+    evaluation (after 1 s) stops the call within 0.5 s."""
+    proc = subprocess.Popen(
+        [sys.executable, "-c", INTERRUPT_CHILD],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+    assert proc.stdout is not None
+    assert proc.stdout.readline().strip() == "ready"
+    time.sleep(after)
+    sent = time.perf_counter()
+    proc.send_signal(signal.SIGINT)
+    line = proc.stdout.readline()
+    stopped = time.perf_counter() - sent
+    out, err = proc.communicate(timeout=60)
+    assert proc.returncode == 130, (line, out, err)
+    assert line.startswith("interrupted"), (line, out, err)
+    assert stopped < STOP_WITHIN_S, f"stopped {stopped:.3f} s after SIGINT"
+    assert "Traceback" not in err

@@ -6,6 +6,8 @@
 //! * [`dd`]: double-double real and complex numbers built on them (the
 //!   reduction's level-set constants, `crate::kotter`; the separatrix test and
 //!   `1 − m` of the Euler tops, `crate::solution::euler`).
+//! * `dd_fn`: `exp` and the circular functions in double-double (the theta
+//!   series of the precise evaluation, `crate::theta::dd`).
 //! * [`first_order`]: complex values with their first-order rounding error
 //!   (compensated arithmetic; the double-double periods' node sums).
 //! * [`complex`]: the principal square root with the crate's one branch cut

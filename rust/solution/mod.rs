@@ -220,6 +220,19 @@ fn phase_mod2(x0: f64, rate: f64, rate_lo: f64, t: f64) -> f64 {
     crate::theta::rem2(x0 + r + e)
 }
 
+/// The arguments of a batch of `l(t_k)`: `out` holds `(N, 6)` rows for the
+/// `N` times, and every time is finite.
+pub(crate) fn check_rows(t: &[f64], out: &[f64]) -> Result<()> {
+    if out.len() != 6 * t.len() {
+        return Err(Error::Shape {
+            what: "out",
+            expected: format!("({}, 6)", t.len()),
+            got: format!("{} entries", out.len()),
+        });
+    }
+    crate::error::check_finite("t", t)
+}
+
 impl Solution {
     /// Sets up the solution through `l0` for the top with parameters `a, b`.
     ///
@@ -967,14 +980,7 @@ impl Solution {
     ///
     /// Errors: non-finite `t`, wrong `out` size, [`Error::Interrupted`].
     pub fn l_batch(&self, t: &[f64], out: &mut [f64], cancel: &Cancel) -> Result<()> {
-        if out.len() != 6 * t.len() {
-            return Err(Error::Shape {
-                what: "out",
-                expected: format!("({}, 6)", t.len()),
-                got: format!("{} entries", out.len()),
-            });
-        }
-        crate::error::check_finite("t", t)?;
+        check_rows(t, out)?;
         if self.gated() {
             rows_in_parallel(t, out, cancel, CHUNK, PAR_PIECE, |tp, op| {
                 self.eval_rows(tp, op)
@@ -989,14 +995,7 @@ impl Solution {
     /// [`Solution::l_batch`] on the calling thread only (for benchmarks and
     /// callers that parallelise themselves).
     pub fn l_batch_serial(&self, t: &[f64], out: &mut [f64], cancel: &Cancel) -> Result<()> {
-        if out.len() != 6 * t.len() {
-            return Err(Error::Shape {
-                what: "out",
-                expected: format!("({}, 6)", t.len()),
-                got: format!("{} entries", out.len()),
-            });
-        }
-        crate::error::check_finite("t", t)?;
+        check_rows(t, out)?;
         let gated = self.gated();
         for (tc, oc) in t.chunks(CHUNK).zip(out.chunks_mut(6 * CHUNK)) {
             cancel.check()?;

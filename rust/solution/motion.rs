@@ -453,14 +453,7 @@ impl Motion {
     /// Errors: those of [`Solution::precise`]; [`Error::Unverified`] for the
     /// kinds with no precise evaluation (Euler and integrated motions).
     pub fn l_precise_batch(&self, t: &[f64], out: &mut [f64], cancel: &Cancel) -> Result<()> {
-        if out.len() != 6 * t.len() {
-            return Err(Error::Shape {
-                what: "out",
-                expected: format!("({}, 6)", t.len()),
-                got: format!("{} entries", out.len()),
-            });
-        }
-        crate::error::check_finite("t", t)?;
+        super::check_rows(t, out)?;
         match &self.body {
             Body::Constant => {
                 for o in out.chunks_exact_mut(6) {
@@ -494,14 +487,7 @@ impl Motion {
     ///
     /// Errors: non-finite `t` (or `T t`), wrong `out` size, [`Error::Interrupted`].
     pub fn l_batch(&self, t: &[f64], out: &mut [f64], cancel: &Cancel) -> Result<()> {
-        if out.len() != 6 * t.len() {
-            return Err(Error::Shape {
-                what: "out",
-                expected: format!("({}, 6)", t.len()),
-                got: format!("{} entries", out.len()),
-            });
-        }
-        crate::error::check_finite("t", t)?;
+        super::check_rows(t, out)?;
         if let Body::Genus2(_) | Body::Integrated { .. } = &self.body {
             // Their own batches: the genus-2 one splits over threads itself,
             // the integration runs once from 0 over all the times.

@@ -60,6 +60,13 @@ const TERM_BUDGET: usize = 1_000_000;
 /// horizon of the precise evaluation.
 pub const PRECISE_PHASE_RTOL: f64 = 1e-18;
 
+/// Times per thread between two cancellation checks of the precise
+/// evaluation (~40 ms at ~0.6 ms a time).
+const PRECISE_CHUNK: usize = 64;
+
+/// Smallest piece of times handed to one thread.
+const PRECISE_PIECE: usize = 4;
+
 /// Relative step of the difference Jacobian.
 const FD_STEP: f64 = 1e-7;
 
@@ -443,17 +450,10 @@ impl Solution {
     }
 
     /// `l(t_k)` with the polished constants, evaluated in DD (one time costs
-    /// about a millisecond), into `out` (row-major `(N, 6)`). `t = 0` gives
-    /// `l0` to rounding.
+    /// about a millisecond; rayon over the times), into `out` (row-major
+    /// `(N, 6)`). `t = 0` gives `l0` to rounding.
     pub fn l_precise_batch(&self, t: &[f64], out: &mut [f64], cancel: &Cancel) -> Result<()> {
-        if out.len() != 6 * t.len() {
-            return Err(Error::Shape {
-                what: "out",
-                expected: format!("({}, 6)", t.len()),
-                got: format!("{} entries", out.len()),
-            });
-        }
-        crate::error::check_finite("t", t)?;
+        super::check_rows(t, out)?;
         // The phase horizon of the lattice rates in DD (as `check_drift` for
         // the double ones)
         let t_max = t.iter().fold(0.0f64, |m, v| m.max(v.abs()));
@@ -466,11 +466,12 @@ impl Solution {
             ));
         }
         let p = self.precise(cancel)?;
-        for (&tk, o) in t.iter().zip(out.chunks_exact_mut(6)) {
-            cancel.check()?;
-            o.copy_from_slice(&p.l(tk)?);
-        }
-        Ok(())
+        super::rows_in_parallel(t, out, cancel, PRECISE_CHUNK, PRECISE_PIECE, |tp, op| {
+            for (&tk, o) in tp.iter().zip(op.chunks_exact_mut(6)) {
+                o.copy_from_slice(&p.l(tk)?);
+            }
+            Ok(())
+        })
     }
 }
 

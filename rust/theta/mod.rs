@@ -37,7 +37,8 @@
 //! # Files
 //!
 //! `plan.rs`: validation of `τ` and the plan (radius, cost model);
-//! `linalg.rs`: the factorisation of `Im τ`; `reduce.rs`: the reduction of
+//! `dd.rs`: genus-2 thetas and gradients in double-double (the precise
+//! evaluation of the Theorem); `linalg.rs`: the factorisation of `Im τ`; `reduce.rs`: the reduction of
 //! `z`; `sum.rs`: the class sums; `eval.rs`: one point; `many.rs`: batches;
 //! `batch.rs`: the vectorised genus-2 kernel; `selected.rs`: blocks of
 //! selected characteristics; `bound.rs`: the tail bound; `chars.rs`: the
