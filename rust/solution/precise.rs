@@ -51,9 +51,11 @@ pub const PRECISE_RESIDUAL_RTOL: f64 = 1e-17;
 /// fastest lattice period, so the twelve phases spread over the torus.
 const POINT_SPACING: f64 = 0.818_720_723_084_583;
 
-/// Lattice points one DD theta sum may take (a nearly singular `Im τ` needs
-/// ~1/λ_min of them); beyond, the precise evaluation is refused.
-const TERM_BUDGET: usize = 1_000_000;
+/// Lattice points one DD theta sum may take (~1000 on the shared tops; a
+/// nearly singular `Im τ` needs ~1/λ_min of them): at ~0.5 µs a point, at
+/// most ~25 ms a time and ~4 s for the polish's 140 sums. Beyond, the precise
+/// evaluation is refused.
+const TERM_BUDGET: usize = 50_000;
 
 /// Relative accuracy assumed of the lattice rates `X, Y` in DD (measured
 /// ≤ 1.4e-19 against 60-digit periods, `riemann::periods_dd`): the phase
