@@ -25,6 +25,12 @@ CLAIMS = {
         r"\[0, 100\]: ([0-9.e+-]+)",
         1e-11,
     ),
+    # docs/theorem.md: both evaluations of the Theorem agree to their accuracy
+    "precise_theorem.py": (
+        ["wide", "/tmp/manakov_precise_example.png"],
+        r"precise vs double on \[0, 100\]: ([0-9.e+-]+)",
+        1e-13,
+    ),
     "riemann_basis.py": (["--no-plot"], r"tau asymmetry \(relative\): ([0-9.e+-]+)", 1e-14),
     # docs/clebsch.md: the Clebsch closed form to 1e-11 on [0, 100]
     "fluid_body.py": (["clebsch_generic", "20"], r"\[0, 100\]: ([0-9.e+-]+)", 1e-11),
