@@ -73,6 +73,25 @@ def test_precise_l_at_zero_is_l0_and_scales_exactly():
     np.testing.assert_array_equal(big.l(t / s, precise=True), s * sol.l(t, precise=True))
 
 
+def test_precise_l_is_time_reversible_to_the_bit():
+    """Frahm's (1) is quadratic in ``l``: ``-l(-t)`` solves it too, so
+    ``l(t; -l0) = -l(-t; l0)``. The two sides come from two set-ups (the constants of
+    ``l0`` and of ``-l0``); correctly rounded, they agree to the bit. The double
+    evaluation, a few ulp off, does not (it differs on every one of these states)."""
+    rng = np.random.default_rng(3)
+    t = np.array([0.5, 3.0, 17.0])
+    double_differs = 0
+    for _ in range(8):
+        a = np.sort(rng.normal(size=4) * 2)
+        b, l0 = rng.normal(size=4), rng.normal(size=6)
+        top = manakov.ManakovTop(a, b)
+        fwd, back = top.solve(l0), top.solve(-l0)
+        assert fwd.kind == back.kind == "genus2"
+        np.testing.assert_array_equal(back.l(t, precise=True), -fwd.l(-t, precise=True))
+        double_differs += int(np.any(back.l(t) != -fwd.l(-t)))
+    assert double_differs >= 6, double_differs
+
+
 def test_precise_l_shapes_and_input_checks():
     p = manakov.problem("generic")
     l0 = np.asarray(p.l0, float)

@@ -434,8 +434,9 @@ class Solution:
         ``residual``: the largest scaled defect the polished constants leave in the
         conditions that define them (real quotients, the integrals (6)–(7) of
         ``l0``, Frahm's (1) along ``U``, ``l(0) = l0``; at most 1e-17, else the
-        precise evaluation is refused). ``correction``: the largest relative change
-        the polish made to a constant of the double set-up. The first access runs
+        precise evaluation is refused). ``correction``: the largest change the
+        polish made to a constant of the double set-up (absolute for ``τ`` and the
+        lattice coordinates of ``v0``, relative for the weights of the quotients). The first access runs
         the polish (about 0.1 s); it is kept.
 
         Raises

@@ -42,7 +42,7 @@ pub const PRECISE_POINTS: usize = 12;
 /// polished ones left median 3.8e-21, max 4.4e-19 on the 104 states of
 /// `tests/data/closed_u_long_double.py` (the four shared tops and 100 random
 /// ones, a third of them stiff), whose constants the polish moved by up to
-/// 1.7e-13 relative. The lattice rates `X, Y` are good to ~1e-19 relative,
+/// 1.7e-13. The lattice rates `X, Y` are good to ~1e-19 relative,
 /// which bounds how well (1) can hold.
 pub const PRECISE_RESIDUAL_RTOL: f64 = 1e-17;
 
@@ -93,7 +93,8 @@ pub struct Precise {
     chars: [([u8; 2], [u8; 2]); 8],
     /// The largest scaled residual of the conditions at the polished constants.
     residual: f64,
-    /// The largest relative change the polish made to a constant.
+    /// The largest change the polish made to a constant (absolute for `τ`
+    /// and the lattice coordinates of `v0`, relative for the weights).
     correction: f64,
 }
 
@@ -231,7 +232,8 @@ impl Precise {
         self.residual
     }
 
-    /// The largest relative change the polish made to a constant.
+    /// The largest change the polish made to a constant (absolute for `τ`
+    /// and the lattice coordinates of `v0`, relative for the weights).
     pub fn correction(&self) -> f64 {
         self.correction
     }
