@@ -337,9 +337,9 @@ class Solution:
             Evaluate the Theorem to the floating-point floor: its constants
             (``τ``, the phase ``v0``, the weights of the quotients) polished in
             double-double against the conditions that define them, and the theta
-            quotients summed in double-double (Notes). About 0.1 s once per
-            solution and 0.5–1 ms per time, against ~1 µs; genus-2 and constant
-            kinds only.
+            quotients summed in double-double (Notes). About 0.04 s once per
+            solution and ~0.2 ms per time and thread, against ~0.1 µs; genus-2 and
+            constant kinds only.
 
         Returns
         -------
@@ -436,8 +436,8 @@ class Solution:
         ``l0``, Frahm's (1) along ``U``, ``l(0) = l0``; at most 1e-17, else the
         precise evaluation is refused). ``correction``: the largest change the
         polish made to a constant of the double set-up (absolute for ``τ`` and the
-        lattice coordinates of ``v0``, relative for the weights of the quotients). The first access runs
-        the polish (about 0.1 s); it is kept.
+        lattice coordinates of ``v0``, relative for the weights of the quotients).
+        The first access runs the polish (about 0.04 s); it is kept.
 
         Raises
         ------

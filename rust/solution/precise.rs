@@ -52,9 +52,9 @@ pub const PRECISE_RESIDUAL_RTOL: f64 = 1e-17;
 const POINT_SPACING: f64 = 0.818_720_723_084_583;
 
 /// Lattice points one DD theta sum may take (~1000 on the shared tops; a
-/// nearly singular `Im τ` needs ~1/λ_min of them): at ~0.5 µs a point, at
-/// most ~25 ms a time and ~4 s for the polish's 140 sums. Beyond, the precise
-/// evaluation is refused.
+/// nearly singular `Im τ` needs ~1/λ_min of them): at ~0.2 µs a point, at
+/// most ~10 ms a time and ~1.5 s for the polish's 140 sums. Beyond, the
+/// precise evaluation is refused.
 const TERM_BUDGET: usize = 50_000;
 
 /// Relative accuracy assumed of the lattice rates `X, Y` in DD (measured
@@ -63,7 +63,7 @@ const TERM_BUDGET: usize = 50_000;
 pub const PRECISE_PHASE_RTOL: f64 = 1e-18;
 
 /// Times per thread between two cancellation checks of the precise
-/// evaluation (~40 ms at ~0.6 ms a time).
+/// evaluation (~13 ms at ~0.2 ms a time).
 const PRECISE_CHUNK: usize = 64;
 
 /// Smallest piece of times handed to one thread.
@@ -453,9 +453,9 @@ impl Solution {
         Ok(cur)
     }
 
-    /// `l(t_k)` with the polished constants, evaluated in DD (one time costs
-    /// about a millisecond; rayon over the times), into `out` (row-major
-    /// `(N, 6)`). `t = 0` gives `l0` to rounding.
+    /// `l(t_k)` with the polished constants, evaluated in DD (~0.2 ms a
+    /// time; rayon over the times), into `out` (row-major `(N, 6)`). `t = 0`
+    /// gives `l0` to rounding.
     pub fn l_precise_batch(&self, t: &[f64], out: &mut [f64], cancel: &Cancel) -> Result<()> {
         super::check_rows(t, out)?;
         // The phase horizon of the lattice rates in DD (as `check_drift` for
