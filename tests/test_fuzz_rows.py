@@ -8,7 +8,6 @@ failing one test, and SIGINT is only meaningful in a process of its own.
 from __future__ import annotations
 
 import resource
-import signal
 import subprocess
 import sys
 import textwrap
@@ -17,12 +16,10 @@ import time
 import numpy as np
 import pytest
 from _npz import load_npz
+from _sigint import STOP_WITHIN_S, sigint_after
 
 import manakov
 from manakov import HyperellipticCurve
-
-#: Ctrl-C must stop a call within this long (the project's promise).
-STOP_WITHIN_S = 0.5
 
 #: An ill-conditioned tau is refused within this long: the refusal needs no
 #: lattice sum, only an LLL reduction and the cost model (microseconds); the
@@ -188,27 +185,11 @@ SIGINT_CHILD = textwrap.dedent(
 )
 
 
-def _sigint_after(child: str, delay: float) -> tuple[str, float, subprocess.Popen]:
-    proc = subprocess.Popen(
-        [sys.executable, "-c", child],
-        stdout=subprocess.PIPE,
-        stderr=subprocess.PIPE,
-        text=True,
-    )
-    assert proc.stdout is not None
-    assert proc.stdout.readline().strip() == "ready"
-    time.sleep(delay)
-    sent = time.perf_counter()
-    proc.send_signal(signal.SIGINT)
-    line = proc.stdout.readline()
-    return line, time.perf_counter() - sent, proc
-
-
 @posix
 @pytest.mark.parametrize("case", ["kotter", "LevelSet.kotter"])
 def test_sigint_stops_the_kotter_batch_of_a_million_states(case):
     # Before: KeyboardInterrupt after 30.3 s (kotter) and 21.7 s (LevelSet.kotter).
-    line, stopped, proc = _sigint_after(SIGINT_CHILD.format(n=10**6, case=case), 1.0)
+    line, stopped, proc = sigint_after(SIGINT_CHILD.format(n=10**6, case=case), 1.0)
     out, err = proc.communicate(timeout=120)
     assert line.startswith("interrupted"), (line, out, err[-2000:])
     assert proc.returncode == 130

@@ -2,20 +2,16 @@
 
 from __future__ import annotations
 
-import signal
-import subprocess
 import sys
 import textwrap
 import time
 
 import numpy as np
 import pytest
+from _sigint import STOP_WITHIN_S, sigint_after
 
 import manakov
 from manakov.theta import MAX_SECONDS_PER_POINT
-
-#: Ctrl-C must stop a call within this long (issue 11).
-STOP_WITHIN_S = 0.5
 
 TAU = np.array([[0.3 + 1.1j, 0.1 + 0.4j], [0.1 + 0.4j, -0.2 + 1.3j]])
 
@@ -49,21 +45,10 @@ CHILD = textwrap.dedent(
 @pytest.mark.skipif(sys.platform == "win32", reason="POSIX signals")
 @pytest.mark.parametrize("parallel", [False, True])
 def test_sigint_stops_a_long_theta_batch(parallel):
-    proc = subprocess.Popen(
-        [sys.executable, "-c", CHILD.format(parallel=parallel)],
-        stdout=subprocess.PIPE,
-        stderr=subprocess.PIPE,
-        text=True,
-    )
-    assert proc.stdout is not None
-    assert proc.stdout.readline().strip() == "ready"
-    time.sleep(0.8)  # well inside the batch
-    sent = time.perf_counter()
-    proc.send_signal(signal.SIGINT)
+    # SIGINT 0.8 s in: well inside the batch.
+    line, stopped, proc = sigint_after(CHILD.format(parallel=parallel), 0.8)
     # The call has stopped when the child reports it (interpreter shutdown after
     # that, freeing a 256 MB output, is not part of the call).
-    line = proc.stdout.readline()
-    stopped = time.perf_counter() - sent
     out, err = proc.communicate(timeout=30)
     assert proc.returncode == 130, (line, out, err)
     assert line.startswith("interrupted"), (line, out, err)

@@ -435,15 +435,26 @@ impl Motion {
                 // In the normalized frame: the solution's own batch (parallel,
                 // with a certifying integration, where the drift check needs
                 // one, run once over all the times and interruptible).
-                let ts: Vec<f64> = t.iter().map(|&x| self.time_scale * x).collect();
-                crate::error::check_finite("t x time scale", &ts)?;
-                sol.l_batch(&ts, out, cancel)?;
-                if self.scale != 1.0 {
-                    out.iter_mut().for_each(|v| *v *= self.scale);
-                }
-                Ok(())
+                self.in_normalized_frame(t, out, |ts, o| sol.l_batch(ts, o, cancel))
             }
         }
+    }
+
+    /// `eval` at the times `T t` of the normalized frame, its rows taken back
+    /// to the user's frame (`s l`; both scales powers of two: exact).
+    fn in_normalized_frame(
+        &self,
+        t: &[f64],
+        out: &mut [f64],
+        eval: impl FnOnce(&[f64], &mut [f64]) -> Result<()>,
+    ) -> Result<()> {
+        let ts: Vec<f64> = t.iter().map(|&x| self.time_scale * x).collect();
+        crate::error::check_finite("t x time scale", &ts)?;
+        eval(&ts, out)?;
+        if self.scale != 1.0 {
+            out.iter_mut().for_each(|v| *v *= self.scale);
+        }
+        Ok(())
     }
 
     /// `l(t_k)` of the Theorem with its constants polished and evaluated in
@@ -462,14 +473,7 @@ impl Motion {
                 Ok(())
             }
             Body::Genus2(sol) => {
-                // the scales are powers of two: exact
-                let ts: Vec<f64> = t.iter().map(|&x| self.time_scale * x).collect();
-                crate::error::check_finite("t x time scale", &ts)?;
-                sol.l_precise_batch(&ts, out, cancel)?;
-                if self.scale != 1.0 {
-                    out.iter_mut().for_each(|v| *v *= self.scale);
-                }
-                Ok(())
+                self.in_normalized_frame(t, out, |ts, o| sol.l_precise_batch(ts, o, cancel))
             }
             _ => Err(Error::Unverified {
                 what: "precise l(t)",
