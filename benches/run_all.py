@@ -56,6 +56,7 @@ COMPARISONS = (
     ("theta_compare.py", ("--quick",)),
     ("riemann_compare.py", ("--quick",)),
     ("theorem_compare.py", ()),
+    ("precise_compare.py", ("--quick",)),
     ("tori_compare.py", ("--quick",)),
     ("fluid_compare.py", ("--quick",)),
 )
