@@ -153,3 +153,16 @@ def test_sigint_stops_the_polish_and_a_long_precise_batch(after):
     assert line.startswith("interrupted"), (line, out, err)
     assert stopped < STOP_WITHIN_S, f"stopped {stopped:.3f} s after SIGINT"
     assert "Traceback" not in err
+
+
+@pytest.mark.parametrize("precise", [False, True])
+def test_a_refusal_in_the_normalized_frame_says_whose_times_it_names(precise):
+    """A state of size 2^-30 is solved in the normalized frame (``t' = T t``,
+    ``T = 2^-30``); beyond the phase horizon the refusal names the frame's time and
+    says so, instead of a time the user never passed."""
+    p = manakov.problem("generic")
+    sol = manakov.ManakovTop(p.a, p.b).solve(np.asarray(p.l0, float) * 2.0**-30)
+    assert sol.time_scale == 2.0**-30
+    with pytest.raises(manakov.ClosedFormError, match="horizon") as info:
+        sol.l(1e21, precise=precise)
+    assert "normalized frame, T t with T = time_scale = 9.3" in str(info.value)

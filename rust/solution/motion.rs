@@ -450,7 +450,17 @@ impl Motion {
     ) -> Result<()> {
         let ts: Vec<f64> = t.iter().map(|&x| self.time_scale * x).collect();
         crate::error::check_finite("t x time scale", &ts)?;
-        eval(&ts, out)?;
+        eval(&ts, out).map_err(|e| match e {
+            // a refusal names the solution's times; say whose they are
+            Error::Unverified { what, reason } if self.time_scale != 1.0 => Error::Unverified {
+                what,
+                reason: format!(
+                    "{reason} (times in the normalized frame, T t with T = time_scale = {:e})",
+                    self.time_scale
+                ),
+            },
+            other => other,
+        })?;
         if self.scale != 1.0 {
             out.iter_mut().for_each(|v| *v *= self.scale);
         }
