@@ -54,7 +54,7 @@ fn dd(p: [f64; 2]) -> Dd {
 
 /// The differences of the `c_ij` that (1) on so(4) needs
 /// (as [`crate::so4::vector_field4_lanes`]), in double-double.
-fn diffs(c: &[Dd; 6]) -> [Dd; 12] {
+pub(crate) fn diffs(c: &[Dd; 6]) -> [Dd; 12] {
     let [c12, c13, c14, c23, c24, c34] = *c;
     [
         c23.sub(c13),
@@ -74,7 +74,7 @@ fn diffs(c: &[Dd; 6]) -> [Dd; 12] {
 
 /// (1) on so(4): `l̇_ij = Σ_{k ∉ {i,j}} l_ik l_kj (c_kj − c_ik)` in
 /// double-double, `d` from [`diffs`].
-fn field(d: &[Dd; 12], l: &[Dd; 6]) -> [Dd; 6] {
+pub(crate) fn field(d: &[Dd; 12], l: &[Dd; 6]) -> [Dd; 6] {
     let [l12, l13, l14, l23, l24, l34] = *l;
     let t = |x: Dd, y: Dd, c: Dd| x.mul(y).mul(c);
     [

@@ -27,6 +27,7 @@ use nalgebra::DMatrix;
 
 use super::Solution;
 use crate::error::{Error, Result};
+use crate::integrate::gauss_dd::{diffs, field};
 use crate::numeric::cancel::Cancel;
 use crate::numeric::dd::{Cdd, Dd};
 use crate::theta::dd::{theta_jet_dd, JetDd};
@@ -105,7 +106,8 @@ type Slot = (Option<usize>, usize);
 struct Target {
     l0: [f64; 6],
     a: [f64; 4],
-    c: [Dd; 6],
+    /// The differences `c_kj − c_ik` of the unrounded top that (1) needs, in DD.
+    d: [Dd; 12],
     h0: [Dd; 4],
     size: f64,
     amax: f64,
@@ -135,7 +137,7 @@ impl Precise {
             for i in 0..4 {
                 r.push(h[i].sub(tg.h0[i]).to_f64() / hs[i]);
             }
-            let f = field_dd(&tg.c, &l);
+            let f = field(&tg.d, &l);
             for q in 0..6 {
                 r.push(ld[q].sub(f[q]).to_f64() / (tg.cmax * s2));
             }
@@ -145,14 +147,18 @@ impl Precise {
 
     /// `dv/dt = X + τ Y`.
     fn velocity(&self) -> [Cdd; 2] {
-        let (x, y) = ([self.rate[0], self.rate[1]], [self.rate[2], self.rate[3]]);
+        self.on_lattice(&self.rate)
+    }
+
+    /// `x + τ y` of the lattice coordinates `p = (x, y)`.
+    fn on_lattice(&self, p: &[Dd; 4]) -> [Cdd; 2] {
         [
-            Cdd::real(x[0])
-                .add(self.tau[0].mul_dd(y[0]))
-                .add(self.tau[1].mul_dd(y[1])),
-            Cdd::real(x[1])
-                .add(self.tau[1].mul_dd(y[0]))
-                .add(self.tau[2].mul_dd(y[1])),
+            Cdd::real(p[0])
+                .add(self.tau[0].mul_dd(p[2]))
+                .add(self.tau[1].mul_dd(p[3])),
+            Cdd::real(p[1])
+                .add(self.tau[1].mul_dd(p[2]))
+                .add(self.tau[2].mul_dd(p[3])),
         ]
     }
 
@@ -199,14 +205,7 @@ impl Precise {
             let n = 2.0 * (0.5 * x.hi).round();
             x.sub(Dd::new(n))
         });
-        [
-            Cdd::real(p[0])
-                .add(self.tau[0].mul_dd(p[2]))
-                .add(self.tau[1].mul_dd(p[3])),
-            Cdd::real(p[1])
-                .add(self.tau[1].mul_dd(p[2]))
-                .add(self.tau[2].mul_dd(p[3])),
-        ]
+        self.on_lattice(&p)
     }
 
     fn thetas_at(&self, t: f64) -> Result<Vec<JetDd>> {
@@ -294,21 +293,6 @@ fn integrals_dd(a: &[f64; 4], l: &[Dd; 6]) -> [Dd; 4] {
     [h0, h1, h2, h3]
 }
 
-/// Frahm's (1) in DD, as [`crate::so4::vector_field4`], `c` in state order.
-fn field_dd(c: &[Dd; 6], l: &[Dd; 6]) -> [Dd; 6] {
-    let [l12, l13, l14, l23, l24, l34] = *l;
-    let [c12, c13, c14, c23, c24, c34] = *c;
-    let t = |x: Dd, y: Dd, ck: Dd, cl: Dd| x.mul(y).mul(ck.sub(cl));
-    [
-        t(l13, l23, c23, c13).add(t(l14, l24, c24, c14)).neg(),
-        t(l12, l23, c23, c12).sub(t(l14, l34, c34, c14)),
-        t(l12, l24, c24, c12).add(t(l13, l34, c34, c13)),
-        t(l12, l13, c13, c12).add(t(l24, l34, c34, c24)).neg(),
-        t(l23, l34, c34, c23).sub(t(l12, l14, c14, c12)),
-        t(l13, l14, c14, c13).add(t(l23, l24, c24, c23)).neg(),
-    ]
-}
-
 impl Solution {
     /// The constants polished in DD ([`Precise`]), computed on the first call
     /// and kept.
@@ -365,7 +349,6 @@ impl Solution {
             residual: f64::INFINITY,
             correction: 0.0,
         };
-        let c: [Dd; 6] = std::array::from_fn(|q| Dd::sum(self.c4[q], self.c4_lo[q]));
         let l0 = self.l0;
         let l0dd = l0.map(Dd::new);
         // Times spread over the torus: steps of an irrational fraction of the
@@ -379,7 +362,7 @@ impl Solution {
         let tg = Target {
             l0,
             a: self.a,
-            c,
+            d: diffs(&super::verify::c_dd(&self.c4, &self.c4_lo, 1.0)),
             h0: integrals_dd(&self.a, &l0dd),
             size: self.size,
             amax: self

@@ -488,7 +488,7 @@ pub(super) fn integrate_confirmed(
 
 /// The coefficients `sign (c4 + c4_lo)` in double-double (`c4_lo` the
 /// rounding errors of `c4`; `sign` ±1 for the direction of time).
-fn c_dd(c4: &[f64; 6], c4_lo: &[f64; 6], sign: f64) -> [Dd; 6] {
+pub(super) fn c_dd(c4: &[f64; 6], c4_lo: &[f64; 6], sign: f64) -> [Dd; 6] {
     std::array::from_fn(|q| Dd::sum(sign * c4[q], sign * c4_lo[q]))
 }
 
