@@ -1715,6 +1715,105 @@ def test_next_to_a_hyperbolic_block_the_long_period_grows_like_the_log() -> None
     assert abs(1.0 / nu[1] - predicted) / predicted <= NEAR_HYPERBOLIC_SLOPE_RTOL
 
 
+#: Harsh-draw states next to a coordinate plane ``(l12, l34)``, ``(l13, l24)`` or
+#: ``(l14, l23)`` of equilibria, where the genus-2 route refuses (docs/degenerate.md
+#: §11): 1819 next to an equilibrium elliptic in both directions, 887 next to one
+#: that is a saddle in one direction and elliptic in the other.
+NEXT_TO_ELLIPTIC_PLANE = (
+    [0.39973548074527443, 0.40312012806594694, 0.4731563444580469, 0.4760189378858858],
+    [0.11426337156495725, -58.48045532613106, -58.468887213696576, -46.039036297529925],
+    [
+        -2347.8303066617714,
+        -1.1601161895162865e-05,
+        2.2631129688867637e-05,
+        8.126344141311137e-05,
+        0.0011143371466547322,
+        -520605.8382183288,
+    ],
+)
+NEXT_TO_SADDLE_PLANE = (
+    [0.24453413282417813, 15.756925872306347, 236.3364924043354, 236.42311542150537],
+    [0.1548066480024426, 0.263572080202057, -124.6065678662577, -124.01660014435805],
+    [
+        0.004337268451521106,
+        2024.198665222142,
+        0.0015619484117841108,
+        -1.3691591293726713e-05,
+        927296.7925405018,
+        -0.00023528353481500972,
+    ],
+)
+#: At ``δ = 2e-9`` from the elliptic plane the frequencies are its normal modes to
+#: ``δ²``; the numpy eigenvalues of the linearization meet them to rounding
+#: (measured 5.7e-16).
+NORMAL_MODE_RTOL = 1e-12
+#: ``1/ν2`` carried from a genus-2 torus at ``σ = 1e-6`` to the state along the
+#: saddle's slope ``4/λ``: the analytic terms at ``x = 1e-12`` (measured 1.1e-12;
+#: with the block orbit's ``2/λ`` 0.16).
+SADDLE_SLOPE_RTOL = 1e-9
+
+
+def _plane_linearization(c: np.ndarray, lp: np.ndarray) -> np.ndarray:
+    """The 6×6 derivative of (1) at ``lp`` by the polarization of a quadratic field
+    (exact up to rounding), in numpy."""
+    pairs = [(0, 1), (0, 2), (0, 3), (1, 2), (1, 3), (2, 3)]
+
+    def field(v: np.ndarray) -> np.ndarray:
+        m = np.zeros((4, 4))
+        for q, (i, j) in enumerate(pairs):
+            m[i, j], m[j, i] = v[q], -v[q]
+        w = c * m
+        d = m @ w - w @ m
+        return np.array([d[i, j] for i, j in pairs])
+
+    h = np.abs(lp).max()
+    return np.column_stack([(field(lp + h * e) - field(lp - h * e)) / (2 * h) for e in np.eye(6)])
+
+
+def _module_miss(f, g) -> float:
+    """Smallest relative (max-norm) miss of ``g`` by ``M f``, ``M`` unimodular with
+    entries up to 4."""
+    best = np.inf
+    r = range(-4, 5)
+    for p, q, s, t in itertools.product(r, r, r, r):
+        if abs(p * t - q * s) == 1:
+            h = np.abs([p * f[0] + q * f[1], s * f[0] + t * f[1]])
+            best = min(best, float(np.max(np.abs(h - g)) / np.max(np.abs(g))))
+    return best
+
+
+def test_next_to_an_elliptic_coordinate_plane_the_map_gives_the_normal_modes() -> None:
+    a, b, l0 = (np.asarray(v) for v in NEXT_TO_ELLIPTIC_PLANE)
+    top = manakov.ManakovTop(a, b)
+    fm = manakov.frequency_map(top, l0[None, :])
+    assert manakov.tori.STATUS_NAMES[int(fm.status[0])] == "ok"
+    nu = top.solve(l0).frequencies
+    assert np.array_equal(fm.frequencies[0], nu)
+    lp = np.where(np.isin(np.arange(6), [0, 5]), l0, 0.0)
+    ev = np.linalg.eigvals(_plane_linearization(np.asarray(top.c), lp))
+    modes = np.sort(np.abs(ev.imag))[[2, 4]] / (2 * np.pi)
+    assert np.all(np.abs(ev.real) <= 1e-9 * np.abs(ev).max())
+    assert _module_miss(modes, nu) <= NORMAL_MODE_RTOL
+
+
+def test_next_to_a_saddle_coordinate_plane_the_long_period_grows_like_the_log() -> None:
+    a, b, l0 = (np.asarray(v) for v in NEXT_TO_SADDLE_PLANE)
+    top = manakov.ManakovTop(a, b)
+    fm = manakov.frequency_map(top, l0[None, :])
+    assert manakov.tori.STATUS_NAMES[int(fm.status[0])] == "ok"
+    nu = top.solve(l0).frequencies
+    assert np.array_equal(fm.frequencies[0], nu)
+    # the plane (l13, l24); the saddle's rate from numpy's eigenvalues
+    lp = np.where(np.isin(np.arange(6), [1, 4]), l0, 0.0)
+    ev = np.linalg.eigvals(_plane_linearization(np.asarray(top.c), lp))
+    lam = np.abs(ev.real).max()
+    delta = np.linalg.norm(l0 - lp) / np.linalg.norm(l0)
+    sigma = 1e-6
+    torus = top.solve(lp + (l0 - lp) * (sigma / delta)).torus
+    predicted = 1.0 / torus.frequencies[1] + 4.0 / lam * np.log(sigma / delta)
+    assert abs(1.0 / nu[1] - predicted) / predicted <= SADDLE_SLOPE_RTOL
+
+
 #: Distances from the self-dual states of the sweep below; exactly 0 is the Euler top.
 SELF_DUAL_DISTANCES = [1e-1, 1e-2, 1e-3, 1e-4, 1e-5, 1e-6, 1e-8, 1e-10, 1e-12, 1e-14, 1e-16, 0.0]
 #: Where the genus-2 torus and the interpolation from the self-dual Euler orbit both

@@ -2,22 +2,8 @@ use super::clebsch::{ClebschConjugacy, ClebschSolution, CLEBSCH_RTOL};
 use super::*;
 use crate::integrate::{integrate, integrate_many, Method, Options};
 use crate::numeric::cancel::Cancel;
+use crate::numeric::test_rng::Rng;
 use crate::so4::FrahmTop;
-
-/// A small deterministic generator (xorshift64*), uniform in [-1, 1).
-struct Rng(u64);
-impl Rng {
-    fn next(&mut self) -> f64 {
-        self.0 ^= self.0 >> 12;
-        self.0 ^= self.0 << 25;
-        self.0 ^= self.0 >> 27;
-        let x = self.0.wrapping_mul(0x2545_F491_4F6C_DD1D);
-        (x >> 11) as f64 / (1u64 << 52) as f64 - 1.0
-    }
-    fn vec<const N: usize>(&mut self) -> [f64; N] {
-        std::array::from_fn(|_| self.next())
-    }
-}
 
 /// A random body with a dense, positive definite energy: `Q = G Gᵀ + I/2`.
 fn random_body(rng: &mut Rng) -> KirchhoffBody {
@@ -192,7 +178,7 @@ fn gauss16_keeps_the_casimirs_and_the_energy() {
 fn batches_give_the_bits_of_single_runs() {
     let mut rng = Rng(5);
     let body = random_body(&mut rng);
-    let y0s: Vec<f64> = (0..5 * 6).map(|_| rng.next()).collect();
+    let y0s: Vec<f64> = (0..5 * 6).map(|_| rng.uniform()).collect();
     let times = [0.5, 1.0, 2.0];
     let o = opts(Method::Gauss16, 0.05);
     let (ys, _) = integrate_many(&body, &y0s, 0.0, &times, &o, true).unwrap();
@@ -263,11 +249,11 @@ fn clebsch_field_is_conjugate_to_a_manakov_top() {
     let mut rng = Rng(21);
     for trial in 0..30 {
         let a = [
-            0.5 + rng.next().abs(),
-            0.5 + rng.next().abs(),
-            0.5 + rng.next().abs(),
+            0.5 + rng.uniform().abs(),
+            0.5 + rng.uniform().abs(),
+            0.5 + rng.uniform().abs(),
         ];
-        let (a, c) = clebsch_body(a, 2.0 * rng.next(), 3.0);
+        let (a, c) = clebsch_body(a, 2.0 * rng.uniform(), 3.0);
         let conj = ClebschConjugacy::new(&a, &c).unwrap();
         let al = conj.alpha();
         assert!(al[0] == 0.0 && al.windows(2).all(|w| w[0] < w[1]) && al[3] == 1.0);

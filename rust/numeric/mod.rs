@@ -17,6 +17,7 @@
 //!   and the step count between two checks ([`cancel::CHECK_EVERY`]).
 //! * [`alloc`]: the one path for allocations sized by user input (a size
 //!   budget, then fallible allocation: an error naming the size, never an abort).
+//! * `test_rng`: the tests' deterministic random inputs.
 //! * [`tol`]: thresholds shared by several layers (the smallest step of the
 //!   explicit integrators, the two tests for the singular level sets).
 
@@ -27,4 +28,6 @@ pub mod complex;
 pub mod dd;
 pub(crate) mod dd_fn;
 pub(crate) mod first_order;
+#[cfg(test)]
+pub(crate) mod test_rng;
 pub mod tol;

@@ -15,6 +15,7 @@ use crate::solution::motion::{Kind, Motion};
 use crate::solution::transverse::euler_frequencies_with;
 use crate::tori::motion::torus_of_motion;
 use crate::tori::near_euler::near_euler_frequencies;
+use crate::tori::near_plane::near_plane_frequencies;
 
 type C = Complex64;
 
@@ -140,15 +141,23 @@ impl MotionCore {
         })
     }
 
-    /// `(ν1, ν2)` (user's time) of a state next to an so(3) block or the
-    /// self-dual states whose frequencies are otherwise refused: the
-    /// interpolation between the Euler motion of the nearest state of that
-    /// subspace and states farther out (`crate::tori::near_euler`), the numbers
-    /// the frequency map gives. Raises where it does not apply or its bound
-    /// fails.
+    /// `(ν1, ν2)` (user's time) of a state next to an so(3) block, the
+    /// self-dual states or a coordinate plane whose frequencies are otherwise
+    /// refused: the interpolation between the Euler motion of the nearest
+    /// state of that subspace (or the plane's equilibrium) and states farther
+    /// out (`crate::tori::near_euler`), the numbers the frequency map gives.
+    /// Raises where it does not apply or its bound fails.
     fn near_euler_frequencies(&self, py: Python<'_>) -> PyResult<[f64; 2]> {
         let cancel = py_cancel();
         Ok(py.detach(|| near_euler_frequencies(self.motion.frame(), self.motion.l0(), &cancel))?)
+    }
+
+    /// The route of `near_euler_frequencies` next to the nearest coordinate
+    /// plane alone (`crate::tori::near_plane`), for checks against the
+    /// genus-2 torus where both answer.
+    fn near_plane_frequencies(&self, py: Python<'_>) -> PyResult<[f64; 2]> {
+        let cancel = py_cancel();
+        Ok(py.detach(|| near_plane_frequencies(self.motion.frame(), self.motion.l0(), &cancel))?)
     }
 
     /// `(ν1, ν2)` of the closed forms (user's time): `(ν_⊥, ν_E)` of

@@ -1,21 +1,13 @@
 use super::*;
+use crate::numeric::test_rng::Rng;
 
 fn c(re: f64, im: f64) -> C {
     C::new(re, im)
 }
 
-/// xorshift64*: deterministic test inputs without a rand dependency.
-struct Rng(u64);
-impl Rng {
-    fn next(&mut self) -> f64 {
-        self.0 ^= self.0 >> 12;
-        self.0 ^= self.0 << 25;
-        self.0 ^= self.0 >> 27;
-        (self.0.wrapping_mul(0x2545F4914F6CDD1D) >> 11) as f64 / (1u64 << 53) as f64
-    }
-    fn c(&mut self, r: f64) -> C {
-        c(r * (2.0 * self.next() - 1.0), r * (2.0 * self.next() - 1.0))
-    }
+/// A complex number with parts uniform in `[-r, r)`.
+fn rand_c(rng: &mut Rng, r: f64) -> C {
+    c(r * rng.uniform(), r * rng.uniform())
 }
 
 fn max_asym(t: &DMatrix<C>) -> f64 {
@@ -33,7 +25,7 @@ fn random_curves_all_genera() {
     let mut rng = Rng(0x1234_5678_9abc_def1);
     for n in 3..=10 {
         for _ in 0..20 {
-            let e: Vec<C> = (0..n).map(|_| rng.c(2.0)).collect();
+            let e: Vec<C> = (0..n).map(|_| rand_c(&mut rng, 2.0)).collect();
             let h = HyperellipticCurve::new(&e).unwrap();
             let (a, b) = h.periods();
             let raw = a.clone().try_inverse().unwrap() * b;
@@ -49,13 +41,13 @@ fn abel_path_independence_and_theta_divisor() {
     let mut rng = Rng(77);
     for n in [5usize, 6] {
         for _ in 0..20 {
-            let e: Vec<C> = (0..n).map(|_| rng.c(2.0)).collect();
+            let e: Vec<C> = (0..n).map(|_| rand_c(&mut rng, 2.0)).collect();
             let h = HyperellipticCurve::new(&e).unwrap();
             let plan = h.theta_plan().unwrap();
             let kv = h.riemann_constant().unwrap().to_vec();
             for _ in 0..10 {
-                let x = rng.c(3.0);
-                let y = h.y(x, if rng.next() < 0.5 { 1 } else { -1 });
+                let x = rand_c(&mut rng, 3.0);
+                let y = h.y(x, if rng.next01() < 0.5 { 1 } else { -1 });
                 let u0 = h.abel(x, y).unwrap();
                 for route in [None, Some(0), Some(n - 1)] {
                     let u1 = h.abel_via(x, y, route).unwrap();
@@ -84,10 +76,10 @@ fn inversion_round_trip() {
     let mut rng = Rng(99);
     for it in 0..40 {
         let n = if it % 2 == 0 { 5 } else { 6 };
-        let e: Vec<C> = (0..n).map(|_| rng.c(2.0)).collect();
+        let e: Vec<C> = (0..n).map(|_| rand_c(&mut rng, 2.0)).collect();
         let h = HyperellipticCurve::new(&e).unwrap();
         for _ in 0..5 {
-            let (x1, x2) = (rng.c(2.5), rng.c(2.5));
+            let (x1, x2) = (rand_c(&mut rng, 2.5), rand_c(&mut rng, 2.5));
             let (y1, y2) = (h.y(x1, 1), h.y(x2, -1));
             let u1 = h.abel(x1, y1).unwrap();
             let u2 = h.abel(x2, y2).unwrap();
@@ -337,7 +329,7 @@ fn riemann_constant_closed_form_equals_the_search() {
     let mut rng = Rng(0x5eed_0bad_cafe);
     for n in 3..=10 {
         for _ in 0..10 {
-            let e: Vec<C> = (0..n).map(|_| rng.c(2.0)).collect();
+            let e: Vec<C> = (0..n).map(|_| rand_c(&mut rng, 2.0)).collect();
             let h = HyperellipticCurve::new(&e).unwrap();
             let (a, b) = h.riemann_constant_char().unwrap();
             let idx = crate::theta::char_index(&a, &b).unwrap();
@@ -470,10 +462,10 @@ fn curves_beyond_the_double_range_of_r_are_built_at_scale() {
 fn lattice_point_inverts_lattice_coordinates() {
     let mut rng = Rng(91);
     for n in [5usize, 6] {
-        let e: Vec<C> = (0..n).map(|_| rng.c(2.0)).collect();
+        let e: Vec<C> = (0..n).map(|_| rand_c(&mut rng, 2.0)).collect();
         let h = HyperellipticCurve::new(&e).unwrap();
         for _ in 0..20 {
-            let z = [rng.c(3.0), rng.c(3.0)];
+            let z = [rand_c(&mut rng, 3.0), rand_c(&mut rng, 3.0)];
             let (alpha, beta) = h.lattice_coordinates(&z);
             let back = h.lattice_point(&alpha, &beta);
             for i in 0..2 {

@@ -31,7 +31,8 @@
 //! [`near_euler`] interpolates the frequencies between the Euler orbit and
 //! the tori of states farther out; next to a transversally hyperbolic block
 //! orbit [`near_hyperbolic`] fits them in `ln(1/σ)` with the orbit's own
-//! exponent.
+//! exponent; next to a coordinate plane of equilibria [`near_plane`] takes
+//! them from the equilibrium's linearization.
 //!
 //! [`map_states`] runs a per-state function over a batch in parallel (rayon),
 //! in waves between which the caller's [`Cancel`] is checked; the results do
@@ -40,6 +41,7 @@
 pub mod motion;
 pub mod near_euler;
 pub mod near_hyperbolic;
+pub mod near_plane;
 pub mod solve;
 #[cfg(test)]
 mod tests;

@@ -34,6 +34,7 @@
 
 use super::motion::state_frequencies_plain;
 use super::near_hyperbolic::near_hyperbolic_frequencies;
+use super::near_plane::near_plane_frequencies;
 use super::{MapEntry, Status};
 use crate::error::{Error, Result};
 use crate::numeric::cancel::Cancel;
@@ -65,7 +66,7 @@ pub const NEAR_SELF_DUAL_MAX: f64 = 1e-3;
 pub const SELF_DUAL_NODES: [f64; 4] = [1e-5, 2e-5, 4e-5, 8e-5];
 
 /// The node sets tried, as factors of the standard nodes.
-const NODE_SCALES: [f64; 3] = [1.0, 0.25, 4.0];
+pub(super) const NODE_SCALES: [f64; 3] = [1.0, 0.25, 4.0];
 
 /// The first node is at least this many times as far out as the state: the
 /// nodes' Lagrange weights at the state then sum to at most 0.42 (`x = σ`,
@@ -264,13 +265,38 @@ fn refusal(reason: String) -> Error {
 /// `(ν1, ν2)` (user's time) of the state `l0` of the top `frame` by the
 /// interpolation of the module doc, in the reduced basis of the nearest node
 /// (next to a transversally hyperbolic block orbit: the fits of
-/// [`super::near_hyperbolic`]); an error where neither applies or the bound
-/// exceeds [`NEAR_EULER_RTOL`].
+/// [`super::near_hyperbolic`]); where neither applies, the interpolation
+/// next to the nearest coordinate-plane equilibrium
+/// ([`super::near_plane`]); an error where none applies or the bound exceeds
+/// [`NEAR_EULER_RTOL`] (the first refusal's, which names the nearest Euler
+/// subspace, and the plane's reason after it).
 pub fn near_euler_frequencies(
     frame: &TopFrame,
     l0: &[f64; 6],
     cancel: &Cancel,
 ) -> Result<[f64; 2]> {
+    match near_subspace_frequencies(frame, l0, cancel) {
+        Ok(nu) => Ok(nu),
+        Err(Error::Interrupted) => Err(Error::Interrupted),
+        Err(first) => near_plane_frequencies(frame, l0, cancel).map_err(|e| match (e, first) {
+            (Error::Interrupted, _) => Error::Interrupted,
+            (
+                Error::Unverified { what, reason },
+                Error::Unverified {
+                    what: w0,
+                    reason: r0,
+                },
+            ) => Error::Unverified {
+                what: w0,
+                reason: format!("{r0}; {what}: {reason}"),
+            },
+            (_, first) => first,
+        }),
+    }
+}
+
+/// [`near_euler_frequencies`] next to the Euler subspaces alone.
+fn near_subspace_frequencies(frame: &TopFrame, l0: &[f64; 6], cancel: &Cancel) -> Result<[f64; 2]> {
     let (delta, emb, le) = embeddings()
         .iter()
         .map(|&e| {
@@ -333,7 +359,7 @@ pub fn near_euler_frequencies(
 /// nearest state `le` of the subspace and the nodes at relative distances
 /// `nodes` along `le + σ (l0 − le)/δ`, at the state (`abscissa`: `σ ↦ x`).
 #[allow(clippy::too_many_arguments)]
-fn interpolate(
+pub(super) fn interpolate(
     frame: &TopFrame,
     l0: &[f64; 6],
     le: &[f64; 6],

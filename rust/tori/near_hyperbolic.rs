@@ -106,7 +106,26 @@ pub(super) fn near_hyperbolic_frequencies(
             e => refusal(format!("the block orbit's transverse exponent: {e}")),
         })?;
     // finite and positive (hyperbolic_exponent_with)
-    let slope = 2.0 / lambda;
+    fit_with_slope(frame, l0, le, delta, nu_e, 2.0 / lambda, lambda_rel, cancel)
+}
+
+/// The fits of the module doc with a given slope `slope` of `1/ν2` in
+/// `ln(1/σ)` (relative error `slope_rel`): `2/λ` next to a block orbit,
+/// `4/λ` next to a coordinate-plane equilibrium that is a saddle in one
+/// direction and elliptic (frequency `nu_e`) in the other
+/// ([`super::near_plane`]), for the state `l0` at relative distance `delta`
+/// from `le`.
+#[allow(clippy::too_many_arguments)]
+pub(super) fn fit_with_slope(
+    frame: &TopFrame,
+    l0: &[f64; 6],
+    le: &[f64; 6],
+    delta: f64,
+    nu_e: f64,
+    slope: f64,
+    slope_rel: f64,
+    cancel: &Cancel,
+) -> Result<[f64; 2]> {
     // The standard nodes first; where they do not answer, nodes four, sixteen
     // and sixty-four times closer in (the analytic terms 16, 256, 4096 times
     // smaller, where the level set's route still answers),
@@ -127,18 +146,17 @@ pub(super) fn near_hyperbolic_frequencies(
     let attempts = NODE_SCALES
         .into_iter()
         .filter(|scale| NODE_MARGIN * delta <= scale * HYPERBOLIC_NODES[0])
-        .map(|scale| two_sets(&line, lambda_rel, scale));
+        .map(|scale| two_sets(&line, slope_rel, scale));
     first_answer(attempts).unwrap_or_else(|| {
         Err(refusal(format!(
-            "the state is at relative distance {delta:e} from the block; the fits need at \
-             most {:e} ({NODE_MARGIN} times closer in than the first node)",
+            "the state is at relative distance {delta:e}; the fits need at most {:e} ({NODE_MARGIN} times closer in than the first node)",
             HYPERBOLIC_NODES[0] / NODE_MARGIN
         )))
     })
 }
 
 /// The node sets tried, as factors of [`HYPERBOLIC_NODES`].
-const NODE_SCALES: [f64; 4] = [1.0, 0.25, 0.0625, 0.015625];
+pub(super) const NODE_SCALES: [f64; 4] = [1.0, 0.25, 0.0625, 0.015625];
 
 /// The answer of the node sets `first` and [`SECOND_SET`] times `first`
 /// (factors of [`HYPERBOLIC_NODES`]), if their bound allows.
