@@ -1782,13 +1782,20 @@ def _module_miss(f, g) -> float:
     return best
 
 
-def test_next_to_an_elliptic_coordinate_plane_the_map_gives_the_normal_modes() -> None:
-    a, b, l0 = (np.asarray(v) for v in NEXT_TO_ELLIPTIC_PLANE)
+def _answered_by_the_map(state):
+    """The top, ``l0`` and its frequencies, which the map gives (status ``ok``) and
+    ``Solution.frequencies`` repeats."""
+    a, b, l0 = (np.asarray(v) for v in state)
     top = manakov.ManakovTop(a, b)
     fm = manakov.frequency_map(top, l0[None, :])
     assert manakov.tori.STATUS_NAMES[int(fm.status[0])] == "ok"
     nu = top.solve(l0).frequencies
     assert np.array_equal(fm.frequencies[0], nu)
+    return top, l0, nu
+
+
+def test_next_to_an_elliptic_coordinate_plane_the_map_gives_the_normal_modes() -> None:
+    top, l0, nu = _answered_by_the_map(NEXT_TO_ELLIPTIC_PLANE)
     lp = np.where(np.isin(np.arange(6), [0, 5]), l0, 0.0)
     ev = np.linalg.eigvals(_plane_linearization(np.asarray(top.c), lp))
     modes = np.sort(np.abs(ev.imag))[[2, 4]] / (2 * np.pi)
@@ -1797,12 +1804,7 @@ def test_next_to_an_elliptic_coordinate_plane_the_map_gives_the_normal_modes() -
 
 
 def test_next_to_a_saddle_coordinate_plane_the_long_period_grows_like_the_log() -> None:
-    a, b, l0 = (np.asarray(v) for v in NEXT_TO_SADDLE_PLANE)
-    top = manakov.ManakovTop(a, b)
-    fm = manakov.frequency_map(top, l0[None, :])
-    assert manakov.tori.STATUS_NAMES[int(fm.status[0])] == "ok"
-    nu = top.solve(l0).frequencies
-    assert np.array_equal(fm.frequencies[0], nu)
+    top, l0, nu = _answered_by_the_map(NEXT_TO_SADDLE_PLANE)
     # the plane (l13, l24); the saddle's rate from numpy's eigenvalues
     lp = np.where(np.isin(np.arange(6), [1, 4]), l0, 0.0)
     ev = np.linalg.eigvals(_plane_linearization(np.asarray(top.c), lp))

@@ -513,6 +513,7 @@ fn passes_fit(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::tori::tests::module_miss;
 
     /// The linearization is that of (1) itself: central differences of the
     /// vector field at the plane state meet it.
@@ -753,32 +754,6 @@ mod tests {
             ],
         ),
     ];
-
-    /// The smallest relative miss (max norm) of `g` by `M f` over the
-    /// unimodular integer matrices `M` with entries up to 8 (the same module).
-    fn module_miss(f: &[f64; 2], g: &[f64; 2]) -> f64 {
-        let mut miss = f64::INFINITY;
-        for p in -8i32..=8 {
-            for q in -8i32..=8 {
-                for r in -8i32..=8 {
-                    for s in -8i32..=8 {
-                        if (p * s - q * r).abs() != 1 {
-                            continue;
-                        }
-                        let h = [
-                            f64::from(p) * f[0] + f64::from(q) * f[1],
-                            f64::from(r) * f[0] + f64::from(s) * f[1],
-                        ];
-                        let m = (0..2)
-                            .map(|i| (h[i].abs() - g[i]).abs() / g[0].max(g[1]))
-                            .fold(0.0f64, f64::max);
-                        miss = miss.min(m);
-                    }
-                }
-            }
-        }
-        miss
-    }
 
     /// Where the level set's route refuses the state, the map answers; and on
     /// the same line, closer to the plane than the nodes (`σ = 1e-6 … 1e-4`;

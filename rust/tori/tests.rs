@@ -1259,26 +1259,7 @@ fn next_to_a_hyperbolic_block_the_frequencies_follow_the_orbits_exponent() {
     assert_eq!(torus.status, Status::Ok, "the genus-2 torus at 3e-5");
     let fit = near_euler_frequencies(&frame, &lh, &cancel).unwrap();
     // the same module: a unimodular integer matrix takes one pair to the other
-    let mut miss = f64::INFINITY;
-    for p in -8i32..=8 {
-        for q in -8i32..=8 {
-            for r in -8i32..=8 {
-                for s in -8i32..=8 {
-                    if (p * s - q * r).abs() != 1 {
-                        continue;
-                    }
-                    let h = [
-                        f64::from(p) * fit[0] + f64::from(q) * fit[1],
-                        f64::from(r) * fit[0] + f64::from(s) * fit[1],
-                    ];
-                    let m = (0..2)
-                        .map(|i| (h[i].abs() - torus.nu[i]).abs() / torus.nu[i])
-                        .fold(0.0f64, f64::max);
-                    miss = miss.min(m);
-                }
-            }
-        }
-    }
+    let miss = module_miss(&fit, &torus.nu);
     assert!(
         miss <= NEAR_EULER_RTOL,
         "fit {fit:?}, torus {:?}: {miss:e}",
@@ -1304,4 +1285,31 @@ fn next_to_a_hyperbolic_block_the_frequencies_follow_the_orbits_exponent() {
         "{:?} against ν2 = {predicted}: {err:e}",
         deep.nu
     );
+}
+
+/// The smallest miss of `g` by `M f` over the unimodular integer matrices `M`
+/// with entries up to 8, relative per component (`|(M f)_i| − g_i` over
+/// `g_i`), max over the two: whether two frequency pairs span the same module.
+pub(super) fn module_miss(f: &[f64; 2], g: &[f64; 2]) -> f64 {
+    let mut miss = f64::INFINITY;
+    for p in -8i32..=8 {
+        for q in -8i32..=8 {
+            for r in -8i32..=8 {
+                for s in -8i32..=8 {
+                    if (p * s - q * r).abs() != 1 {
+                        continue;
+                    }
+                    let h = [
+                        f64::from(p) * f[0] + f64::from(q) * f[1],
+                        f64::from(r) * f[0] + f64::from(s) * f[1],
+                    ];
+                    let m = (0..2)
+                        .map(|i| (h[i].abs() - g[i]).abs() / g[i])
+                        .fold(0.0f64, f64::max);
+                    miss = miss.min(m);
+                }
+            }
+        }
+    }
+    miss
 }
