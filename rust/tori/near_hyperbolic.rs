@@ -149,7 +149,8 @@ pub(super) fn fit_with_slope(
         .map(|scale| two_sets(&line, slope_rel, scale));
     first_answer(attempts).unwrap_or_else(|| {
         Err(refusal(format!(
-            "the state is at relative distance {delta:e}; the fits need at most {:e} ({NODE_MARGIN} times closer in than the first node)",
+            "the state is at relative distance {delta:e}; the fits need at most {:e} \
+             ({NODE_MARGIN} times closer in than the first node)",
             HYPERBOLIC_NODES[0] / NODE_MARGIN
         )))
     })
