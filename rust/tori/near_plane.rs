@@ -29,7 +29,6 @@
 //!   coefficients, the slope of `1/ν2` being `4/λ` (measured between nodes:
 //!   2.00 times the `2/λ` of a block orbit, on three harsh-draw states): the
 //!   fits of [`super::near_hyperbolic`] with that slope.
-//!
 //! * **Saddles in both directions** (rates `λ_a`, `λ_b`): the frequencies in
 //!   a lattice basis solve `(2 ln(1/σ) N + A(x)) ν = e(x)` with `N` the
 //!   integer matrix of the lattice vectors' passes by the saddle and
@@ -57,9 +56,10 @@ pub const PLANES: [[usize; 2]; 3] = [[0, 5], [1, 4], [2, 3]];
 /// Names of [`PLANES`] for messages.
 const PLANE_NAMES: [&str; 3] = ["(l12, l34)", "(l13, l24)", "(l14, l23)"];
 
-/// Least relative separation `|ω1 − ω2|/max ω` of the normal modes: below
-/// it the eigenvalues' formula loses more than `1e-13/separation` of their
-/// digits, and a node's basis could not be matched to them anyway.
+/// Least relative separation `|ω1 − ω2|/max ω` of the normal modes: near a
+/// 1:1 resonance the square root of the discriminant carries the rounding of
+/// `K L` magnified by `~1/separation`, and a node's basis could not be
+/// matched to two nearly equal modes anyway.
 pub const MODE_SEPARATION_MIN: f64 = 1e-3;
 
 /// The refusal of the interpolation (the caller keeps the genus-2 route's
@@ -244,9 +244,10 @@ pub fn plane_type(frame: &TopFrame, lp: &[f64; 6], plane: usize) -> PlaneType {
 }
 
 /// `(ν1, ν2)` (user's time) of the state `l0` next to the nearest coordinate
-/// plane, by the interpolation of the module doc; an error where the plane is
-/// farther than [`NEAR_BLOCK_MAX`], its equilibrium is not elliptic in both
-/// directions, or the interpolation's bound exceeds [`NEAR_EULER_RTOL`].
+/// plane, by the route of its equilibrium's type (module doc); an error where
+/// the plane is farther than [`NEAR_BLOCK_MAX`], the equilibrium is a focus,
+/// has nearly equal normal modes or a degenerate linearization, or the
+/// route's bound exceeds [`NEAR_EULER_RTOL`].
 pub fn near_plane_frequencies(
     frame: &TopFrame,
     l0: &[f64; 6],
@@ -263,7 +264,7 @@ pub fn near_plane_frequencies(
     if !(delta > 0.0 && delta <= NEAR_BLOCK_MAX) {
         return Err(refusal(format!(
             "the state is at relative distance {delta:e} from the nearest coordinate plane \
-             {name} of equilibria (the interpolation needs 0 < distance <= {NEAR_BLOCK_MAX:e})"
+             {name} of equilibria (these routes need 0 < distance <= {NEAR_BLOCK_MAX:e})"
         )));
     }
     // normal modes in the normalized frame, carried to the user's time as the
@@ -303,7 +304,8 @@ pub fn near_plane_frequencies(
         PlaneType::Other => {
             return Err(refusal(format!(
                 "the equilibrium on the coordinate plane {name} nearest the state (at relative \
-                 distance {delta:e}) is a focus, or its two normal modes nearly coincide"
+                 distance {delta:e}) is a focus, its two normal modes nearly coincide, or its \
+                 linearization is degenerate"
             )))
         }
     };
