@@ -1691,13 +1691,20 @@ NEAR_HYPERBOLIC_STATE = (
 NEAR_HYPERBOLIC_SLOPE_RTOL = 1e-7
 
 
-def test_next_to_a_hyperbolic_block_the_long_period_grows_like_the_log() -> None:
-    a, b, l0 = (np.asarray(v) for v in NEAR_HYPERBOLIC_STATE)
+def _answered_by_the_map(state):
+    """The top, ``l0`` and its frequencies, which the map gives (status ``ok``) and
+    ``Solution.frequencies`` repeats."""
+    a, b, l0 = (np.asarray(v) for v in state)
     top = manakov.ManakovTop(a, b)
     fm = manakov.frequency_map(top, l0[None, :])
     assert manakov.tori.STATUS_NAMES[int(fm.status[0])] == "ok"
     nu = top.solve(l0).frequencies
     assert np.array_equal(fm.frequencies[0], nu)
+    return top, l0, nu
+
+
+def test_next_to_a_hyperbolic_block_the_long_period_grows_like_the_log() -> None:
+    top, l0, nu = _answered_by_the_map(NEAR_HYPERBOLIC_STATE)
     # Two genus-2 tori on the same line, closer to the block than the fit's nodes
     # (an independent route): 1/ν2 is linear in ln(1/σ) there, and its line meets
     # the state's.
@@ -1780,18 +1787,6 @@ def _module_miss(f, g) -> float:
             h = np.abs([p * f[0] + q * f[1], s * f[0] + t * f[1]])
             best = min(best, float(np.max(np.abs(h - g)) / np.max(np.abs(g))))
     return best
-
-
-def _answered_by_the_map(state):
-    """The top, ``l0`` and its frequencies, which the map gives (status ``ok``) and
-    ``Solution.frequencies`` repeats."""
-    a, b, l0 = (np.asarray(v) for v in state)
-    top = manakov.ManakovTop(a, b)
-    fm = manakov.frequency_map(top, l0[None, :])
-    assert manakov.tori.STATUS_NAMES[int(fm.status[0])] == "ok"
-    nu = top.solve(l0).frequencies
-    assert np.array_equal(fm.frequencies[0], nu)
-    return top, l0, nu
 
 
 def test_next_to_an_elliptic_coordinate_plane_the_map_gives_the_normal_modes() -> None:

@@ -66,7 +66,7 @@ pub const NEAR_SELF_DUAL_MAX: f64 = 1e-3;
 pub const SELF_DUAL_NODES: [f64; 4] = [1e-5, 2e-5, 4e-5, 8e-5];
 
 /// The node sets tried, as factors of the standard nodes.
-pub(super) const NODE_SCALES: [f64; 3] = [1.0, 0.25, 4.0];
+const NODE_SCALES: [f64; 3] = [1.0, 0.25, 4.0];
 
 /// The first node is at least this many times as far out as the state: the
 /// nodes' Lagrange weights at the state then sum to at most 0.42 (`x = σ`,
@@ -336,12 +336,27 @@ fn near_subspace_frequencies(frame: &TopFrame, l0: &[f64; 6], cancel: &Cancel) -
             euler.status.name()
         )));
     }
-    // The standard nodes first; where a node is refused or its basis does not
-    // match (the first node's shift from the Euler value too large), nodes
-    // four times closer in, then four times farther out.
+    interpolate_over_node_sets(frame, l0, &le, delta, nu0, base, &abscissa, cancel)
+}
+
+/// [`interpolate`] through the node set `base` first; where a node is
+/// refused or its basis does not match (the first node's shift from the
+/// value at `x = 0` too large), nodes four times closer in, then four times
+/// farther out ([`NODE_SCALES`]), each never closer in than [`NODE_MARGIN`]
+/// times the state's distance: the first answer, else the first refusal.
+#[allow(clippy::too_many_arguments)]
+pub(super) fn interpolate_over_node_sets(
+    frame: &TopFrame,
+    l0: &[f64; 6],
+    le: &[f64; 6],
+    delta: f64,
+    nu0: [f64; 2],
+    base: [f64; 4],
+    abscissa: &dyn Fn(f64) -> f64,
+    cancel: &Cancel,
+) -> Result<[f64; 2]> {
     let mut tried: Vec<f64> = Vec::new();
     let attempts = NODE_SCALES.into_iter().filter_map(|scale| {
-        // never closer in than NODE_MARGIN times the state's distance
         let factor = scale.max(NODE_MARGIN * delta / base[0]);
         if tried.contains(&factor) {
             return None;
@@ -349,7 +364,7 @@ fn near_subspace_frequencies(frame: &TopFrame, l0: &[f64; 6], cancel: &Cancel) -
         tried.push(factor);
         let nodes = base.map(|s| s * factor);
         Some(interpolate(
-            frame, l0, &le, delta, nu0, nodes, &abscissa, cancel,
+            frame, l0, le, delta, nu0, nodes, abscissa, cancel,
         ))
     });
     first_answer(attempts).unwrap_or_else(|| Err(refusal("no set of nodes applies".into())))
@@ -359,7 +374,7 @@ fn near_subspace_frequencies(frame: &TopFrame, l0: &[f64; 6], cancel: &Cancel) -
 /// nearest state `le` of the subspace and the nodes at relative distances
 /// `nodes` along `le + σ (l0 − le)/δ`, at the state (`abscissa`: `σ ↦ x`).
 #[allow(clippy::too_many_arguments)]
-pub(super) fn interpolate(
+fn interpolate(
     frame: &TopFrame,
     l0: &[f64; 6],
     le: &[f64; 6],

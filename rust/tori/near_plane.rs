@@ -38,8 +38,8 @@
 //! Foci and nearly equal normal modes are not answered here.
 
 use super::motion::state_frequencies_plain;
-use super::near_euler::{first_answer, interpolate, BLOCK_NODES, NEAR_BLOCK_MAX};
-use super::near_euler::{NEAR_EULER_RTOL, NODE_MARGIN, NODE_SCALES};
+use super::near_euler::{first_answer, interpolate_over_node_sets, BLOCK_NODES, NEAR_BLOCK_MAX};
+use super::near_euler::{NEAR_EULER_RTOL, NODE_MARGIN};
 use super::near_hyperbolic::{fit_with_slope, HYPERBOLIC_NODES, NODE_SCALES as HYPERBOLIC_SCALES};
 use super::Status;
 use crate::error::{Error, Result};
@@ -310,21 +310,9 @@ pub fn near_plane_frequencies(
         }
     };
     let abscissa = |sigma: f64| sigma * sigma;
-    let mut tried: Vec<f64> = Vec::new();
-    let attempts = NODE_SCALES.into_iter().filter_map(|scale| {
-        let factor = scale.max(NODE_MARGIN * delta / BLOCK_NODES[0]);
-        if tried.contains(&factor) {
-            return None;
-        }
-        tried.push(factor);
-        let nodes = BLOCK_NODES.map(|s| s * factor);
-        Some(interpolate(
-            frame, l0, &lp, delta, nu0, nodes, &abscissa, cancel,
-        ))
-    });
-    // the interpolation's refusals name this route, not the Euler subspaces'
     let answer =
-        first_answer(attempts).unwrap_or_else(|| Err(refusal("no set of nodes applies".into())));
+        interpolate_over_node_sets(frame, l0, &lp, delta, nu0, BLOCK_NODES, &abscissa, cancel);
+    // the interpolation's refusals name this route, not the Euler subspaces'
     answer.map_err(|e| match e {
         Error::Unverified { reason, .. } => refusal(reason),
         e => e,
