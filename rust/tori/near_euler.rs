@@ -128,15 +128,21 @@ fn euler_projection(l: &[f64; 6], emb: Embedding) -> (f64, [f64; 6]) {
             emb.state(&std::array::from_fn(|j| 0.5 * (m[j] + s * n[j])))
         }
     };
+    (relative_distance(l, &le), le)
+}
+
+/// `|l − le|/|l|` (2-norm), scaled first so that no square overflows or
+/// underflows; NaN for a zero or non-finite `l`.
+pub(super) fn relative_distance(l: &[f64; 6], le: &[f64; 6]) -> f64 {
     let s = l.iter().fold(0.0f64, |m, v| m.max(v.abs()));
     if s == 0.0 || !s.is_finite() {
-        return (f64::NAN, le);
+        return f64::NAN;
     }
     let all: f64 = l.iter().map(|v| (v / s) * (v / s)).sum();
     let off: f64 = (0..6)
         .map(|q| ((l[q] - le[q]) / s) * ((l[q] - le[q]) / s))
         .sum();
-    ((off / all).sqrt(), le)
+    (off / all).sqrt()
 }
 
 /// The Euler subspaces: the four blocks, then the self-dual and

@@ -199,19 +199,7 @@ fn fit_at(line: &Line, nodes: [f64; 7]) -> Result<([f64; 2], f64, f64)> {
         slope,
         cancel,
     } = *line;
-    let mut f = [[0.0; 2]; 7];
-    for (k, &sigma) in nodes.iter().enumerate() {
-        cancel.check()?;
-        let node: [f64; 6] = std::array::from_fn(|q| le[q] + (l0[q] - le[q]) * (sigma / delta));
-        let e = state_frequencies_plain(frame, &node, cancel);
-        if e.status != Status::Ok {
-            return Err(refusal(format!(
-                "the node at distance {sigma:e} from the block has status '{}'",
-                e.status.name()
-            )));
-        }
-        f[k] = e.nu;
-    }
+    let f = node_frequencies(frame, l0, le, delta, &nodes, "the block", cancel)?;
     let ln: [f64; 7] = nodes.map(|s| (1.0 / s).ln());
     let [r, s] = long_cycle(&f, &ln, slope)?;
     let [p, q] = complement(r, s);
@@ -279,6 +267,34 @@ fn fit_at(line: &Line, nodes: [f64; 7]) -> Result<([f64; 2], f64, f64)> {
     let share = slope * (l - model(&lfit, x, l)).abs() * n2;
     let carry = (n1 - eps * nu_e).abs() / n1.abs();
     Ok((nu, resid, share * carry.max(1.0)))
+}
+
+/// The genus-2 frequencies of the node states `le + σ (l0 − le)/δ` at the
+/// relative distances `nodes` from `le` (named `from` in the refusal of a
+/// node the level set's route refuses).
+pub(super) fn node_frequencies(
+    frame: &TopFrame,
+    l0: &[f64; 6],
+    le: &[f64; 6],
+    delta: f64,
+    nodes: &[f64; 7],
+    from: &str,
+    cancel: &Cancel,
+) -> Result<[[f64; 2]; 7]> {
+    let mut f = [[0.0; 2]; 7];
+    for (k, &sigma) in nodes.iter().enumerate() {
+        cancel.check()?;
+        let node: [f64; 6] = std::array::from_fn(|q| le[q] + (l0[q] - le[q]) * (sigma / delta));
+        let e = state_frequencies_plain(frame, &node, cancel);
+        if e.status != Status::Ok {
+            return Err(refusal(format!(
+                "the node at distance {sigma:e} from {from} has status '{}'",
+                e.status.name()
+            )));
+        }
+        f[k] = e.nu;
+    }
+    Ok(f)
 }
 
 /// The integer combination `(r, s)` (`|r|, |s| ≤` [`MAX_COMB`], coprime) of

@@ -37,11 +37,11 @@
 //! Every answer is bounded by [`NEAR_EULER_RTOL`], as next to the blocks.
 //! Foci and nearly equal normal modes are not answered here.
 
-use super::motion::state_frequencies_plain;
 use super::near_euler::{first_answer, interpolate_over_node_sets, BLOCK_NODES, NEAR_BLOCK_MAX};
-use super::near_euler::{NEAR_EULER_RTOL, NODE_MARGIN};
-use super::near_hyperbolic::{fit_with_slope, HYPERBOLIC_NODES, NODE_SCALES as HYPERBOLIC_SCALES};
-use super::Status;
+use super::near_euler::{relative_distance, NEAR_EULER_RTOL, NODE_MARGIN};
+use super::near_hyperbolic::{
+    fit_with_slope, node_frequencies, HYPERBOLIC_NODES, NODE_SCALES as HYPERBOLIC_SCALES,
+};
 use crate::error::{Error, Result};
 use crate::numeric::cancel::Cancel;
 use crate::so4::PAIRS4;
@@ -79,16 +79,7 @@ fn plane_projection(l: &[f64; 6], plane: [usize; 2]) -> (f64, [f64; 6]) {
     for q in plane {
         lp[q] = l[q];
     }
-    let s = l.iter().fold(0.0f64, |m, v| m.max(v.abs()));
-    if s == 0.0 || !s.is_finite() {
-        return (f64::NAN, lp);
-    }
-    let all: f64 = l.iter().map(|v| (v / s) * (v / s)).sum();
-    let off: f64 = (0..6)
-        .filter(|q| !plane.contains(q))
-        .map(|q| (l[q] / s) * (l[q] / s))
-        .sum();
-    ((off / all).sqrt(), lp)
+    (relative_distance(l, &lp), lp)
 }
 
 /// The linearization of (1) at a state `lp` of a coordinate plane, as the
@@ -415,19 +406,7 @@ fn passes_fit(
     nodes: [f64; 7],
     cancel: &Cancel,
 ) -> Result<([f64; 2], f64)> {
-    let mut f = [[0.0; 2]; 7];
-    for (k, &sigma) in nodes.iter().enumerate() {
-        cancel.check()?;
-        let node: [f64; 6] = std::array::from_fn(|q| lp[q] + (l0[q] - lp[q]) * (sigma / delta));
-        let e = state_frequencies_plain(frame, &node, cancel);
-        if e.status != Status::Ok {
-            return Err(refusal(format!(
-                "the node at distance {sigma:e} from the double saddle has status '{}'",
-                e.status.name()
-            )));
-        }
-        f[k] = e.nu;
-    }
+    let f = node_frequencies(frame, l0, lp, delta, &nodes, "the double saddle", cancel)?;
     let ln = nodes.map(|s| (1.0 / s).ln());
     let xmax = nodes[6] * nodes[6];
     let ys = nodes.map(|s| s * s / xmax);
@@ -445,15 +424,11 @@ fn passes_fit(
         }
     });
     let svd = m.clone().svd(true, true);
-    let range = -MAX_PASSES..=MAX_PASSES;
+    // every integer 2×2 matrix with entries in [−MAX_PASSES, MAX_PASSES]
+    let side = 2 * MAX_PASSES + 1;
+    let entry = |i: i32, k: u32| i / side.pow(k) % side - MAX_PASSES;
     let mut fits: Vec<([[f64; 2]; 2], Vec<f64>, f64)> = Vec::new();
-    for n in range.clone().flat_map(|a| {
-        let r = range.clone();
-        r.flat_map(move |b| {
-            (-MAX_PASSES..=MAX_PASSES)
-                .flat_map(move |c| (-MAX_PASSES..=MAX_PASSES).map(move |d| [a, b, c, d]))
-        })
-    }) {
+    for n in (0..side.pow(4)).map(|i| [entry(i, 0), entry(i, 1), entry(i, 2), entry(i, 3)]) {
         if n[0] * n[3] - n[1] * n[2] == 0 {
             continue;
         }
