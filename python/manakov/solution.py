@@ -656,10 +656,17 @@ class Solution:
           transversally hyperbolic: ``1/ν2`` and ``(ν1 ∓ ν_E)/ν2`` fitted in
           ``ln(1/σ)`` (``σ`` the distance; slope ``2/λ`` for ``1/ν2``, ``λ`` the
           orbit's exponent) to the tori of seven states farther out, under the
-          same bound. :func:`manakov.frequency_map` gives the same numbers.
-          Otherwise the torus's ``ClosedFormError``.
+          same bound. Next to a coordinate plane of equilibria: the same from
+          the equilibrium's normal modes or saddle rates. Where all of these
+          refuse: the frequencies' definition, ``ν = Λ⁻¹ e1`` for the lattice
+          ``Λ`` of times ``(t1, t2)`` after which the flows of ``H`` and of a
+          second Hamiltonian of Manakov's family bring ``l0`` back to itself,
+          from closed orbits integrated in double-double and checked against
+          half steps to 1e-12 (a reduced basis of the same module, which may
+          differ from the torus's). :func:`manakov.frequency_map` gives the same
+          numbers. Otherwise the torus's ``ClosedFormError``.
         * ``"integrated"`` (``l(t)`` by a confirmed integration): the same
-          interpolation where it applies (within ~1e-6 of the self-dual states,
+          routes where they apply (within ~1e-6 of the self-dual states,
           where ``h1² = 4 h0²`` to rounding, the motion is of this kind);
           otherwise ``ClosedFormError``.
         * ``"euler"``: the orbit is closed (a 1-torus); ``ν2 = ν_E = ω/(4K)``, its
@@ -690,12 +697,16 @@ class Solution:
         return self._freq
 
     def _near_euler(self, refused: Exception) -> np.ndarray:
-        """The frequencies interpolated next to an Euler subspace, kept; else the
-        original refusal, which names its cause."""
+        """The frequencies interpolated next to an Euler subspace or a coordinate
+        plane, else those of the closed orbits of the commuting flows, kept; else
+        the original refusal, which names its cause."""
         try:
             nu = self._motion.near_euler_frequencies()
         except _core.ClosedFormError:
-            raise refused from None
+            try:
+                nu = self._motion.closed_orbit_frequencies()
+            except _core.ClosedFormError:
+                raise refused from None
         self._freq = _frozen(np.array(nu))
         return self._freq
 

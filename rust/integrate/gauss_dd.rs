@@ -142,6 +142,14 @@ fn step(d: &[Dd; 12], y: &mut [Dd; 6], h: Dd, k: &mut [[Dd; 6]; S]) -> Result<()
     })
 }
 
+/// One step of length `h` from `y` for the differences `d` ([`diffs`]), the
+/// stage iteration started from the field at `y`.
+pub(crate) fn advance(d: &[Dd; 12], y: &mut [Dd; 6], h: Dd) -> Result<()> {
+    let f0 = field(d, y);
+    let mut k = [f0; S];
+    step(d, y, h, &mut k)
+}
+
 /// Steps [`gauss16_dd_so4`] takes to reach the sorted times `times` from 0 at
 /// steps of at most `dt`, each split in `split`.
 pub(crate) fn gauss16_dd_steps(times: &[f64], dt: f64, split: u32) -> f64 {
@@ -194,9 +202,7 @@ pub(crate) fn gauss16_dd_so4(
             let h = span.div(Dd::new(n));
             for _ in 0..n as u64 {
                 cancel.check()?;
-                let f0 = field(&d, &y);
-                let mut k = [f0; S];
-                step(&d, &mut y, h, &mut k)?;
+                advance(&d, &mut y, h)?;
             }
         }
         prev = t;

@@ -13,7 +13,7 @@ use crate::numeric::alloc::try_with_capacity;
 use crate::solution::jacobi::Jacobi;
 use crate::solution::motion::{Kind, Motion};
 use crate::solution::transverse::euler_frequencies_with;
-use crate::tori::motion::torus_of_motion;
+use crate::tori::motion::{closed_orbit_frequencies_of_state, torus_of_motion};
 use crate::tori::near_euler::near_euler_frequencies;
 use crate::tori::near_plane::near_plane_frequencies;
 
@@ -158,6 +158,15 @@ impl MotionCore {
     fn near_plane_frequencies(&self, py: Python<'_>) -> PyResult<[f64; 2]> {
         let cancel = py_cancel();
         Ok(py.detach(|| near_plane_frequencies(self.motion.frame(), self.motion.l0(), &cancel))?)
+    }
+
+    /// The frequency map's last route alone (`crate::tori::closed_orbits`),
+    /// for checks against the genus-2 torus where both answer.
+    fn closed_orbit_frequencies(&self, py: Python<'_>) -> PyResult<[f64; 2]> {
+        let cancel = py_cancel();
+        Ok(py.detach(|| {
+            closed_orbit_frequencies_of_state(self.motion.frame(), self.motion.l0(), &cancel)
+        })?)
     }
 
     /// `(ν1, ν2)` of the closed forms (user's time): `(ν_⊥, ν_E)` of

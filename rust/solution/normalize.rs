@@ -224,6 +224,15 @@ impl TopFrame {
     /// `|p2| > |p3| max|a'|`, else `a'²`; `p2, p3` from divided differences of
     /// `c'` (second differences of `b'`).
     pub fn second_flow_b(&self) -> [f64; 4] {
+        if self.second_flow_power() == 3 {
+            self.a.map(|x| x * x * x)
+        } else {
+            self.a.map(|x| x * x)
+        }
+    }
+
+    /// The power `k` of `b' = a'^k` in [`Self::second_flow_b`]: 3 or 2.
+    pub fn second_flow_power(&self) -> i32 {
         let a = &self.a;
         let c = &self.c4;
         // b[1,2,3] = (c23 − c12)/(a3 − a1), b[2,3,4] = (c34 − c23)/(a4 − a2).
@@ -233,9 +242,9 @@ impl TopFrame {
         let p2 = b123 - p3 * (a[0] + a[1] + a[2]);
         let s = a.iter().fold(0.0f64, |m, x| m.max(x.abs()));
         if p2.abs() > p3.abs() * s {
-            a.map(|x| x * x * x)
+            3
         } else {
-            a.map(|x| x * x)
+            2
         }
     }
 }

@@ -32,12 +32,15 @@
 //! the tori of states farther out; next to a transversally hyperbolic block
 //! orbit [`near_hyperbolic`] fits them in `ln(1/σ)` with the orbit's own
 //! exponent; next to a coordinate plane of equilibria [`near_plane`] takes
-//! them from the equilibrium's linearization.
+//! them from the equilibrium's linearization; where every one of these
+//! refuses, [`closed_orbits`] finds the lattice of the two commuting flows'
+//! periods by integration in double-double.
 //!
 //! [`map_states`] runs a per-state function over a batch in parallel (rayon),
 //! in waves between which the caller's [`Cancel`] is checked; the results do
 //! not depend on the number of threads or on how the batch is split.
 
+pub mod closed_orbits;
 pub mod motion;
 pub mod near_euler;
 pub mod near_hyperbolic;

@@ -4,7 +4,7 @@
 //!
 //! | kind | status | `(ν1, ν2)` |
 //! |---|---|---|
-//! | genus-2 | as before ([`super::solve`]), on the normalized data | the real torus's, times `T` |
+//! | genus-2 | as before ([`super::solve`]), on the normalized data; where it refuses, the routes next to degenerate sets ([`super::near_euler`]), then the closed orbits ([`super::closed_orbits`]) | the real torus's, times `T` |
 //! | Euler (block or self-dual) | [`Status::Ok`] | `(ν_E, ν_⊥)` of [`crate::solution::transverse`] |
 //! | separatrix | [`Status::Separatrix`] | NaN |
 //! | equilibrium, spherical top | [`Status::Equilibrium`] | NaN |
@@ -15,6 +15,7 @@
 
 use num_complex::Complex64 as C;
 
+use super::closed_orbits::closed_orbit_frequencies;
 use super::near_euler::near_euler_frequencies;
 use super::solve::{classify as classify_error, flow_data_with, level_set_entry_with};
 use super::{real_torus_with_rates, MapEntry, RealTorus, Status};
@@ -48,8 +49,29 @@ pub fn state_frequencies_in_with(frame: &TopFrame, l0: &[f64; 6], cancel: &Cance
             status: Status::Ok,
             nu,
         },
-        Err(_) => entry,
+        // Where those refuse too, the frequencies' definition: the closed
+        // orbits of the two commuting flows (docs/degenerate.md §11).
+        Err(Error::Interrupted) => entry,
+        Err(_) => match closed_orbit_frequencies_of_state(frame, l0, cancel) {
+            Ok(nu) => MapEntry {
+                status: Status::Ok,
+                nu,
+            },
+            Err(_) => entry,
+        },
     }
+}
+
+/// [`closed_orbit_frequencies`] of the user's state `l0`, per unit of the
+/// user's time.
+pub fn closed_orbit_frequencies_of_state(
+    frame: &TopFrame,
+    l0: &[f64; 6],
+    cancel: &Cancel,
+) -> Result<[f64; 2]> {
+    let (_, scale, ln) = classify(frame, l0);
+    let t_scale = scale * frame.lambda;
+    closed_orbit_frequencies(frame, &ln, cancel).map(|nu| nu.map(|v| v * t_scale))
 }
 
 /// Whether a genus-2 state refused with this status may be answered by

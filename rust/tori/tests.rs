@@ -1288,26 +1288,29 @@ fn next_to_a_hyperbolic_block_the_frequencies_follow_the_orbits_exponent() {
 }
 
 /// The smallest miss of `g` by `M f` over the unimodular integer matrices `M`
-/// with entries up to 8, relative per component (`|(M f)_i| − g_i` over
-/// `g_i`), max over the two: whether two frequency pairs span the same module.
+/// whose first column has entries up to 64 (the second is then the nearest
+/// integer), relative per component (`|(M f)_i| − g_i` over `g_i`), max over
+/// the two: whether two frequency pairs span the same module. Wide enough for
+/// bases of very different frequencies, where `M` has entries like 19.
 pub(super) fn module_miss(f: &[f64; 2], g: &[f64; 2]) -> f64 {
+    // for each g_i, the integer pairs (p, q) with |p f1 + q f2| nearest to it
+    let rows = |gi: f64| -> Vec<(i64, i64, f64)> {
+        (-64i64..=64)
+            .flat_map(|p| {
+                [1.0, -1.0].map(move |sign: f64| {
+                    let q = ((sign * gi - p as f64 * f[0]) / f[1]).round();
+                    let h = p as f64 * f[0] + q * f[1];
+                    (p, q as i64, (h.abs() - gi).abs() / gi)
+                })
+            })
+            .collect()
+    };
+    let (r1, r2) = (rows(g[0]), rows(g[1]));
     let mut miss = f64::INFINITY;
-    for p in -8i32..=8 {
-        for q in -8i32..=8 {
-            for r in -8i32..=8 {
-                for s in -8i32..=8 {
-                    if (p * s - q * r).abs() != 1 {
-                        continue;
-                    }
-                    let h = [
-                        f64::from(p) * f[0] + f64::from(q) * f[1],
-                        f64::from(r) * f[0] + f64::from(s) * f[1],
-                    ];
-                    let m = (0..2)
-                        .map(|i| (h[i].abs() - g[i]).abs() / g[i])
-                        .fold(0.0f64, f64::max);
-                    miss = miss.min(m);
-                }
+    for &(p, q, e1) in &r1 {
+        for &(r, s, e2) in &r2 {
+            if (p * s - q * r).abs() == 1 {
+                miss = miss.min(e1.max(e2));
             }
         }
     }
