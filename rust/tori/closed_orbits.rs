@@ -19,32 +19,39 @@
 //! once `Δ` is that small: a state at relative distance `σ` from a plane of
 //! equilibria has `Δ ~ σ² |l|²`, `1e-18 |l|²` at `σ = 1e-9`. Gauss collocation
 //! keeps every quadratic invariant to rounding, so in double-double
-//! ([`crate::integrate::gauss_dd`]) the level stays within `~1e-32 |l|²`.
+//! (`crate::integrate::gauss_dd`) the level stays within `~1e-32 |l|²`.
 //!
-//! **Algorithm** (normalized frame, so `|c|` and the time scale are `O(1)`).
-//! 1. *Base point* `x`: the fastest point of the orbit of `H` over its first
-//!    [`BASE_STEPS`] steps, away from the equilibria the torus may pass close
-//!    to, where the closures below are ill conditioned.
-//! 2. *Search*: the orbit of `H` from `x`; every local minimum of `|y(t) − x|`
-//!    (over the steps) below [`CANDIDATE_FRACTION`] of the orbit's extent so
-//!    far is a candidate return.
-//! 3. *Closure*: Gauss–Newton on `(δ1, δ2)` such that the time-1 flow of
-//!    `δ1 c + δ2 c'` carries the candidate `y(τ)` to `x` exactly (to
+//! **Algorithm** (normalized frame).
+//! 1. *Steps and base point.* Steps of `STEP_THETA` over the largest
+//!    modulus `ρ` of the Jacobian's eigenvalues along the first [`BASE_STEPS`]
+//!    steps of the orbit of `H`; the base point `x` is the fastest point of
+//!    those, away from the equilibria the torus may pass close to, where the
+//!    closures below are ill conditioned.
+//! 2. *First return.* Along the orbit of `H` from `x`, every local minimum
+//!    (over the steps) of `|y − x|` below [`CANDIDATE_FRACTION`] of the
+//!    orbit's extent so far is a candidate.
+//! 3. *Closure* (`Flows::close`): Gauss–Newton on `(δ1, δ2)` such that the
+//!    time-1 flow of `δ1 c + δ2 c'` carries the candidate `y(τ)` to `x` (to
 //!    [`CLOSE_RTOL`] of the extent); as the flows commute, `(τ + δ1, δ2) ∈ Λ`.
 //!    A candidate on another sheet of the torus (next to a saddle the torus
-//!    passes close to itself) does not converge and is dropped.
-//! 4. *Lattice*: the one the closures generate (a closure that is a rational,
-//!    not integer, combination of the basis refines it). The search stops once
-//!    [`MIN_CLOSURES`] closures are in and the last [`STABLE_CLOSURES`] of them
-//!    left the lattice as it was. The returns closest to `x` are the
-//!    convergents of the torus's rotation number, two consecutive of which
-//!    generate `Λ` (the first return map is a circle rotation).
-//! 5. *Check*: the whole computation again with every step halved (order 16:
-//!    the difference is the default step's truncation error); both must agree
-//!    to [`CHECK_RTOL`], and the half steps' frequencies are returned.
+//!    passes close to itself) does not converge and is dropped; so is a
+//!    closure shorter than `MIN_RETURN`.
+//! 4. *Across.* The first return `v` is often a near-period of a nearly
+//!    periodic orbit of `H`, which would drift for a whole slow period before
+//!    its next return. The loop `γ(r) = φ_{r v}(x)` is sampled; its returns to
+//!    `x` refine `v` where it is a multiple; the orbit of the flow orthogonal to
+//!    `v` (in the metric of radians of each flow's rate) crosses `γ` at lattice
+//!    vectors, closed the same way, until [`MIN_CLOSURES`] are in and the last
+//!    [`STABLE_CLOSURES`] left the lattice they generate as it was (a closure
+//!    that is a rational, not integer, combination of the basis refines it).
+//! 5. *Torsion.* A crossing the search missed leaves a sublattice: the points
+//!    `(i λ1 + j λ2)/p` for `p` in `TORSION_PRIMES` are tried directly.
+//! 6. *Check*: steps 2–5 again with every step halved (order 16: the
+//!    difference is the default step's truncation error); the lattices must
+//!    agree to [`CHECK_RTOL`], and the half steps' frequencies are returned.
 //!
 //! **Basis.** Lagrange–Gauss reduced in the metric that counts each flow's
-//! time in units of its own step scale, `‖λ1‖ ≤ ‖λ2‖`, signs with `ν ≥ 0`.
+//! time in radians of its rate, `‖λ1‖ ≤ ‖λ2‖`, signs with `ν ≥ 0`.
 //! It is a basis of the same frequency module as the genus-2 torus's, which
 //! may present it in another basis (compare modules, not entries).
 
@@ -54,8 +61,9 @@ use crate::numeric::cancel::Cancel;
 use crate::numeric::dd::Dd;
 use crate::solution::normalize::TopFrame;
 
-/// Steps of the orbit of `H` over which the base point is chosen (about
-/// `BASE_STEPS / (2π)` periods of the fastest linear motion on the torus).
+/// Steps of the orbit of `H` over which the base point and the rates are
+/// found (about `BASE_STEPS · STEP_THETA / (2π) ≈ 40` periods of the fastest
+/// linear motion on the torus).
 pub const BASE_STEPS: usize = 512;
 
 /// Local minima of `|y(t) − x|` below this fraction of the orbit's extent
@@ -86,9 +94,11 @@ pub const COORDINATE_TOL: f64 = 1e-7;
 /// largest entry of the basis).
 pub const CHECK_RTOL: f64 = 1e-12;
 
-/// Most double-double steps of one run (search and closures), checked as
-/// they are taken; a state that needs more is refused. About 0.03 ms each.
-pub const MAX_DD_STEPS: usize = 200_000;
+/// Most double-double steps of the run at the default step (search and
+/// closures; twice as many at half steps), checked as they are taken; a state
+/// that needs more is refused. About 0.1 ms each, so a refusal costs ~6 s;
+/// on the harsh draw the states answered took at most ~3e4.
+pub const MAX_DD_STEPS: usize = 60_000;
 
 /// Closures shorter than this (in radians of the flows' rates) are returns to
 /// the start, not lattice vectors: a periodic orbit of a field with Lipschitz
@@ -109,7 +119,9 @@ const TORSION_PRIMES: [i64; 2] = [2, 3];
 const NEWTON_MAX: usize = 16;
 
 /// Step times the largest modulus of the field's Jacobian eigenvalues over
-/// the base phase: order 16 leaves `~(1/4)^17 · 4e-10 ~ 2e-20` per step.
+/// the base phase: the 8-stage Gauss method's error constant is
+/// `(8!)⁴/(16! 17!) ~ 3.5e-10`, so its relative phase error per period is
+/// `~(1/2)^16 · 3.5e-10 ~ 5e-15`; the half steps' check measures it.
 /// The eigenvalues, not `(max c − min c) max |l_q|`: on states whose
 /// components span many orders of magnitude the latter is up to ~1e3 times
 /// the motion's rates.
@@ -185,9 +197,10 @@ impl Flows {
     fn count(&mut self, n: usize, cancel: &Cancel) -> Result<()> {
         cancel.check()?;
         self.steps += n;
-        if self.steps > MAX_DD_STEPS {
+        let limit = MAX_DD_STEPS * self.split as usize;
+        if self.steps > limit {
             return Err(refusal(format!(
-                "the search for closed orbits needs more than {MAX_DD_STEPS} steps in \
+                "the search for closed orbits needs more than {limit} steps in \
                  double-double (the torus's periods are too long next to its fastest rate)"
             )));
         }
@@ -208,7 +221,7 @@ impl Flows {
         });
         let rate = delta[0].abs() * self.rho[0] + delta[1].abs() * self.rho[1];
         let n = (rate / STEP_THETA).ceil().max(1.0) * f64::from(self.split);
-        if n.is_nan() || n > MAX_DD_STEPS as f64 {
+        if n.is_nan() || n > (MAX_DD_STEPS * self.split as usize) as f64 {
             return Err(refusal("a closure's correction is out of range".into()));
         }
         let n = n as usize;
