@@ -429,7 +429,7 @@ fn search(
     }
 }
 
-/// Steps 2–4 of the module doc: the reduced basis of the lattice `Λ_s`
+/// Steps 2–5 of the module doc: the reduced basis of the lattice `Λ_s`
 /// (each flow's time in units of its rate, `f.rho`) from the base point `x`,
 /// with every step split in `split`.
 fn run(f: &mut Flows, x: &[Dd; 6], split: u32, cancel: &Cancel) -> Result<[[f64; 2]; 2]> {

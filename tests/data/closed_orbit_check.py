@@ -10,7 +10,7 @@ functions, so the genus-2 torus (``sol.torus``) is an independent reference.
 Part 1: every STRIDE-th state of the harsh draw (tests/data/every_state_harsh.py,
 seed 20261125) whose genus-2 torus is answered is given to the closed-orbit
 route directly; the two frequency pairs must span the same module (a unimodular
-integer matrix, entries up to 8) to the reported relative error (max norm).
+integer matrix, first column up to 1024) to the reported relative error (max norm).
 Part 2: every state of the draw (or of ``N``) that the map answers only by
 this route, with its frequencies and time.
 
@@ -31,12 +31,35 @@ import numpy as np
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
 
 from every_state_harsh import draw  # noqa: E402
-from plane_equilibrium_check import module_error  # noqa: E402
 
 import manakov  # noqa: E402
 
 #: the bound the frequency map states for its interpolated and fitted routes
 BOUND = 5e-11
+#: largest first-column entry of the unimodular matrices searched: the harsh draw's
+#: frequencies differ by up to 1e5, and bases by matrices with entries like 400
+WIDTH = 1024
+
+
+def module_error(f, g) -> float:
+    """Smallest relative (max-norm) miss of ``g`` by ``M f``, ``M`` unimodular with
+    first column up to WIDTH (the second the nearest integers)."""
+    f, g = np.asarray(f, float), np.abs(np.asarray(g, float))
+    rows = []
+    for gi in g:
+        p = np.arange(-WIDTH, WIDTH + 1)[:, None]
+        sign = np.array([1.0, -1.0])[None, :]
+        q = np.round((sign * gi - p * f[0]) / f[1])
+        e = np.abs(np.abs(p * f[0] + q * f[1]) - gi) / np.max(g)
+        rows.append((np.broadcast_to(p, q.shape).ravel(), q.ravel(), e.ravel()))
+    (p1, q1, e1), (p2, q2, e2) = rows
+    # the best few candidates of each row, paired where unimodular
+    best = np.inf
+    for i in np.argsort(e1)[:64]:
+        for j in np.argsort(e2)[:64]:
+            if abs(p1[i] * q2[j] - q1[i] * p2[j]) == 1:
+                best = min(best, max(e1[i], e2[j]))
+    return float(best)
 
 
 def main(n: int = 10_000, stride: int = 50) -> None:
