@@ -305,8 +305,9 @@ def frequency_map(
     equilibrium's normal modes or saddle rates alike. Where all of these refuse,
     ``ν = Λ⁻¹ e1`` for the lattice ``Λ`` of times ``(t1, t2)`` after which the
     flows of ``H`` and of a second Hamiltonian of Manakov's family bring the state
-    back to itself, from closed orbits integrated in double-double (up to 2·10⁵
-    steps, about 20 s) and checked against half steps to 1e-12.
+    back to itself, from closed orbits integrated in double-double (up to 6·10⁴
+    steps, about 6 s, then again at half steps) and checked against the half
+    steps to 1e-12.
 
     Parameters
     ----------
