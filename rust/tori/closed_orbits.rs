@@ -194,6 +194,20 @@ struct Flows {
 }
 
 impl Flows {
+    fn new(frame: &TopFrame) -> Flows {
+        let c: [Dd; 6] = std::array::from_fn(|q| Dd::sum(frame.c4[q], frame.c4_lo[q]));
+        let c2 = second_flow_c(frame);
+        Flows {
+            d: diffs(&c),
+            d2: diffs(&c2),
+            c,
+            c2,
+            rho: [0.0; 2],
+            split: 1,
+            steps: 0,
+        }
+    }
+
     fn count(&mut self, n: usize, cancel: &Cancel) -> Result<()> {
         cancel.check()?;
         self.steps += n;
@@ -214,19 +228,13 @@ impl Flows {
 
     /// `φ'_{δ2} ∘ φ_{δ1}(y)`: the time-1 flow of `δ1 c + δ2 c'`.
     fn both(&mut self, y: &[Dd; 6], delta: [f64; 2], cancel: &Cancel) -> Result<[Dd; 6]> {
-        let c: [Dd; 6] = std::array::from_fn(|q| {
-            self.c[q]
-                .mul_f64(delta[0])
-                .add(self.c2[q].mul_f64(delta[1]))
-        });
-        let rate = delta[0].abs() * self.rho[0] + delta[1].abs() * self.rho[1];
-        let n = (rate / STEP_THETA).ceil().max(1.0) * f64::from(self.split);
+        let n = (rate_of(self, delta) / STEP_THETA).ceil().max(1.0) * f64::from(self.split);
         if n.is_nan() || n > (MAX_DD_STEPS * self.split as usize) as f64 {
             return Err(refusal("a closure's correction is out of range".into()));
         }
         let n = n as usize;
         self.count(n, cancel)?;
-        let d = diffs(&c);
+        let d = diffs(&combined(self, delta));
         let h = Dd::new(1.0).div(Dd::new(n as f64));
         let mut out = *y;
         for _ in 0..n {
@@ -313,22 +321,6 @@ fn rate(d: &[Dd; 12], y: &[Dd; 6]) -> f64 {
             .iter()
             .fold(0.0f64, |m, z| m.max(z.norm())),
         None => j.norm(),
-    }
-}
-
-impl Flows {
-    fn new(frame: &TopFrame) -> Flows {
-        let c: [Dd; 6] = std::array::from_fn(|q| Dd::sum(frame.c4[q], frame.c4_lo[q]));
-        let c2 = second_flow_c(frame);
-        Flows {
-            d: diffs(&c),
-            d2: diffs(&c2),
-            c,
-            c2,
-            rho: [0.0; 2],
-            split: 1,
-            steps: 0,
-        }
     }
 }
 
@@ -458,12 +450,14 @@ fn run(f: &mut Flows, x: &[Dd; 6], split: u32, cancel: &Cancel) -> Result<[[f64;
         loop_samples.push((y, [v[0] * k as f64 / m as f64, v[1] * k as f64 / m as f64]));
         advance(&d, &mut y, hd)?;
     }
-    let extent = loop_samples
+    let dist: Vec<f64> = loop_samples
         .iter()
-        .fold(0.0f64, |e, (s, _)| e.max(norm(&diff(s, x))));
+        .map(|(s, _)| norm(&diff(s, x)))
+        .collect();
+    let extent = dist.iter().fold(0.0f64, |e, d| e.max(*d));
     for k in 1..m.saturating_sub(1) {
-        let dk = |k: usize| norm(&diff(&loop_samples[k].0, x));
-        if dk(k) < dk(k - 1) && dk(k) <= dk(k + 1) && dk(k) < CANDIDATE_FRACTION * extent {
+        if dist[k] < dist[k - 1] && dist[k] <= dist[k + 1] && dist[k] < CANDIDATE_FRACTION * extent
+        {
             let got = f.close(x, &loop_samples[k].0, loop_samples[k].1, extent, cancel)?;
             if let Some(w) = got.filter(|w| rate_of(f, *w) >= MIN_RETURN) {
                 lattice.add(scaled(w))?;
@@ -615,8 +609,7 @@ impl Lattice {
             let nv = v[0].hypot(v[1]);
             let nw = w[0].hypot(w[1]);
             if det.abs() > 1e-6 * nv * nw {
-                self.basis = Some([v, w]);
-                self.basis = Some(self.reduced()?);
+                self.basis = Some(gauss_reduced([v, w]));
                 return Ok(true);
             }
             // collinear: w = (p/m) v generates v/m with gcd(p, m) = 1
@@ -659,30 +652,35 @@ impl Lattice {
                 (x as f64 * b1[1] + y as f64 * b2[1]) / mf,
             ]
         };
-        self.basis = Some([comb(g[0], g[1]), comb(0, h)]);
-        self.basis = Some(self.reduced()?);
+        self.basis = Some(gauss_reduced([comb(g[0], g[1]), comb(0, h)]));
         Ok(true)
     }
 
-    /// The Lagrange–Gauss reduced basis (columns), `‖λ1‖ ≤ ‖λ2‖`.
+    /// The basis (columns), reduced; a refusal before two independent
+    /// closures are in.
     fn reduced(&self) -> Result<[[f64; 2]; 2]> {
-        let [mut u, mut v] = self
-            .basis
-            .ok_or_else(|| refusal("the closed orbits found span no lattice of rank 2".into()))?;
-        let n2 = |a: [f64; 2]| a[0] * a[0] + a[1] * a[1];
-        if n2(u) > n2(v) {
-            std::mem::swap(&mut u, &mut v);
-        }
-        for _ in 0..64 {
-            let k = ((u[0] * v[0] + u[1] * v[1]) / n2(u)).round();
-            v = [v[0] - k * u[0], v[1] - k * u[1]];
-            if n2(v) >= n2(u) {
-                break;
-            }
-            std::mem::swap(&mut u, &mut v);
-        }
-        Ok([u, v])
+        self.basis
+            .ok_or_else(|| refusal("the closed orbits found span no lattice of rank 2".into()))
     }
+}
+
+/// The Lagrange–Gauss reduced basis of the lattice of the columns `b`,
+/// `‖λ1‖ ≤ ‖λ2‖`.
+fn gauss_reduced(b: [[f64; 2]; 2]) -> [[f64; 2]; 2] {
+    let [mut u, mut v] = b;
+    let n2 = |a: [f64; 2]| a[0] * a[0] + a[1] * a[1];
+    if n2(u) > n2(v) {
+        std::mem::swap(&mut u, &mut v);
+    }
+    for _ in 0..64 {
+        let k = ((u[0] * v[0] + u[1] * v[1]) / n2(u)).round();
+        v = [v[0] - k * u[0], v[1] - k * u[1]];
+        if n2(v) >= n2(u) {
+            break;
+        }
+        std::mem::swap(&mut u, &mut v);
+    }
+    [u, v]
 }
 
 #[cfg(test)]
